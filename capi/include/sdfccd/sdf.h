@@ -1,0 +1,108 @@
+/* SPDX-License-Identifier: MIT */
+/** @file sdf.h  Signed distance fields: analytic shapes, CSG, user callbacks, and evaluation.
+ *
+ * Conventions: metres; phi < 0 inside, phi > 0 outside; the gradient points outward and is
+ * the contact normal. An SDF lives in its own local frame; queries place it in the world
+ * with a pose or a rigid motion (ccd.h).
+ *
+ * Handles are small values. A null handle has index1 == 0. Destroying a handle that a
+ * combination (union, transform...) still uses is allowed: the combination keeps the
+ * shape alive until it is destroyed itself.
+ */
+#ifndef SDFCCD_SDF_H
+#define SDFCCD_SDF_H
+
+#include "types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Handle to an SDF. Generation-checked: a stale handle gives ::SDFCCD_INVALID_HANDLE. */
+typedef struct sdfccd_SdfId { uint32_t index1; uint32_t generation; } sdfccd_SdfId;
+
+/** Kinds of SDF, as reported by sdfccd_sdf_get_info(). */
+typedef enum sdfccd_SdfKind {
+    SDFCCD_SDF_SPHERE, SDFCCD_SDF_BOX, SDFCCD_SDF_ROUNDED_BOX, SDFCCD_SDF_TORUS, SDFCCD_SDF_CAPSULE,
+    SDFCCD_SDF_CYLINDER, SDFCCD_SDF_HALF_SPACE, SDFCCD_SDF_SPIKE_GRID, SDFCCD_SDF_CSG,
+    SDFCCD_SDF_TRANSFORM, SDFCCD_SDF_CALLBACK, SDFCCD_SDF_GRID, SDFCCD_SDF_KIND_COUNT
+} sdfccd_SdfKind;
+
+/** Sphere of radius `radius` > 0 centred at the origin. Exact distance. */
+SDFCCD_API sdfccd_Status sdfccd_create_sphere(double radius, sdfccd_SdfId* out_sdf);
+/** Box with half extents `half` (all > 0), centred at the origin, axis-aligned. Exact distance. */
+SDFCCD_API sdfccd_Status sdfccd_create_box(sdfccd_Vec3 half, sdfccd_SdfId* out_sdf);
+/** Box of half extents `half` whose edges and corners are rounded with radius `radius`
+ * (0 <= radius <= min half extent); the outer size stays `half`. Exact distance. */
+SDFCCD_API sdfccd_Status sdfccd_create_rounded_box(sdfccd_Vec3 half, double radius, sdfccd_SdfId* out_sdf);
+/** Torus around the z axis, ring radius `major` > `minor` > 0, in the xy plane. Exact distance. */
+SDFCCD_API sdfccd_Status sdfccd_create_torus(double major, double minor, sdfccd_SdfId* out_sdf);
+/** Capsule along z: segment from (0,0,-half_height) to (0,0,+half_height), radius `radius`. Exact. */
+SDFCCD_API sdfccd_Status sdfccd_create_capsule(double half_height, double radius, sdfccd_SdfId* out_sdf);
+/** Solid cylinder along z, |z| <= half_height, radius `radius`, flat caps. Exact distance. */
+SDFCCD_API sdfccd_Status sdfccd_create_cylinder(double half_height, double radius, sdfccd_SdfId* out_sdf);
+/** Half-space {x : dot(normal, x) <= offset}; `normal` is normalised. Exact distance (phi is linear). */
+SDFCCD_API sdfccd_Status sdfccd_create_half_space(sdfccd_Vec3 normal, double offset, sdfccd_SdfId* out_sdf);
+
+/** The paper's spike grid (Fig. 10, Table 3): a square field of upright cones on a ground
+ * plane z = 0. Cones are spaced `spacing` apart in x and y, centred on the origin, `count_x`
+ * by `count_y` of them; each has base radius `base_radius` (<= spacing / 2) and height
+ * `height`. phi is the exact distance to the union of the ground slab (z <= 0) and the nearest
+ * cones (each point tests the cones of its own and the 8 neighbouring cells), so it is
+ * 1-Lipschitz. Beyond the grid's edge only the ground remains. */
+typedef struct sdfccd_SpikeGridDef {
+    double spacing;
+    double base_radius;
+    double height;
+    int32_t count_x, count_y;
+    int32_t internal_value; /**< Set by sdfccd_default_spike_grid_def(); do not change. */
+} sdfccd_SpikeGridDef;
+/** Defaults: spacing 0.1 m, base radius 0.05 m, height 0.1 m, 20 x 20 cones. */
+SDFCCD_API sdfccd_SpikeGridDef sdfccd_default_spike_grid_def(void);
+SDFCCD_API sdfccd_Status sdfccd_create_spike_grid(const sdfccd_SpikeGridDef* def, sdfccd_SdfId* out_sdf);
+
+/** Boolean combinations. Union = min(a, b); intersection = max(a, b); difference (a minus b)
+ * = max(a, -b). The results are 1-Lipschitz but are exact distances only outside (union) or in
+ * simple cases; the certified method relies only on the Lipschitz bound. */
+typedef enum sdfccd_CsgOp { SDFCCD_CSG_UNION, SDFCCD_CSG_INTERSECTION, SDFCCD_CSG_DIFFERENCE } sdfccd_CsgOp;
+SDFCCD_API sdfccd_Status sdfccd_create_csg(sdfccd_CsgOp op, sdfccd_SdfId a, sdfccd_SdfId b, sdfccd_SdfId* out_sdf);
+
+/** `child` placed with `pose` and uniformly scaled by `scale` > 0:
+ * phi(x) = scale * phi_child(inverse(pose)(x) / scale). Rigid motion and uniform scale keep distances exact. */
+SDFCCD_API sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, double scale, sdfccd_SdfId* out_sdf);
+
+/** A user SDF. `eval` returns phi at p (local frame) and writes the gradient to *out_grad when
+ * out_grad is not NULL. It must be pure and thread-safe. `lipschitz` bounds |grad phi|
+ * everywhere (1 for a true distance field); the certified method is only as sound as this bound.
+ * `bounds` must contain every point with phi <= 0 (use +-INFINITY if unbounded). */
+typedef double sdfccd_SdfEvalFcn(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user);
+typedef struct sdfccd_CallbackSdfDef {
+    sdfccd_SdfEvalFcn* eval;
+    void* user;
+    double lipschitz;
+    sdfccd_Aabb bounds;
+    int32_t internal_value; /**< Set by sdfccd_default_callback_sdf_def(); do not change. */
+} sdfccd_CallbackSdfDef;
+/** Defaults: eval NULL (must be set), user NULL, lipschitz 1, infinite bounds. */
+SDFCCD_API sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void);
+SDFCCD_API sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfccd_SdfId* out_sdf);
+
+/** Releases the handle. The shape's memory is freed once no combination uses it. */
+SDFCCD_API sdfccd_Status sdfccd_destroy_sdf(sdfccd_SdfId sdf);
+
+/** Value (and gradient when out_grad is not NULL) at p, in the SDF's local frame. */
+SDFCCD_API sdfccd_Status sdfccd_sdf_eval(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad);
+
+typedef struct sdfccd_SdfInfo {
+    sdfccd_SdfKind kind;
+    sdfccd_Aabb domain;   /**< Where values are exact (a grid's box); +-INFINITY for analytic shapes. */
+    sdfccd_Aabb bounds;   /**< Contains every point with phi <= 0 (may be infinite). */
+    double lipschitz;     /**< Global bound on |grad phi|. */
+    int64_t memory_bytes; /**< Bytes owned by this shape alone (children not counted). */
+} sdfccd_SdfInfo;
+SDFCCD_API sdfccd_Status sdfccd_sdf_get_info(sdfccd_SdfId sdf, sdfccd_SdfInfo* out_info);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

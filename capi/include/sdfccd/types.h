@@ -1,0 +1,31 @@
+/* SPDX-License-Identifier: MIT */
+/** @file types.h  Plain value types shared by the whole ABI. All scalars are double, metres and seconds. */
+#ifndef SDFCCD_TYPES_H
+#define SDFCCD_TYPES_H
+
+#include "base.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A point or vector in metres (or m/s, rad/s). */
+typedef struct sdfccd_Vec3 { double x, y, z; } sdfccd_Vec3;
+
+/** A unit quaternion, scalar part first (w, x, y, z), as in the case file. Non-unit input is
+ * normalised by the functions that take it; a zero quaternion is rejected. */
+typedef struct sdfccd_Quat { double w, x, y, z; } sdfccd_Quat;
+
+/** A rigid pose: x_world = rotate(orientation, x_local) + position. */
+typedef struct sdfccd_Pose { sdfccd_Vec3 position; sdfccd_Quat orientation; } sdfccd_Pose;
+
+/** An axis-aligned box. */
+typedef struct sdfccd_Aabb { sdfccd_Vec3 lo, hi; } sdfccd_Aabb;
+
+/** The identity pose. */
+SDFCCD_API sdfccd_Pose sdfccd_pose_identity(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

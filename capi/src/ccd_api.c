@@ -1,0 +1,303 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd C ABI: query parameters, rigid motions and the triangle and mesh queries. Validates
+ * every input, converts to the core's SDF-frame problem, and maps results back to the world. */
+#include "capi_internal.h"
+#include "../../core/ccd.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#define DEF_COOKIE 0x5DFCCD01
+
+sdfccd_QueryParams sdfccd_default_query_params(void)
+{
+    sdfccd_QueryParams p;
+    memset(&p, 0, sizeof p);
+    p.method = SDFCCD_METHOD_FWGSS;
+    p.margin = 0.0;
+    p.time_tolerance = 1e-7;
+    p.distance_tolerance = 1e-7;
+    p.max_iterations = 32;
+    p.max_line_search_iterations = 64;
+    p.subdivision = 1;
+    p.subdivision_min_area = 1e-6;
+    p.contact_slop = 1e-4;
+    p.toi_window = 1e-5;
+    p.max_rotation_per_segment = 3.14159265358979323846;
+    p.certified_time_tolerance = 1e-7;
+    p.certified_max_regions = 2000000;
+    p.broad_phase = 1;
+    p.internal_value = DEF_COOKIE;
+    return p;
+}
+
+sdfccd_RigidMotion sdfccd_default_rigid_motion(void)
+{
+    sdfccd_RigidMotion m;
+    memset(&m, 0, sizeof m);
+    m.pose.orientation.w = 1.0;
+    return m;
+}
+
+static sdfccd_Status convert_params(const sdfccd_QueryParams* in, const char* fn, scc_params* out)
+{
+    if (!in) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
+    if (in->internal_value != DEF_COOKIE)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params were not initialised with sdfccd_default_query_params()", fn);
+    if ((int)in->method < 0 || in->method >= SDFCCD_METHOD_COUNT)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: unknown method %d", fn, (int)in->method);
+#define POS(f) if (!isfinite(in->f) || !(in->f > 0.0)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->" #f " must be finite and > 0 (got %g)", fn, in->f)
+#define NONNEG(f) if (!isfinite(in->f) || in->f < 0.0) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->" #f " must be finite and >= 0 (got %g)", fn, in->f)
+    POS(time_tolerance);
+    POS(distance_tolerance);
+    POS(max_rotation_per_segment);
+    POS(certified_time_tolerance);
+    NONNEG(subdivision_min_area);
+    NONNEG(contact_slop);
+    NONNEG(toi_window);
+#undef POS
+#undef NONNEG
+    if (!isfinite(in->margin)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->margin is not finite", fn);
+    if (in->max_iterations < 1 || in->max_line_search_iterations < 1 || in->certified_max_regions < 1)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: iteration caps must be >= 1", fn);
+    out->method = in->method == SDFCCD_METHOD_FWGSS ? SCC_METHOD_FWGSS
+                : in->method == SDFCCD_METHOD_FW ? SCC_METHOD_FW
+                : in->method == SDFCCD_METHOD_DCD ? SCC_METHOD_DCD : SCC_METHOD_CERTIFIED;
+    out->margin = in->margin;
+    out->time_tol = in->time_tolerance;
+    out->dist_tol = in->distance_tolerance;
+    out->max_iter = in->max_iterations;
+    out->max_ls_iter = in->max_line_search_iterations;
+    out->subdivision = in->subdivision != 0;
+    out->sub_min_area = in->subdivision_min_area;
+    out->contact_slop = in->contact_slop;
+    out->toi_window = in->toi_window;
+    out->max_rotation = in->max_rotation_per_segment;
+    out->cert_time_tol = in->certified_time_tolerance;
+    out->cert_max_regions = in->certified_max_regions;
+    out->broad_phase = in->broad_phase != 0;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status convert_motion(const sdfccd_RigidMotion* in, double t0, const char* what, scc_rigid* out)
+{
+    sdfccd_Status st;
+    scc_xform xf;
+    if ((st = capi_check_pose(in->pose, what, &xf))) return st;
+    if ((st = capi_check_vec(in->local_center, what)) || (st = capi_check_vec(in->linear_velocity, what)) ||
+        (st = capi_check_vec(in->angular_velocity, what)))
+        return st;
+    out->p0 = xf.p;
+    out->q0 = xf.q;
+    out->c_local = capi_v(in->local_center);
+    out->v = capi_v(in->linear_velocity);
+    out->w = capi_v(in->angular_velocity);
+    out->t0 = t0;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status check_interval(double t0, double t1, const char* fn)
+{
+    if (!isfinite(t0) || !isfinite(t1)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: t0 and t1 must be finite (got %g, %g)", fn, t0, t1);
+    if (t1 < t0) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: t1 (%g) < t0 (%g)", fn, t1, t0);
+    return SDFCCD_OK;
+}
+
+/* Common prologue: out_result, params, interval, SDF handle and SDF motion. */
+typedef struct query_setup {
+    scc_params p;
+    capi_sdf* sdf;
+    scc_rigid sdf_motion;
+    const scc_rigid* sdf_motion_ptr;
+} query_setup;
+
+static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, double t0, double t1,
+                           const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+                           sdfccd_QueryResult* out_result, const char* fn, query_setup* q)
+{
+    sdfccd_Status st;
+    char what[96];
+    snprintf(what, sizeof what, "%s: out_result", fn);
+    if ((st = capi_check_ptr(out_result, what))) return st;
+    if (capacity < 0 || (capacity > 0 && !out_contacts))
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: out_contacts is NULL or capacity (%d) < 0", fn, capacity);
+    if ((st = convert_params(params, fn, &q->p)) || (st = check_interval(t0, t1, fn))) return st;
+    q->sdf_motion_ptr = NULL;
+    if (sdf_motion) {
+        snprintf(what, sizeof what, "%s: sdf_motion", fn);
+        if ((st = convert_motion(sdf_motion, t0, what, &q->sdf_motion))) return st;
+        q->sdf_motion_ptr = &q->sdf_motion;
+    }
+    q->sdf = capi_sdf_lookup(sdf);
+    if (!q->sdf) return SDFCCD_INVALID_HANDLE;
+    return SDFCCD_OK;
+}
+
+static sdfccd_ResultState public_state(scc_state s)
+{
+    switch (s) {
+    case SCC_HIT: return SDFCCD_STATE_HIT;
+    case SCC_PENETRATING: return SDFCCD_STATE_PENETRATING;
+    case SCC_NOT_CONVERGED: return SDFCCD_STATE_NOT_CONVERGED;
+    default: return SDFCCD_STATE_NO_HIT;
+    }
+}
+
+/* Maps core results (SDF frame) to the public result (world frame). */
+static void write_result(const query_setup* q, double t0, double t1, const scc_query_summary* s, const scc_contact* c,
+                         sdfccd_Contact* out, int32_t capacity, sdfccd_QueryResult* r)
+{
+    r->state = public_state(s->state);
+    r->hit = s->hit;
+    r->toi = s->toi;
+    r->toi_lower = s->toi_lower;
+    r->fraction = t1 > t0 ? (s->toi - t0) / (t1 - t0) : 0.0;
+    r->contacts_found = s->contacts_found;
+    r->contact_count = s->contacts_found < capacity ? s->contacts_found : capacity;
+    r->iterations = s->iterations;
+    r->sdf_evaluations = s->evals;
+    r->triangles_tested = s->triangles_tested;
+    for (int32_t i = 0; i < r->contact_count; ++i) {
+        sdfccd_Contact* o = &out[i];
+        o->point = capi_pv(scc_world_point(q->sdf_motion_ptr, c[i].toi, c[i].point));
+        o->normal = capi_pv(scc_normalize_or(scc_world_vector(q->sdf_motion_ptr, c[i].toi, c[i].normal), scc_v3(0, 0, 1)));
+        o->distance = c[i].distance;
+        o->gap_t0 = c[i].gap_t0;
+        o->toi = c[i].toi;
+        for (int j = 0; j < 3; ++j) o->barycentric[j] = c[i].bary[j];
+        o->triangle = c[i].triangle;
+        o->kind = c[i].kind == SCC_CONTACT_PRIMARY ? SDFCCD_CONTACT_PRIMARY : SDFCCD_CONTACT_SUBDIVISION;
+    }
+}
+
+static int degenerate(const scc_vec3 v[3])
+{
+    double scale = fmax(scc_len2(scc_sub(v[1], v[0])), scc_len2(scc_sub(v[2], v[0])));
+    return scale == 0.0 || !(scc_triangle_area2(v[0], v[1], v[2]) > 1e-12 * scale);
+}
+
+static sdfccd_Status run_triangle(const query_setup* q, const scc_tri_motion* m, double t0, double t1,
+                                  sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result, const char* fn)
+{
+    scc_contact c[1 + SCC_MAX_SUBDIVISION_CONTACTS];
+    scc_query_summary s;
+    if (!scc_query_triangle(q->sdf->sdf, m, t0, t1, &q->p, capi_allocator(), 0, c, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s))
+        return capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory in the certified search", fn);
+    write_result(q, t0, t1, &s, c, out_contacts, capacity, out_result);
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3],
+                                    const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
+                                    sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
+{
+    static const char fn[] = "sdfccd_query_triangle";
+    query_setup q;
+    sdfccd_Status st;
+    if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
+    if ((st = capi_check_ptr(triangle, "sdfccd_query_triangle: triangle")) || (st = capi_check_ptr(motion, "sdfccd_query_triangle: motion")))
+        return st;
+    scc_rigid body;
+    scc_tri_motion m;
+    memset(&m, 0, sizeof m);
+    for (int i = 0; i < 3; ++i) {
+        if ((st = capi_check_vec(triangle[i], "sdfccd_query_triangle: triangle vertex"))) return st;
+        m.local[i] = capi_v(triangle[i]);
+    }
+    if (degenerate(m.local)) return capi_error(SDFCCD_DEGENERATE, "%s: the triangle has zero area", fn);
+    if ((st = convert_motion(motion, t0, "sdfccd_query_triangle: motion", &body))) return st;
+    m.kind = SCC_TRI_RIGID;
+    m.body = &body;
+    m.sdf = q.sdf_motion_ptr;
+    m.t0 = t0;
+    m.t1 = t1;
+    return run_triangle(&q, &m, t0, t1, out_contacts, capacity, out_result, fn);
+}
+
+sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3],
+                                           const sdfccd_Vec3 end[3], double t0, double t1, const sdfccd_QueryParams* params,
+                                           sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
+{
+    static const char fn[] = "sdfccd_query_triangle_linear";
+    query_setup q;
+    sdfccd_Status st;
+    if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
+    if ((st = capi_check_ptr(start, "sdfccd_query_triangle_linear: start")) || (st = capi_check_ptr(end, "sdfccd_query_triangle_linear: end")))
+        return st;
+    scc_tri_motion m;
+    memset(&m, 0, sizeof m);
+    for (int i = 0; i < 3; ++i) {
+        if ((st = capi_check_vec(start[i], "sdfccd_query_triangle_linear: start vertex")) ||
+            (st = capi_check_vec(end[i], "sdfccd_query_triangle_linear: end vertex")))
+            return st;
+        m.start[i] = capi_v(start[i]);
+        m.end[i] = capi_v(end[i]);
+    }
+    if (degenerate(m.start)) return capi_error(SDFCCD_DEGENERATE, "%s: the triangle has zero area at t0", fn);
+    m.kind = SCC_TRI_LINEAR;
+    m.sdf = q.sdf_motion_ptr;
+    m.t0 = t0;
+    m.t1 = t1;
+    return run_triangle(&q, &m, t0, t1, out_contacts, capacity, out_result, fn);
+}
+
+static sdfccd_Status run_mesh(const query_setup* q, const scc_mesh_motion* mm, sdfccd_Contact* out_contacts, int32_t capacity,
+                              sdfccd_QueryResult* out_result, const char* fn)
+{
+    const int32_t kCap = 1024;
+    int32_t cap = capacity < kCap ? kCap : capacity;
+    scc_contact* c = capi_alloc((size_t)cap * sizeof *c);
+    if (!c) return capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    scc_query_summary s;
+    int ok = scc_query_mesh(q->sdf->sdf, mm, &q->p, capi_allocator(), c, cap, &s);
+    if (ok) write_result(q, mm->t0, mm->t1, &s, c, out_contacts, capacity, out_result);
+    capi_free(c, (size_t)cap * sizeof *c);
+    return ok ? SDFCCD_OK : capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+}
+
+sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
+                                sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
+{
+    static const char fn[] = "sdfccd_query_mesh";
+    query_setup q;
+    sdfccd_Status st;
+    if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
+    if ((st = capi_check_ptr(motion, "sdfccd_query_mesh: motion"))) return st;
+    scc_rigid body;
+    if ((st = convert_motion(motion, t0, "sdfccd_query_mesh: motion", &body))) return st;
+    capi_mesh* m = capi_mesh_lookup(mesh);
+    if (!m) return SDFCCD_INVALID_HANDLE;
+    scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1 };
+    return run_mesh(&q, &mm, out_contacts, capacity, out_result, fn);
+}
+
+sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                       const double* start, const double* end, double t0, double t1,
+                                       const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+                                       sdfccd_QueryResult* out_result)
+{
+    static const char fn[] = "sdfccd_query_mesh_linear";
+    query_setup q;
+    sdfccd_Status st;
+    if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
+    if ((st = capi_check_ptr(start, "sdfccd_query_mesh_linear: start")) || (st = capi_check_ptr(end, "sdfccd_query_mesh_linear: end")))
+        return st;
+    capi_mesh* m = capi_mesh_lookup(mesh);
+    if (!m) return SDFCCD_INVALID_HANDLE;
+    uint32_t nv = m->mesh.vertex_count;
+    for (uint32_t i = 0; i < 3 * nv; ++i)
+        if (!isfinite(start[i]) || !isfinite(end[i]))
+            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate", fn, i / 3);
+    size_t bytes = 2 * (size_t)nv * sizeof(scc_vec3);
+    scc_vec3* v = capi_alloc(bytes);
+    if (!v) return capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    for (uint32_t i = 0; i < nv; ++i) {
+        v[i] = scc_v3(start[3 * i], start[3 * i + 1], start[3 * i + 2]);
+        v[nv + i] = scc_v3(end[3 * i], end[3 * i + 1], end[3 * i + 2]);
+    }
+    scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1 };
+    st = run_mesh(&q, &mm, out_contacts, capacity, out_result, fn);
+    capi_free(v, bytes);
+    return st;
+}

@@ -1,0 +1,112 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: shared types of the narrow-phase solvers (DCD, FW, FWGSS, certified),
+ * adaptive subdivision and the triangle and mesh queries. Stateless: every routine takes
+ * its inputs and writes an output struct. All points are in the SDF's local frame. */
+#ifndef SCC_CCD_H
+#define SCC_CCD_H
+
+#include <stdint.h>
+#include "alloc.h"
+#include "mesh.h"
+#include "motion.h"
+#include "sdf.h"
+
+typedef enum scc_method { SCC_METHOD_FWGSS, SCC_METHOD_FW, SCC_METHOD_DCD, SCC_METHOD_CERTIFIED } scc_method;
+
+typedef struct scc_params {
+    scc_method method;
+    double margin;          /* contact when phi <= margin */
+    double time_tol;        /* absolute (s) */
+    double dist_tol;        /* absolute (m) */
+    int max_iter;
+    int max_ls_iter;
+    int subdivision;
+    double sub_min_area;    /* m^2 */
+    double contact_slop;    /* m */
+    double toi_window;      /* s */
+    double max_rotation;    /* rad per segment */
+    double cert_time_tol;   /* s */
+    int64_t cert_max_regions;
+    int broad_phase;
+} scc_params;
+
+typedef enum scc_state { SCC_NO_HIT, SCC_HIT, SCC_PENETRATING, SCC_NOT_CONVERGED } scc_state;
+
+/* Outcome of one triangle over one interval. */
+typedef struct scc_tri_hit {
+    scc_state state;
+    int hit;                /* a contact was witnessed */
+    double toi;             /* earliest witnessed contact time (the interval end when no hit) */
+    double toi_lower;       /* certified: no contact before this; other methods: = toi */
+    double bary[3];         /* contact point weights */
+    scc_vec3 point;         /* contact point at toi */
+    scc_vec3 normal;        /* grad phi at the point */
+    double distance;        /* phi at the point */
+    int64_t iterations;
+    int64_t evals;
+} scc_tri_hit;
+
+typedef enum scc_contact_kind { SCC_CONTACT_PRIMARY, SCC_CONTACT_SUBDIVISION } scc_contact_kind;
+
+typedef struct scc_contact {
+    scc_vec3 point, normal; /* SDF frame, at toi */
+    double distance;        /* phi at toi */
+    double gap_t0;          /* phi of the same material point at the query's t0 */
+    double toi;
+    double bary[3];
+    uint32_t triangle;
+    scc_contact_kind kind;
+} scc_contact;
+
+/* ---- DCD (Section 3.2, Macklin et al. 2020): deepest point of a static triangle ---- */
+typedef struct scc_dcd_result {
+    double phi;
+    scc_vec3 point, normal;
+    double bary[3];         /* weights of tri[0..2] */
+    int iterations, evals, converged;
+} scc_dcd_result;
+scc_dcd_result scc_dcd(const scc_sdf* sdf, const scc_vec3 tri[3], const scc_params* p);
+
+/* ---- CCD on one interval [ta, tb] with at most max_rotation of rotation ---- */
+void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out);
+void scc_fw(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out);
+/* Returns 0 on allocation failure (out untouched), 1 otherwise. */
+int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                  const scc_allocator* alloc, scc_tri_hit* out);
+
+/* ---- adaptive triangle subdivision at the TOI (Section 4.5) ----
+ * `tri` is the triangle at the TOI, `primary` the weights of the first contact. Writes up to
+ * `capacity` extra contacts (weights w.r.t. tri, point, normal, phi) and returns their count. */
+int scc_subdivide(const scc_sdf* sdf, const scc_vec3 tri[3], const double primary[3], const scc_params* p,
+                  scc_contact* out, int capacity, int64_t* io_evals);
+#define SCC_MAX_SUBDIVISION_CONTACTS 8
+
+/* ---- triangle and mesh queries ---- */
+typedef struct scc_query_summary {
+    scc_state state;
+    int hit;
+    double toi, toi_lower;
+    int contacts_found;     /* may exceed the capacity */
+    int64_t iterations, evals, triangles_tested;
+} scc_query_summary;
+
+/* One triangle over [ta, tb] (within the motion's [t0, t1]): splits large rotations, runs the method, then subdivision.
+ * Returns 0 on allocation failure. Contacts: primary first, then subdivision points. */
+int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                       const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
+                       scc_query_summary* sum);
+
+/* A mesh whose triangles all follow one motion template: rigid (`body` set, vertices local) or
+ * linear (`start`/`end` world vertex arrays). Returns 0 on allocation failure. */
+typedef struct scc_mesh_motion {
+    const scc_mesh* mesh;
+    const scc_rigid* body;      /* rigid when not NULL */
+    const scc_vec3* start;      /* linear: world vertices at t0 */
+    const scc_vec3* end;        /* linear: world vertices at t1 */
+    const scc_rigid* sdf;       /* NULL: static SDF */
+    double t0, t1;
+} scc_mesh_motion;
+int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
+                   scc_contact* out, int capacity, scc_query_summary* sum);
+
+#endif

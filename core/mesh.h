@@ -1,0 +1,30 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: a triangle mesh as the solvers see it (borrowed arrays, no ownership). */
+#ifndef SCC_MESH_H
+#define SCC_MESH_H
+
+#include <stdint.h>
+#include "scc_math.h"
+
+typedef struct scc_mesh {
+    const scc_vec3* vertices;   /* local frame */
+    const uint32_t* indices;    /* 3 per triangle, counter-clockwise */
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    scc_aabb bounds;            /* local-frame box of the vertices */
+} scc_mesh;
+
+static inline void scc_mesh_triangle(const scc_mesh* m, uint32_t t, scc_vec3 out[3])
+{
+    out[0] = m->vertices[m->indices[3 * t + 0]];
+    out[1] = m->vertices[m->indices[3 * t + 1]];
+    out[2] = m->vertices[m->indices[3 * t + 2]];
+}
+
+/* Twice the area of triangle (a, b, c). */
+static inline double scc_triangle_area2(scc_vec3 a, scc_vec3 b, scc_vec3 c)
+{
+    return scc_len(scc_cross(scc_sub(b, a), scc_sub(c, a)));
+}
+
+#endif

@@ -1,0 +1,310 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: analytic SDFs (exact distances and gradients), CSG and rigid+uniform-scale
+ * transforms. These are the analytic fields of the paper's scenes (Section 5: box, sphere,
+ * torus of Fig. 2, spike grid of Fig. 10 / Table 3, the CSG hoop of Fig. 8).
+ * Every field here is 1-Lipschitz, which the certified TOI relies on. */
+#include "sdf_analytic.h"
+
+static const scc_vec3 k_up = { 0.0, 0.0, 1.0 };
+
+static scc_aabb box_infinite(void)
+{
+    scc_aabb b = { { -INFINITY, -INFINITY, -INFINITY }, { INFINITY, INFINITY, INFINITY } };
+    return b;
+}
+
+static scc_aabb box_sym(scc_vec3 h)
+{
+    scc_aabb b = { scc_scale(h, -1.0), h };
+    return b;
+}
+
+static void base_init(scc_sdf* b, scc_sdf_eval_fn* fn, scc_sdf_kind kind, scc_aabb bounds)
+{
+    b->eval = fn;
+    b->lipschitz_in = NULL;
+    b->domain = box_infinite();
+    b->bounds = bounds;
+    b->lipschitz = 1.0;
+    b->kind = kind;
+}
+
+static double sign_of(double x) { return x < 0.0 ? -1.0 : 1.0; }
+
+/* ---- sphere ---- */
+static double sphere_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_sphere* s = (const scc_sdf_sphere*)self;
+    double l = scc_len(p);
+    if (g) *g = l > 0.0 ? scc_scale(p, 1.0 / l) : k_up;
+    return l - s->radius;
+}
+void scc_sdf_sphere_init(scc_sdf_sphere* s, double r)
+{
+    base_init(&s->base, sphere_eval, SCC_SDF_SPHERE, box_sym(scc_v3(r, r, r)));
+    s->radius = r;
+}
+
+/* ---- box and rounded box: inner box of half (h - r), inflated by r ---- */
+static double box_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_box* s = (const scc_sdf_box*)self;
+    scc_vec3 inner = scc_sub(s->half, scc_v3(s->radius, s->radius, s->radius));
+    scc_vec3 q = scc_sub(scc_vabs(p), inner);
+    scc_vec3 qp = scc_vmax(q, scc_v3(0, 0, 0));
+    double outside = scc_len(qp);
+    double inside = fmin(scc_maxc(q), 0.0);
+    if (g) {
+        if (outside > 0.0) {
+            *g = scc_scale(scc_v3(qp.x * sign_of(p.x), qp.y * sign_of(p.y), qp.z * sign_of(p.z)), 1.0 / outside);
+        } else if (q.x >= q.y && q.x >= q.z) {
+            *g = scc_v3(sign_of(p.x), 0, 0);
+        } else if (q.y >= q.z) {
+            *g = scc_v3(0, sign_of(p.y), 0);
+        } else {
+            *g = scc_v3(0, 0, sign_of(p.z));
+        }
+    }
+    return outside + inside - s->radius;
+}
+void scc_sdf_box_init(scc_sdf_box* s, scc_vec3 half, double radius)
+{
+    base_init(&s->base, box_eval, radius > 0.0 ? SCC_SDF_ROUNDED_BOX : SCC_SDF_BOX, box_sym(half));
+    s->half = half;
+    s->radius = radius;
+}
+
+/* ---- torus around z ---- */
+static double torus_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_torus* s = (const scc_sdf_torus*)self;
+    double rho = sqrt(p.x * p.x + p.y * p.y);
+    double ex = rho > 0.0 ? p.x / rho : 1.0, ey = rho > 0.0 ? p.y / rho : 0.0;
+    double qx = rho - s->major, qz = p.z;
+    double l = sqrt(qx * qx + qz * qz);
+    if (g) *g = l > 0.0 ? scc_v3(qx / l * ex, qx / l * ey, qz / l) : scc_v3(ex, ey, 0.0);
+    return l - s->minor;
+}
+void scc_sdf_torus_init(scc_sdf_torus* s, double major, double minor)
+{
+    double e = major + minor;
+    base_init(&s->base, torus_eval, SCC_SDF_TORUS, box_sym(scc_v3(e, e, minor)));
+    s->major = major;
+    s->minor = minor;
+}
+
+/* ---- capsule along z ---- */
+static double capsule_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_capsule* s = (const scc_sdf_capsule*)self;
+    scc_vec3 d = scc_v3(p.x, p.y, p.z - scc_clamp(p.z, -s->half_height, s->half_height));
+    double l = scc_len(d);
+    if (g) *g = l > 0.0 ? scc_scale(d, 1.0 / l) : scc_v3(1.0, 0.0, 0.0);
+    return l - s->radius;
+}
+void scc_sdf_capsule_init(scc_sdf_capsule* s, double hh, double r)
+{
+    base_init(&s->base, capsule_eval, SCC_SDF_CAPSULE, box_sym(scc_v3(r, r, hh + r)));
+    s->half_height = hh;
+    s->radius = r;
+}
+
+/* ---- cylinder along z with flat caps ---- */
+static double cylinder_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_cylinder* s = (const scc_sdf_cylinder*)self;
+    double rho = sqrt(p.x * p.x + p.y * p.y);
+    double ex = rho > 0.0 ? p.x / rho : 1.0, ey = rho > 0.0 ? p.y / rho : 0.0;
+    double dr = rho - s->radius, dz = fabs(p.z) - s->half_height;
+    double or_ = fmax(dr, 0.0), oz = fmax(dz, 0.0);
+    double outside = sqrt(or_ * or_ + oz * oz);
+    if (g) {
+        if (outside > 0.0)
+            *g = scc_v3(or_ / outside * ex, or_ / outside * ey, oz / outside * sign_of(p.z));
+        else if (dr > dz)
+            *g = scc_v3(ex, ey, 0.0);
+        else
+            *g = scc_v3(0.0, 0.0, sign_of(p.z));
+    }
+    return outside + fmin(fmax(dr, dz), 0.0);
+}
+void scc_sdf_cylinder_init(scc_sdf_cylinder* s, double hh, double r)
+{
+    base_init(&s->base, cylinder_eval, SCC_SDF_CYLINDER, box_sym(scc_v3(r, r, hh)));
+    s->half_height = hh;
+    s->radius = r;
+}
+
+/* ---- half-space n.x <= offset ---- */
+static double half_space_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_half_space* s = (const scc_sdf_half_space*)self;
+    if (g) *g = s->normal;
+    return scc_dot(s->normal, p) - s->offset;
+}
+void scc_sdf_half_space_init(scc_sdf_half_space* s, scc_vec3 n, double offset)
+{
+    scc_aabb b = box_infinite();
+    /* An axis-aligned half-space has one finite side. */
+    if (n.x == 0.0 && n.y == 0.0) { if (n.z > 0) b.hi.z = offset / n.z; else b.lo.z = offset / n.z; }
+    else if (n.x == 0.0 && n.z == 0.0) { if (n.y > 0) b.hi.y = offset / n.y; else b.lo.y = offset / n.y; }
+    else if (n.y == 0.0 && n.z == 0.0) { if (n.x > 0) b.hi.x = offset / n.x; else b.lo.x = offset / n.x; }
+    base_init(&s->base, half_space_eval, SCC_SDF_HALF_SPACE, b);
+    s->normal = n;
+    s->offset = offset;
+}
+
+/* ---- spike grid: ground slab z <= 0 united with upright cones ----
+ * A cone is a solid of revolution, so its 3D distance is the 2D distance to its meridian
+ * triangle (0,0) (R,0) (0,H) in the (rho, z) half-plane. */
+
+/* Closest point to p on segment ab (2D). */
+static void closest_on_segment2(double px, double pz, double ax, double az, double bx, double bz, double* cx, double* cz)
+{
+    double dx = bx - ax, dz = bz - az;
+    double t = ((px - ax) * dx + (pz - az) * dz) / (dx * dx + dz * dz);
+    t = scc_clamp(t, 0.0, 1.0);
+    *cx = ax + t * dx;
+    *cz = az + t * dz;
+}
+
+/* Signed distance from (rho, z) to the cone's meridian triangle, gradient in (rho, z). */
+static double cone_distance2(double rho, double z, double R, double H, double* grho, double* gz)
+{
+    const double vx[3] = { 0.0, R, 0.0 }, vz[3] = { 0.0, 0.0, H };
+    double best = INFINITY, bx = 0.0, bz = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        int j = (i + 1) % 3;
+        double cx, cz;
+        closest_on_segment2(rho, z, vx[i], vz[i], vx[j], vz[j], &cx, &cz);
+        double d2 = (rho - cx) * (rho - cx) + (z - cz) * (z - cz);
+        if (d2 < best) { best = d2; bx = cx; bz = cz; }
+    }
+    double d = sqrt(best);
+    int inside = rho >= 0.0 && z >= 0.0 && rho / R + z / H <= 1.0;
+    if (d > 0.0) {
+        double s = inside ? -1.0 : 1.0;
+        *grho = s * (rho - bx) / d;
+        *gz = s * (z - bz) / d;
+    } else {
+        /* On the boundary: use the outward normal of the slanted side. */
+        double n = sqrt(H * H + R * R);
+        *grho = H / n;
+        *gz = R / n;
+    }
+    return inside ? -d : d;
+}
+
+static double spike_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_spike_grid* s = (const scc_sdf_spike_grid*)self;
+    double best = p.z; /* ground slab z <= 0 */
+    scc_vec3 bg = k_up;
+    {
+        int ci = (int)lround((p.x - s->x0) / s->spacing);
+        int cj = (int)lround((p.y - s->y0) / s->spacing);
+        ci = ci < 0 ? 0 : (ci >= s->count_x ? s->count_x - 1 : ci);
+        cj = cj < 0 ? 0 : (cj >= s->count_y ? s->count_y - 1 : cj);
+        for (int j = cj - 1; j <= cj + 1; ++j) {
+            if (j < 0 || j >= s->count_y) continue;
+            for (int i = ci - 1; i <= ci + 1; ++i) {
+                if (i < 0 || i >= s->count_x) continue;
+                double dx = p.x - (s->x0 + i * s->spacing), dy = p.y - (s->y0 + j * s->spacing);
+                double rho = sqrt(dx * dx + dy * dy);
+                double grho, gz;
+                double d = cone_distance2(rho, p.z, s->base_radius, s->height, &grho, &gz);
+                if (d < best) {
+                    best = d;
+                    double ex = rho > 0.0 ? dx / rho : 1.0, ey = rho > 0.0 ? dy / rho : 0.0;
+                    bg = scc_v3(grho * ex, grho * ey, gz);
+                }
+            }
+        }
+    }
+    if (g) *g = bg;
+    return best;
+}
+
+void scc_sdf_spike_grid_init(scc_sdf_spike_grid* s, double spacing, double base_radius, double height, int nx, int ny)
+{
+    scc_aabb b = box_infinite();
+    b.hi.z = height;
+    base_init(&s->base, spike_grid_eval, SCC_SDF_SPIKE_GRID, b);
+    s->spacing = spacing;
+    s->base_radius = base_radius;
+    s->height = height;
+    s->count_x = nx;
+    s->count_y = ny;
+    s->x0 = -0.5 * spacing * (nx - 1);
+    s->y0 = -0.5 * spacing * (ny - 1);
+}
+
+/* ---- CSG ---- */
+static double csg_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_csg* s = (const scc_sdf_csg*)self;
+    scc_vec3 ga, gb;
+    double a = scc_sdf_eval(s->a, p, g ? &ga : NULL);
+    double b = scc_sdf_eval(s->b, p, g ? &gb : NULL);
+    switch (s->op) {
+    case SCC_CSG_UNION:
+        if (g) *g = a <= b ? ga : gb;
+        return fmin(a, b);
+    case SCC_CSG_INTERSECTION:
+        if (g) *g = a >= b ? ga : gb;
+        return fmax(a, b);
+    default: /* difference: a minus b */
+        if (g) *g = a >= -b ? ga : scc_scale(gb, -1.0);
+        return fmax(a, -b);
+    }
+}
+
+static scc_aabb aabb_union(scc_aabb a, scc_aabb b) { scc_aabb r = { scc_vmin(a.lo, b.lo), scc_vmax(a.hi, b.hi) }; return r; }
+static scc_aabb aabb_intersection(scc_aabb a, scc_aabb b) { scc_aabb r = { scc_vmax(a.lo, b.lo), scc_vmin(a.hi, b.hi) }; return r; }
+
+void scc_sdf_csg_init(scc_sdf_csg* s, scc_csg_op op, const scc_sdf* a, const scc_sdf* b)
+{
+    scc_aabb bounds = op == SCC_CSG_UNION ? aabb_union(a->bounds, b->bounds)
+                    : op == SCC_CSG_INTERSECTION ? aabb_intersection(a->bounds, b->bounds) : a->bounds;
+    base_init(&s->base, csg_eval, SCC_SDF_CSG, bounds);
+    s->base.domain = aabb_intersection(a->domain, b->domain);
+    s->base.lipschitz = fmax(a->lipschitz, b->lipschitz);
+    s->op = op;
+    s->a = a;
+    s->b = b;
+}
+
+/* ---- rigid transform and uniform scale ---- */
+static double transform_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+{
+    const scc_sdf_transform* s = (const scc_sdf_transform*)self;
+    scc_vec3 local = scc_scale(scc_xform_apply_inv(s->xf, p), 1.0 / s->scale);
+    scc_vec3 gl;
+    double v = scc_sdf_eval(s->child, local, g ? &gl : NULL);
+    if (g) *g = scc_quat_rotate(s->xf.q, gl);
+    return v * s->scale;
+}
+
+/* World box of a transformed local box (infinite stays infinite). */
+static scc_aabb transform_box(scc_aabb b, scc_xform xf, double scale)
+{
+    if (!scc_vfinite(b.lo) || !scc_vfinite(b.hi)) return box_infinite();
+    scc_aabb r = { { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY } };
+    for (int i = 0; i < 8; ++i) {
+        scc_vec3 c = scc_v3(i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z);
+        c = scc_xform_apply(xf, scc_scale(c, scale));
+        r.lo = scc_vmin(r.lo, c);
+        r.hi = scc_vmax(r.hi, c);
+    }
+    return r;
+}
+
+void scc_sdf_transform_init(scc_sdf_transform* s, const scc_sdf* child, scc_xform xf, double scale)
+{
+    base_init(&s->base, transform_eval, SCC_SDF_TRANSFORM, transform_box(child->bounds, xf, scale));
+    s->base.domain = transform_box(child->domain, xf, scale);
+    s->base.lipschitz = child->lipschitz;
+    s->child = child;
+    s->xf = xf;
+    s->scale = scale;
+}

@@ -1,0 +1,103 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: the per-triangle query. Splits the interval so no segment rotates more than
+ * the limit (Section 4.6: the solvers assume less than half a turn), runs the chosen method
+ * segment by segment until the first hit, then adds adaptive-subdivision contacts at the TOI
+ * (Section 4.5). DCD tests the end pose only, as a discrete method does. */
+#include "ccd.h"
+
+static double gap_at_t0(const scc_sdf* sdf, const scc_tri_motion* m, const double b[3], int64_t* evals)
+{
+    ++*evals;
+    return scc_sdf_eval(sdf, scc_tri_point_at(m, b, m->t0, NULL), NULL);
+}
+
+int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                       const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
+                       scc_query_summary* sum)
+{
+    scc_tri_hit h;
+    int64_t evals = 0, iterations = 0;
+    int not_converged = 0;
+    if (p->method == SCC_METHOD_DCD) {
+        scc_tri_state st;
+        scc_tri_state_at(m, tb, &st);
+        scc_dcd_result d = scc_dcd(sdf, st.x, p);
+        evals += d.evals;
+        iterations += d.iterations;
+        h.hit = d.phi <= p->margin;
+        h.state = h.hit ? SCC_HIT : (d.converged ? SCC_NO_HIT : SCC_NOT_CONVERGED);
+        h.toi = h.toi_lower = tb;
+        for (int j = 0; j < 3; ++j) h.bary[j] = d.bary[j];
+        h.point = d.point;
+        h.normal = d.normal;
+        h.distance = d.phi;
+    } else {
+        double angle = scc_tri_rotation_angle(m, ta, tb);
+        int segments = 1;
+        if (p->max_rotation > 0.0 && angle > p->max_rotation) {
+            double n = ceil(angle / p->max_rotation);
+            segments = n > 1e6 ? 1000000 : (int)n;
+        }
+        h.hit = 0;
+        h.state = SCC_NO_HIT;
+        for (int k = 0; k < segments; ++k) {
+            double sa = ta + (tb - ta) * k / segments;
+            double sb = k + 1 == segments ? tb : ta + (tb - ta) * (k + 1) / segments;
+            scc_tri_hit seg;
+            if (p->method == SCC_METHOD_FWGSS) scc_fwgss(sdf, m, sa, sb, p, &seg);
+            else if (p->method == SCC_METHOD_FW) scc_fw(sdf, m, sa, sb, p, &seg);
+            else if (!scc_certified(sdf, m, sa, sb, p, alloc, &seg)) return 0;
+            evals += seg.evals;
+            iterations += seg.iterations;
+            if (seg.hit) {
+                h = seg;
+                if (k > 0 && h.state == SCC_PENETRATING) h.state = SCC_HIT; /* touching at a segment start */
+                if (not_converged && h.state == SCC_HIT) h.state = SCC_NOT_CONVERGED;
+                break;
+            }
+            if (seg.state == SCC_NOT_CONVERGED) not_converged = 1;
+            h = seg;
+        }
+        if (!h.hit) {
+            h.state = not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT;
+            h.toi = h.toi_lower = tb;
+        }
+    }
+
+    int n = 0;
+    if (h.hit) {
+        scc_contact primary;
+        primary.point = h.point;
+        primary.normal = h.normal;
+        primary.distance = h.distance;
+        primary.toi = h.toi;
+        for (int j = 0; j < 3; ++j) primary.bary[j] = h.bary[j];
+        primary.triangle = triangle_index;
+        primary.kind = SCC_CONTACT_PRIMARY;
+        primary.gap_t0 = gap_at_t0(sdf, m, h.bary, &evals);
+        if (n < capacity) out[n] = primary;
+        ++n;
+        if (p->subdivision) {
+            scc_contact extra[SCC_MAX_SUBDIVISION_CONTACTS];
+            scc_tri_state st;
+            scc_tri_state_at(m, h.toi, &st);
+            int k = scc_subdivide(sdf, st.x, h.bary, p, extra, SCC_MAX_SUBDIVISION_CONTACTS, &evals);
+            for (int i = 0; i < k; ++i) {
+                extra[i].toi = h.toi;
+                extra[i].triangle = triangle_index;
+                extra[i].gap_t0 = gap_at_t0(sdf, m, extra[i].bary, &evals);
+                if (n < capacity) out[n] = extra[i];
+                ++n;
+            }
+        }
+    }
+    sum->state = h.state;
+    sum->hit = h.hit;
+    sum->toi = h.toi;
+    sum->toi_lower = h.toi_lower;
+    sum->contacts_found = n;
+    sum->iterations = iterations;
+    sum->evals = evals;
+    sum->triangles_tested = 1;
+    return 1;
+}

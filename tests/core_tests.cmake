@@ -1,0 +1,3 @@
+# SPDX-License-Identifier: MIT
+# Core Check suites (one per module).
+sdfccd_add_check_test(test_ccd test_ccd.c)

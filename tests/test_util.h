@@ -1,0 +1,29 @@
+/* SPDX-License-Identifier: MIT
+ * Shared helpers for the Check suites: a seeded RNG, the allocator-balance fixture and
+ * a runner that prints the suite's summary line. */
+#ifndef SDFCCD_TEST_UTIL_H
+#define SDFCCD_TEST_UTIL_H
+
+#include <check.h>
+#include <stdint.h>
+#include "sdfccd/sdfccd.h"
+
+/* splitmix64-based generator; deterministic for a given seed. */
+typedef struct test_rng { uint64_t s; } test_rng;
+uint64_t test_rng_next(test_rng* r);
+double test_rng_uniform(test_rng* r, double lo, double hi); /* [lo, hi) */
+sdfccd_Vec3 test_rng_unit_vector(test_rng* r);
+
+/* Checked fixture: asserts sdfccd_byte_count() returns to its start value after each test. */
+void test_memory_setup(void);
+void test_memory_teardown(void);
+/* Adds the memory fixture to a TCase. */
+void test_add_memory_fixture(TCase* tc);
+
+/* Runs a suite (CK_NORMAL output) and returns the process exit code. */
+int test_run_suite(Suite* s);
+
+#define ck_assert_double_near(a, b, tol) \
+    ck_assert_msg(fabs((double)(a) - (double)(b)) <= (tol), "%s = %.17g, expected %.17g (tol %g)", #a, (double)(a), (double)(b), (double)(tol))
+
+#endif
