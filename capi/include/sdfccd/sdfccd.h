@@ -9,5 +9,6 @@
 #include "mesh.h"
 #include "ccd.h"
 #include "extract.h"
+#include "grid.h"
 
 #endif

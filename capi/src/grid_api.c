@@ -1,0 +1,351 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd C ABI: grid SDF handles, building grids from meshes and SDFs on a small pthread
+ * pool, and grid inspection. The grid itself (cell, evaluation, builder) lives in core/grid*.c. */
+#include "grid_internal.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../../core/mesh_distance.h"
+
+#define GRID_DEF_MAGIC 0x5DFCCD31
+
+/* ---------------- handles ---------------- */
+
+static void grid_release(capi_sdf* s)
+{
+    scc_grid_destroy((scc_grid*)s->extra);
+    s->extra = NULL;
+}
+
+sdfccd_Status capi_grid_register(scc_grid* g, sdfccd_SdfId* out_sdf)
+{
+    capi_sdf* s = capi_sdf_new(sizeof(scc_grid*));
+    if (!s) {
+        scc_grid_destroy(g);
+        return capi_oom("a grid SDF handle");
+    }
+    *(scc_grid**)s->storage = g;
+    s->sdf = &g->base;
+    s->extra = g;
+    s->release_extra = grid_release;
+    s->memory_bytes = (int64_t)(s->storage_size + scc_grid_memory(g));
+    return capi_sdf_register(s, out_sdf);
+}
+
+sdfccd_Status capi_grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid)
+{
+    *out_grid = NULL;
+    capi_sdf* s = capi_sdf_lookup(id);
+    if (!s) return capi_error(SDFCCD_INVALID_HANDLE, "%s: SDF handle {%u, %u} is not a live SDF", fn, id.index1, id.generation);
+    if (s->release_extra != grid_release)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: SDF handle {%u, %u} is not a grid", fn, id.index1, id.generation);
+    *out_grid = (scc_grid*)s->extra;
+    return SDFCCD_OK;
+}
+
+/* ---------------- thread pool ---------------- */
+
+typedef struct pool_run {
+    scc_task_fn* task;
+    void* ctx;
+    uint32_t count;
+    atomic_uint next;
+    atomic_uint done;
+} pool_run;
+
+static void pool_work(pool_run* r)
+{
+    for (;;) {
+        const unsigned i = atomic_fetch_add(&r->next, 1u);
+        if (i >= r->count) return;
+        r->task(r->ctx, i);
+        atomic_fetch_add(&r->done, 1u);
+    }
+}
+
+static void* pool_thread(void* arg)
+{
+    pool_work(arg);
+    return NULL;
+}
+
+void capi_pool_init(capi_pool* p, int threads, sdfccd_ProgressFcn* progress, void* user)
+{
+    memset(p, 0, sizeof *p);
+    if (threads <= 0) {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        threads = n > 0 ? (int)n : 1;
+    }
+    if (threads > 256) threads = 256;
+    p->threads = threads;
+    p->progress = progress;
+    p->progress_user = user;
+    p->stage_base[0] = 0.0; p->stage_weight[0] = 0.9;
+    p->stage_base[1] = 0.9; p->stage_weight[1] = 0.1;
+    p->last_reported = -1.0;
+}
+
+static void pool_report(capi_pool* p, double f)
+{
+    if (!p->progress) return;
+    if (f < 1.0 && f - p->last_reported < 0.005) return;
+    p->last_reported = f;
+    p->progress(f, p->progress_user);
+}
+
+int capi_pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx)
+{
+    capi_pool* p = user;
+    const int st = stage == SCC_GRID_STAGE_CELLS ? 1 : 0;
+    pool_run r;
+    r.task = task;
+    r.ctx = ctx;
+    r.count = count;
+    atomic_init(&r.next, 0u);
+    atomic_init(&r.done, 0u);
+    int extra = p->threads - 1;
+    if ((uint32_t)extra > count) extra = (int)count;
+    pthread_t tids[256];
+    int started = 0;
+    for (int i = 0; i < extra; ++i) {
+        if (pthread_create(&tids[started], NULL, pool_thread, &r) != 0) break; /* run with fewer */
+        ++started;
+    }
+    /* The calling thread works too and is the only one that reports progress. */
+    for (;;) {
+        const unsigned i = atomic_fetch_add(&r.next, 1u);
+        if (i >= r.count) break;
+        task(ctx, i);
+        const unsigned done = atomic_fetch_add(&r.done, 1u) + 1u;
+        if (count) pool_report(p, p->stage_base[st] + p->stage_weight[st] * (double)done / (double)count);
+    }
+    for (int i = 0; i < started; ++i) pthread_join(tids[i], NULL);
+    pool_report(p, st == 1 ? 1.0 : p->stage_base[st] + p->stage_weight[st]);
+    return 0;
+}
+
+/* ---------------- defs ---------------- */
+
+sdfccd_GridDef sdfccd_default_grid_def(void)
+{
+    sdfccd_GridDef d;
+    memset(&d, 0, sizeof d);
+    d.resolution[0] = d.resolution[1] = d.resolution[2] = 32;
+    d.fit_domain = 1;
+    d.band = 0.0;
+    d.threads = 0;
+    d.internal_value = GRID_DEF_MAGIC;
+    return d;
+}
+
+static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
+{
+    if (!def) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: def is NULL", fn);
+    if (def->internal_value != GRID_DEF_MAGIC)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: def was not initialised with sdfccd_default_grid_def()", fn);
+    for (int i = 0; i < 3; ++i)
+        if (def->resolution[i] < 1)
+            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: resolution[%d] = %d must be >= 1", fn, i, def->resolution[i]);
+    const uint64_t n = (uint64_t)def->resolution[0] * (uint64_t)def->resolution[1] * (uint64_t)def->resolution[2];
+    if (n > 0x7FFFFFFEull || scc_grid_dense_node_count((const uint32_t[3]){ (uint32_t)def->resolution[0], (uint32_t)def->resolution[1], (uint32_t)def->resolution[2] }) >= 0xFFFFFFFFull)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: resolution %d x %d x %d needs more than 2^32 nodes", fn,
+                          def->resolution[0], def->resolution[1], def->resolution[2]);
+    if (!def->fit_domain) {
+        sdfccd_Status st;
+        if ((st = capi_check_vec(def->domain.lo, "domain.lo")) || (st = capi_check_vec(def->domain.hi, "domain.hi"))) return st;
+        if (!(def->domain.lo.x < def->domain.hi.x && def->domain.lo.y < def->domain.hi.y && def->domain.lo.z < def->domain.hi.z))
+            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: domain.lo must be below domain.hi on every axis", fn);
+    }
+    if (!(def->band >= 0.0) || isnan(def->band))
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: band = %g must be >= 0 (0 = dense)", fn, def->band);
+    if (def->threads < 0) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: threads = %d must be >= 0", fn, def->threads);
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status build_status(scc_grid_build_status st, const char* fn)
+{
+    switch (st) {
+    case SCC_GRID_BUILD_OK: return SDFCCD_OK;
+    case SCC_GRID_BUILD_OUT_OF_MEMORY: return capi_oom("a grid");
+    case SCC_GRID_BUILD_TOO_LARGE: return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the grid needs more than 2^32 nodes", fn);
+    case SCC_GRID_BUILD_EMPTY_BAND: return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the band culled every cell (no surface inside the domain?)", fn);
+    case SCC_GRID_BUILD_BAD_VALUE: return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the source returned a non-finite value at a node", fn);
+    case SCC_GRID_BUILD_CANCELLED: return capi_error(SDFCCD_BAD_STATE, "%s: cancelled", fn);
+    }
+    return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: unknown build failure", fn);
+}
+
+static void fill_build_def(scc_grid_build_def* bd, const sdfccd_GridDef* def, scc_aabb domain, capi_pool* pool)
+{
+    memset(bd, 0, sizeof *bd);
+    bd->lo = domain.lo;
+    bd->hi = domain.hi;
+    for (int i = 0; i < 3; ++i) bd->res[i] = (uint32_t)def->resolution[i];
+    bd->band = def->band > 0.0 ? def->band : 0.0;
+    bd->parallel_for = capi_pool_parallel_for;
+    bd->parallel_user = pool;
+}
+
+/* ---------------- build from a mesh ---------------- */
+
+typedef struct mesh_sample_ctx {
+    const scc_mesh_sdf* ms;
+    double sign;
+} mesh_sample_ctx;
+
+static double mesh_sample(void* user, scc_vec3 p)
+{
+    const mesh_sample_ctx* c = user;
+    scc_mesh_distance_result r;
+    scc_mesh_sdf_query(c->ms, p, &r);
+    return c->sign * r.distance;
+}
+
+sdfccd_Status capi_mesh_topology_message(const scc_mesh_topology* t, const char* fn)
+{
+    if (!t->closed)
+        return capi_error(SDFCCD_DEGENERATE,
+                          "%s: the mesh is not closed (%u boundary, %u non-manifold, %u inconsistently oriented edges); "
+                          "signs would be wrong (set allow_open_mesh to build anyway)",
+                          fn, t->boundary_edges, t->nonmanifold_edges, t->inconsistent_edges);
+    if (!(t->volume > 0.0))
+        return capi_error(SDFCCD_DEGENERATE, "%s: the mesh is inside out (signed volume %g <= 0); flip its triangles", fn, t->volume);
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
+{
+    static const char* fn = "sdfccd_create_grid_from_mesh";
+    sdfccd_Status st;
+    if ((st = check_grid_def(def, fn)) || (st = capi_check_ptr(out_grid, "sdfccd_create_grid_from_mesh: out_grid"))) return st;
+    capi_mesh* m = capi_mesh_lookup(mesh);
+    if (!m) return SDFCCD_INVALID_HANDLE;
+    scc_mesh_sdf ms;
+    if (scc_mesh_sdf_init(&ms, capi_allocator(), &m->mesh) != 0) return capi_oom("a mesh distance structure");
+    if (!def->allow_open_mesh && (st = capi_mesh_topology_message(&ms.topology, fn))) {
+        scc_mesh_sdf_destroy(&ms);
+        return st;
+    }
+    const scc_aabb domain = def->fit_domain ? scc_grid_fit_domain(m->mesh.bounds) : capi_box(def->domain);
+    capi_pool pool;
+    capi_pool_init(&pool, def->threads, def->progress, def->progress_user);
+    scc_grid_build_def bd;
+    fill_build_def(&bd, def, domain, &pool);
+    mesh_sample_ctx ctx = { &ms, def->invert ? -1.0 : 1.0 };
+    bd.sample = mesh_sample;
+    bd.sample_user = &ctx;
+    scc_grid* g = NULL;
+    st = build_status(scc_grid_build(capi_allocator(), &bd, &g), fn);
+    scc_mesh_sdf_destroy(&ms);
+    if (st) return st;
+    return capi_grid_register(g, out_grid);
+}
+
+/* ---------------- build from an SDF ---------------- */
+
+typedef struct sdf_sample_ctx { const scc_sdf* sdf; double sign; } sdf_sample_ctx;
+
+static double sdf_sample(void* user, scc_vec3 p)
+{
+    const sdf_sample_ctx* c = user;
+    return c->sign * scc_sdf_eval(c->sdf, p, NULL);
+}
+
+sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
+{
+    static const char* fn = "sdfccd_create_grid_from_sdf";
+    sdfccd_Status st;
+    if ((st = check_grid_def(def, fn)) || (st = capi_check_ptr(out_grid, "sdfccd_create_grid_from_sdf: out_grid"))) return st;
+    capi_sdf* s = capi_sdf_lookup(sdf);
+    if (!s) return SDFCCD_INVALID_HANDLE;
+    scc_aabb domain;
+    if (def->fit_domain) {
+        if (!scc_vfinite(s->sdf->bounds.lo) || !scc_vfinite(s->sdf->bounds.hi))
+            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the SDF's bounds are infinite; set fit_domain = 0 and a domain", fn);
+        domain = scc_grid_fit_domain(s->sdf->bounds);
+    } else {
+        domain = capi_box(def->domain);
+    }
+    capi_sdf_retain(s); /* keep the source alive during the build */
+    capi_pool pool;
+    capi_pool_init(&pool, def->threads, def->progress, def->progress_user);
+    scc_grid_build_def bd;
+    fill_build_def(&bd, def, domain, &pool);
+    sdf_sample_ctx ctx = { s->sdf, def->invert ? -1.0 : 1.0 };
+    bd.sample = sdf_sample;
+    bd.sample_user = &ctx;
+    scc_grid* g = NULL;
+    st = build_status(scc_grid_build(capi_allocator(), &bd, &g), fn);
+    capi_sdf_release(s);
+    if (st) return st;
+    return capi_grid_register(g, out_grid);
+}
+
+/* ---------------- inspection ---------------- */
+
+int64_t capi_grid_file_bytes(const scc_grid* g)
+{
+    int64_t b = 124 + 3 * 8;
+    for (uint32_t f = 0; f < g->field_count; ++f)
+        b += 8 + 8 * (int64_t)g->fields[f].node_count + 8 + 128 * (int64_t)g->fields[f].cell_count + 8 + 4 * (int64_t)g->n_cells;
+    return b;
+}
+
+sdfccd_Status sdfccd_grid_get_info(sdfccd_SdfId grid, sdfccd_GridInfo* out_info)
+{
+    sdfccd_Status st;
+    if ((st = capi_check_ptr(out_info, "sdfccd_grid_get_info: out_info"))) return st;
+    scc_grid* g;
+    if ((st = capi_grid_lookup(grid, "sdfccd_grid_get_info", &g))) return st;
+    sdfccd_GridInfo* o = out_info;
+    memset(o, 0, sizeof *o);
+    for (int i = 0; i < 3; ++i) o->resolution[i] = (int32_t)g->res[i];
+    o->domain.lo = capi_pv(g->lo);
+    o->domain.hi = capi_pv(g->hi);
+    o->cell_size = capi_pv(g->h);
+    o->field_count = (int32_t)g->field_count;
+    o->cell_count = (int64_t)g->n_cells;
+    o->stored_cells = (int64_t)g->fields[0].cell_count;
+    o->valued_cells = (int64_t)g->valued_cells;
+    o->node_count = (int64_t)g->fields[0].node_count;
+    o->memory_bytes = (int64_t)(scc_grid_memory(g) + sizeof(capi_sdf) + sizeof(scc_grid*));
+    o->file_bytes = capi_grid_file_bytes(g);
+    o->max_lipschitz = g->lipschitz_max;
+    o->band = g->band;
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_grid_interpolate(sdfccd_SdfId grid, int32_t field, sdfccd_Vec3 p, double* out_value,
+                                      sdfccd_Vec3* out_grad, int32_t* out_has_value)
+{
+    sdfccd_Status st;
+    if ((st = capi_check_ptr(out_value, "sdfccd_grid_interpolate: out_value")) ||
+        (st = capi_check_ptr(out_has_value, "sdfccd_grid_interpolate: out_has_value")) ||
+        (st = capi_check_vec(p, "sdfccd_grid_interpolate: p")))
+        return st;
+    scc_grid* g;
+    if ((st = capi_grid_lookup(grid, "sdfccd_grid_interpolate", &g))) return st;
+    if (field < 0 || (uint32_t)field >= g->field_count)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_grid_interpolate: field %d is not in [0, %u)", field, g->field_count);
+    double v = 0.0;
+    scc_vec3 gr = scc_v3(0, 0, 0);
+    const int ok = scc_grid_interpolate(g, (uint32_t)field, capi_v(p), &v, &gr);
+    *out_has_value = ok;
+    *out_value = ok ? v : 0.0;
+    if (out_grad) *out_grad = ok ? capi_pv(gr) : capi_pv(scc_v3(0, 0, 0));
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_grid_lipschitz_bound(sdfccd_SdfId grid, sdfccd_Aabb box, double* out_bound)
+{
+    sdfccd_Status st;
+    if ((st = capi_check_ptr(out_bound, "sdfccd_grid_lipschitz_bound: out_bound"))) return st;
+    scc_grid* g;
+    if ((st = capi_grid_lookup(grid, "sdfccd_grid_lipschitz_bound", &g))) return st;
+    scc_aabb b = capi_box(box);
+    *out_bound = scc_grid_lipschitz_in(&g->base, &b);
+    return SDFCCD_OK;
+}

@@ -1,0 +1,221 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd C ABI: reading and writing Discregrid .cdf/.cdm files (the raw layout of
+ * CubicLagrangeDiscreteGrid::save, which Bullet's btMiniSDF::load also reads; shared notes
+ * sdf-format-and-assets.md section 1). The reader validates every count against the bytes
+ * left before allocating or reading, and every node id and cell-map entry against its array,
+ * so a corrupt file gives a status and never an out-of-bounds access. */
+#include "grid_internal.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+static int host_is_little_endian(void)
+{
+    const uint32_t one = 1;
+    unsigned char b;
+    memcpy(&b, &one, 1);
+    return b == 1;
+}
+
+/* ---------------- reading ---------------- */
+
+typedef struct reader {
+    const unsigned char* data;
+    size_t size, pos;
+} reader;
+
+static sdfccd_Status fmt(const reader* r, const char* what)
+{
+    return capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: %s (at byte %zu of %zu)", what, r->pos, r->size);
+}
+
+static int rd(reader* r, void* out, size_t n)
+{
+    if (r->size - r->pos < n) return 0;
+    memcpy(out, r->data + r->pos, n);
+    r->pos += n;
+    return 1;
+}
+
+static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId* out_grid)
+{
+    reader r = { data, size, 0 };
+    double dom[6], h[3], ih[3];
+    uint32_t res[3];
+    uint64_t n_cells, n_fields, outer;
+    if (!rd(&r, dom, sizeof dom) || !rd(&r, res, sizeof res) || !rd(&r, h, sizeof h) || !rd(&r, ih, sizeof ih) ||
+        !rd(&r, &n_cells, 8) || !rd(&r, &n_fields, 8))
+        return fmt(&r, "file too short for the header");
+    for (int i = 0; i < 3; ++i) {
+        if (!isfinite(dom[i]) || !isfinite(dom[3 + i]) || !(dom[i] < dom[3 + i])) { r.pos = 0; return fmt(&r, "domain is not finite or min >= max"); }
+        if (res[i] == 0) { r.pos = 48; return fmt(&r, "a resolution is 0"); }
+        const double ext = dom[3 + i] - dom[i];
+        if (!isfinite(h[i]) || !(h[i] > 0.0) || fabs(h[i] * res[i] - ext) > 1e-9 * ext) { r.pos = 60; return fmt(&r, "cell size does not match domain / resolution"); }
+        if (!isfinite(ih[i]) || fabs(h[i] * ih[i] - 1.0) > 1e-9) { r.pos = 84; return fmt(&r, "inverse cell size does not match the cell size"); }
+    }
+    const uint64_t full = (uint64_t)res[0] * res[1] * res[2];
+    if (n_cells != full) { r.pos = 108; return fmt(&r, "cell count differs from the product of the resolution"); }
+    if (n_cells > 0x7FFFFFFEull) { r.pos = 108; return fmt(&r, "more than 2^31 - 2 cells"); }
+    if (n_fields == 0 || n_fields > 1024) { r.pos = 116; return fmt(&r, "field count is 0 or implausibly large"); }
+    /* The smallest possible file for these counts: each field needs 3 counts and its map. */
+    if ((size - r.pos) / (24 + 4 * (n_cells ? n_cells : 1)) < n_fields) return fmt(&r, "file too short for the field count and cell maps");
+
+    const scc_vec3 lo = scc_v3(dom[0], dom[1], dom[2]), hi = scc_v3(dom[3], dom[4], dom[5]);
+    scc_grid* g = scc_grid_create_raw(capi_allocator(), lo, hi, res, scc_v3(h[0], h[1], h[2]), scc_v3(ih[0], ih[1], ih[2]), (uint32_t)n_fields);
+    if (!g) return capi_oom("a grid");
+    const scc_allocator* a = capi_allocator();
+    sdfccd_Status st = SDFCCD_OK;
+
+    /* node arrays */
+    if (!rd(&r, &outer, 8)) { st = fmt(&r, "file ends before the node arrays"); goto fail; }
+    if (outer != n_fields) { st = fmt(&r, "number of node arrays differs from the field count"); goto fail; }
+    for (uint64_t f = 0; f < n_fields; ++f) {
+        uint64_t count;
+        if (!rd(&r, &count, 8)) { st = fmt(&r, "file ends in a node array count"); goto fail; }
+        if (count > (size - r.pos) / 8) { st = fmt(&r, "node array larger than the rest of the file"); goto fail; }
+        if (count > 0xFFFFFFFFull) { st = fmt(&r, "node array count beyond 32-bit ids"); goto fail; }
+        scc_grid_field* fd = &g->fields[f];
+        if (count) {
+            fd->nodes = scc_alloc(a, (size_t)count * 8);
+            if (!fd->nodes) { st = capi_oom("grid nodes"); goto fail; }
+        }
+        fd->node_count = count;
+        const size_t at = r.pos;
+        rd(&r, fd->nodes, (size_t)count * 8);
+        for (uint64_t i = 0; i < count; ++i)
+            if (!isfinite(fd->nodes[i])) { r.pos = at + 8 * i; st = fmt(&r, "node value is NaN or infinite"); goto fail; }
+    }
+    /* cell arrays */
+    if (!rd(&r, &outer, 8)) { st = fmt(&r, "file ends before the cell arrays"); goto fail; }
+    if (outer != n_fields) { st = fmt(&r, "number of cell arrays differs from the field count"); goto fail; }
+    for (uint64_t f = 0; f < n_fields; ++f) {
+        uint64_t count;
+        if (!rd(&r, &count, 8)) { st = fmt(&r, "file ends in a cell array count"); goto fail; }
+        if (count > (size - r.pos) / 128) { st = fmt(&r, "cell array larger than the rest of the file"); goto fail; }
+        if (count > n_cells) { st = fmt(&r, "more stored cells than grid cells"); goto fail; }
+        scc_grid_field* fd = &g->fields[f];
+        if (count) {
+            fd->cells = scc_alloc(a, (size_t)count * 128);
+            if (!fd->cells) { st = capi_oom("grid cells"); goto fail; }
+        }
+        fd->cell_count = count;
+        const size_t at = r.pos;
+        rd(&r, fd->cells, (size_t)count * 128);
+        for (uint64_t i = 0; i < count * 32; ++i)
+            if (fd->cells[i] >= fd->node_count) { r.pos = at + 4 * i; st = fmt(&r, "cell references a node id out of range"); goto fail; }
+    }
+    /* cell maps */
+    if (!rd(&r, &outer, 8)) { st = fmt(&r, "file ends before the cell maps"); goto fail; }
+    if (outer != n_fields) { st = fmt(&r, "number of cell maps differs from the field count"); goto fail; }
+    for (uint64_t f = 0; f < n_fields; ++f) {
+        uint64_t count;
+        if (!rd(&r, &count, 8)) { st = fmt(&r, "file ends in a cell map count"); goto fail; }
+        if (count != n_cells) { st = fmt(&r, "cell map length differs from the cell count"); goto fail; }
+        if (count > (size - r.pos) / 4) { st = fmt(&r, "cell map larger than the rest of the file"); goto fail; }
+        scc_grid_field* fd = &g->fields[f];
+        fd->map = scc_alloc(a, (size_t)count * 4);
+        if (!fd->map) { st = capi_oom("grid cell map"); goto fail; }
+        const size_t at = r.pos;
+        rd(&r, fd->map, (size_t)count * 4);
+        for (uint64_t i = 0; i < count; ++i)
+            if (fd->map[i] != SCC_GRID_NO_CELL && fd->map[i] >= fd->cell_count) { r.pos = at + 4 * i; st = fmt(&r, "cell map entry out of range"); goto fail; }
+    }
+    if (r.pos != size) { st = fmt(&r, "trailing bytes after the last cell map"); goto fail; }
+
+    capi_pool pool;
+    capi_pool_init(&pool, 0, NULL, NULL);
+    switch (scc_grid_finalize(g, 0.0, capi_pool_parallel_for, &pool)) {
+    case SCC_GRID_OK: break;
+    case SCC_GRID_EMPTY: st = capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: field 0 has no cell with values"); goto fail;
+    case SCC_GRID_TOO_LARGE: st = capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: too many cells"); goto fail;
+    default: st = capi_oom("grid bounds"); goto fail;
+    }
+    return capi_grid_register(g, out_grid);
+fail:
+    scc_grid_destroy(g);
+    return st;
+}
+
+sdfccd_Status sdfccd_load_grid_memory(const void* data, size_t size, sdfccd_SdfId* out_grid)
+{
+    sdfccd_Status st;
+    if ((st = capi_check_ptr(data, "sdfccd_load_grid_memory: data")) || (st = capi_check_ptr(out_grid, "sdfccd_load_grid_memory: out_grid"))) return st;
+    if (!host_is_little_endian()) return capi_error(SDFCCD_UNSUPPORTED, "sdfccd_load_grid: .cdf files are little-endian; this host is not");
+    return parse(data, size, out_grid);
+}
+
+sdfccd_Status sdfccd_load_grid(const char* path, sdfccd_SdfId* out_grid)
+{
+    sdfccd_Status st;
+    if ((st = capi_check_ptr(path, "sdfccd_load_grid: path")) || (st = capi_check_ptr(out_grid, "sdfccd_load_grid: out_grid"))) return st;
+    if (!host_is_little_endian()) return capi_error(SDFCCD_UNSUPPORTED, "sdfccd_load_grid: .cdf files are little-endian; this host is not");
+    FILE* f = fopen(path, "rb");
+    if (!f) return capi_error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot open '%s': %s", path, strerror(errno));
+    long size = -1;
+    if (fseek(f, 0, SEEK_END) == 0) size = ftell(f);
+    if (size < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        return capi_error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot determine the size of '%s'", path);
+    }
+    if (size == 0) {
+        fclose(f);
+        return capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: '%s' is empty", path);
+    }
+    unsigned char* buf = capi_alloc((size_t)size);
+    if (!buf) { fclose(f); return capi_oom("a file buffer"); }
+    const size_t got = fread(buf, 1, (size_t)size, f);
+    const int err = ferror(f);
+    fclose(f);
+    if (got != (size_t)size || err) {
+        capi_free(buf, (size_t)size);
+        return capi_error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot read '%s'", path);
+    }
+    st = parse(buf, (size_t)size, out_grid);
+    capi_free(buf, (size_t)size);
+    if (st) {
+        /* prefix the path to the parser's message */
+        char msg[400];
+        snprintf(msg, sizeof msg, "%s", sdfccd_last_error());
+        capi_error(st, "%s ['%s']", msg, path);
+    }
+    return st;
+}
+
+/* ---------------- writing ---------------- */
+
+static int wr(FILE* f, const void* p, size_t n) { return n == 0 || fwrite(p, 1, n, f) == n; }
+
+sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
+{
+    sdfccd_Status st;
+    if ((st = capi_check_ptr(path, "sdfccd_save_grid: path"))) return st;
+    scc_grid* g;
+    if ((st = capi_grid_lookup(grid, "sdfccd_save_grid", &g))) return st;
+    if (!host_is_little_endian()) return capi_error(SDFCCD_UNSUPPORTED, "sdfccd_save_grid: .cdf files are little-endian; this host is not");
+    FILE* f = fopen(path, "wb");
+    if (!f) return capi_error(SDFCCD_IO_ERROR, "sdfccd_save_grid: cannot create '%s': %s", path, strerror(errno));
+    const double dom[6] = { g->lo.x, g->lo.y, g->lo.z, g->hi.x, g->hi.y, g->hi.z };
+    const double h[3] = { g->h.x, g->h.y, g->h.z }, ih[3] = { g->inv_h.x, g->inv_h.y, g->inv_h.z };
+    const uint64_t n_cells = g->n_cells, n_fields = g->field_count;
+    int ok = wr(f, dom, sizeof dom) && wr(f, g->res, 12) && wr(f, h, sizeof h) && wr(f, ih, sizeof ih) &&
+             wr(f, &n_cells, 8) && wr(f, &n_fields, 8);
+    ok = ok && wr(f, &n_fields, 8);
+    for (uint32_t i = 0; ok && i < g->field_count; ++i) {
+        const uint64_t c = g->fields[i].node_count;
+        ok = wr(f, &c, 8) && wr(f, g->fields[i].nodes, (size_t)c * 8);
+    }
+    ok = ok && wr(f, &n_fields, 8);
+    for (uint32_t i = 0; ok && i < g->field_count; ++i) {
+        const uint64_t c = g->fields[i].cell_count;
+        ok = wr(f, &c, 8) && wr(f, g->fields[i].cells, (size_t)c * 128);
+    }
+    ok = ok && wr(f, &n_fields, 8);
+    for (uint32_t i = 0; ok && i < g->field_count; ++i) ok = wr(f, &n_cells, 8) && wr(f, g->fields[i].map, (size_t)n_cells * 4);
+    if (fclose(f) != 0) ok = 0;
+    if (!ok) {
+        remove(path);
+        return capi_error(SDFCCD_IO_ERROR, "sdfccd_save_grid: writing '%s' failed", path);
+    }
+    return SDFCCD_OK;
+}

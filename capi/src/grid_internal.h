@@ -1,0 +1,31 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd C ABI internals for grid SDFs: the handle wrapper and the thread pool. */
+#ifndef SDFCCD_GRID_INTERNAL_H
+#define SDFCCD_GRID_INTERNAL_H
+
+#include "capi_internal.h"
+#include "sdfccd/grid.h"
+#include "../../core/grid.h"
+
+/* Wraps a finished core grid in a new SDF handle (takes ownership; destroys it on failure). */
+sdfccd_Status capi_grid_register(scc_grid* g, sdfccd_SdfId* out_sdf);
+/* The grid behind a handle: INVALID_HANDLE, or INVALID_ARGUMENT when the SDF is not a grid. */
+sdfccd_Status capi_grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid);
+/* Size of the .cdf file of a grid. */
+int64_t capi_grid_file_bytes(const scc_grid* g);
+/* DEGENERATE with a message when the topology cannot give correct signs, else OK. */
+struct scc_mesh_topology;
+sdfccd_Status capi_mesh_topology_message(const struct scc_mesh_topology* t, const char* fn);
+
+/* Runs a parallel_for on `threads` threads (0 = online cores) and reports progress. */
+typedef struct capi_pool {
+    int threads;
+    sdfccd_ProgressFcn* progress;
+    void* progress_user;
+    double stage_base[2], stage_weight[2]; /* progress mapping per stage */
+    double last_reported;
+} capi_pool;
+void capi_pool_init(capi_pool* p, int threads, sdfccd_ProgressFcn* progress, void* user);
+int capi_pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx);
+
+#endif

@@ -1,0 +1,648 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: the 32-node cubic Lagrange (serendipity) cell of Discregrid (Koschier et al.,
+ * "An hp-adaptive discretization algorithm for signed distance field generation", 2017) as
+ * used by Discregrid's CubicLagrangeDiscreteGrid and Bullet's btMiniSDF; grid evaluation,
+ * conservative values outside the domain and in culled cells, and per-cell gradient bounds
+ * from the Bernstein form of the interpolant's derivative. Written from the description in
+ * the shared notes (sdf-format-and-assets.md sections 2-5), not from either codebase.
+ */
+#include "grid.h"
+
+#include <float.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------------------------
+ * The element. Slot numbering (notes section 3):
+ *   corners      0..7 : di + 2 dj + 4 dk            at (2di-1, 2dj-1, 2dk-1)
+ *   x-edge nodes 8..15: 8 + 4 dj + 2 dk + s         at (-1/3 + 2s/3, 2dj-1, 2dk-1)
+ *   y-edge nodes 16..23: 16 + 4 dk + 2 di + s       at (2di-1, -1/3 + 2s/3, 2dk-1)
+ *   z-edge nodes 24..31: 24 + 4 di + 2 dj + s       at (2di-1, 2dj-1, -1/3 + 2s/3)
+ * ---------------------------------------------------------------------------------------- */
+
+/* sigma[a] = local coordinates of slot a; axis[a] = edge direction (-1 for corners). */
+static const double k_sigma[32][3] = {
+    { -1, -1, -1 }, { 1, -1, -1 }, { -1, 1, -1 }, { 1, 1, -1 },
+    { -1, -1, 1 }, { 1, -1, 1 }, { -1, 1, 1 }, { 1, 1, 1 },
+    /* x edges: 8 + 4dj + 2dk + s */
+    { -1.0 / 3, -1, -1 }, { 1.0 / 3, -1, -1 }, { -1.0 / 3, -1, 1 }, { 1.0 / 3, -1, 1 },
+    { -1.0 / 3, 1, -1 }, { 1.0 / 3, 1, -1 }, { -1.0 / 3, 1, 1 }, { 1.0 / 3, 1, 1 },
+    /* y edges: 16 + 4dk + 2di + s */
+    { -1, -1.0 / 3, -1 }, { -1, 1.0 / 3, -1 }, { 1, -1.0 / 3, -1 }, { 1, 1.0 / 3, -1 },
+    { -1, -1.0 / 3, 1 }, { -1, 1.0 / 3, 1 }, { 1, -1.0 / 3, 1 }, { 1, 1.0 / 3, 1 },
+    /* z edges: 24 + 4di + 2dj + s */
+    { -1, -1, -1.0 / 3 }, { -1, -1, 1.0 / 3 }, { -1, 1, -1.0 / 3 }, { -1, 1, 1.0 / 3 },
+    { 1, -1, -1.0 / 3 }, { 1, -1, 1.0 / 3 }, { 1, 1, -1.0 / 3 }, { 1, 1, 1.0 / 3 },
+};
+
+scc_vec3 scc_cell_node_local(int slot)
+{
+    if (slot < 0 || slot > 31) return scc_v3(0, 0, 0);
+    return scc_v3(k_sigma[slot][0], k_sigma[slot][1], k_sigma[slot][2]);
+}
+
+void scc_cell_shape(scc_vec3 xi, double N[32], double dN[32][3])
+{
+    const double x[3] = { xi.x, xi.y, xi.z };
+    /* Linear factors (1 + s x_d) for s = -1 (index 0) and s = +1 (index 1). */
+    double lin[3][2];
+    for (int d = 0; d < 3; ++d) { lin[d][0] = 1.0 - x[d]; lin[d][1] = 1.0 + x[d]; }
+    const double r2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    const double q = 9.0 * r2 - 19.0;
+
+    /* Corners: N = (1/64) (1+s1 x)(1+s2 y)(1+s3 z)(9 r^2 - 19). */
+    for (int a = 0; a < 8; ++a) {
+        const int i0 = a & 1, i1 = (a >> 1) & 1, i2 = (a >> 2) & 1;
+        const double l0 = lin[0][i0], l1 = lin[1][i1], l2 = lin[2][i2];
+        N[a] = (1.0 / 64.0) * l0 * l1 * l2 * q;
+        if (dN) {
+            const double s[3] = { i0 ? 1.0 : -1.0, i1 ? 1.0 : -1.0, i2 ? 1.0 : -1.0 };
+            const double l[3] = { l0, l1, l2 };
+            for (int e = 0; e < 3; ++e) {
+                const double others = l[(e + 1) % 3] * l[(e + 2) % 3];
+                dN[a][e] = (1.0 / 64.0) * others * (s[e] * q + 18.0 * x[e] * l[e]);
+            }
+        }
+    }
+    /* Edge nodes: along axis d at sd = +-1/3, the two other axes p (outer) and q (inner).
+     * N = (9/64)(1 - x_d^2)(1 + 9 sd x_d)(1 + sp x_p)(1 + sq x_q). */
+    for (int d = 0; d < 3; ++d) {
+        const int p = d == 0 ? 1 : (d == 1 ? 2 : 0); /* outer axis of the slot nesting */
+        const int r = d == 0 ? 2 : (d == 1 ? 0 : 1); /* inner axis */
+        const double w = 1.0 - x[d] * x[d];
+        for (int dp = 0; dp < 2; ++dp)
+            for (int dr = 0; dr < 2; ++dr)
+                for (int s = 0; s < 2; ++s) {
+                    const int a = 8 + 8 * d + 4 * dp + 2 * dr + s;
+                    const double c = s ? 3.0 : -3.0; /* 9 * sd */
+                    const double m = 1.0 + c * x[d];
+                    const double lp = lin[p][dp], lr = lin[r][dr];
+                    N[a] = (9.0 / 64.0) * w * m * lp * lr;
+                    if (dN) {
+                        dN[a][d] = (9.0 / 64.0) * lp * lr * (c * w - 2.0 * x[d] * m);
+                        dN[a][p] = (9.0 / 64.0) * w * m * (dp ? 1.0 : -1.0) * lr;
+                        dN[a][r] = (9.0 / 64.0) * w * m * lp * (dr ? 1.0 : -1.0);
+                    }
+                }
+    }
+}
+
+/* ------------------------------------------------------------------------------------------
+ * Grid data
+ * ---------------------------------------------------------------------------------------- */
+
+static scc_grid* grid_alloc(const scc_allocator* a, uint32_t field_count)
+{
+    if (field_count == 0) return NULL;
+    scc_grid* g = scc_alloc(a, sizeof *g);
+    if (!g) return NULL;
+    memset(g, 0, sizeof *g);
+    g->fields = scc_alloc(a, (size_t)field_count * sizeof *g->fields);
+    if (!g->fields) { scc_free(a, g, sizeof *g); return NULL; }
+    memset(g->fields, 0, (size_t)field_count * sizeof *g->fields);
+    g->field_count = field_count;
+    g->allocator = *a;
+    return g;
+}
+
+scc_grid* scc_grid_create_raw(const scc_allocator* a, scc_vec3 lo, scc_vec3 hi, const uint32_t res[3],
+                              scc_vec3 h, scc_vec3 inv_h, uint32_t field_count)
+{
+    scc_grid* g = grid_alloc(a, field_count);
+    if (!g) return NULL;
+    g->lo = lo; g->hi = hi;
+    g->res[0] = res[0]; g->res[1] = res[1]; g->res[2] = res[2];
+    g->h = h; g->inv_h = inv_h;
+    g->n_cells = (uint64_t)res[0] * res[1] * res[2];
+    return g;
+}
+
+scc_grid* scc_grid_create(const scc_allocator* a, scc_vec3 lo, scc_vec3 hi, const uint32_t res[3], uint32_t field_count)
+{
+    scc_vec3 h = scc_v3((hi.x - lo.x) / (double)res[0], (hi.y - lo.y) / (double)res[1], (hi.z - lo.z) / (double)res[2]);
+    scc_vec3 ih = scc_v3(1.0 / h.x, 1.0 / h.y, 1.0 / h.z);
+    return scc_grid_create_raw(a, lo, hi, res, h, ih, field_count);
+}
+
+void scc_grid_destroy(scc_grid* g)
+{
+    if (!g) return;
+    const scc_allocator* a = &g->allocator;
+    scc_allocator al = *a;
+    for (uint32_t f = 0; f < g->field_count; ++f) {
+        scc_grid_field* fd = &g->fields[f];
+        scc_free(&al, fd->nodes, (size_t)fd->node_count * sizeof(double));
+        scc_free(&al, fd->cells, (size_t)fd->cell_count * 32 * sizeof(uint32_t));
+        scc_free(&al, fd->map, (size_t)g->n_cells * sizeof(uint32_t));
+    }
+    if (g->field_count) {
+        scc_free(&al, g->cell_lipschitz, (size_t)g->fields[0].cell_count * sizeof(float));
+    }
+    scc_free(&al, g->hole_source, (size_t)g->n_cells * sizeof(uint32_t));
+    scc_free(&al, g->fields, (size_t)g->field_count * sizeof *g->fields);
+    scc_free(&al, g, sizeof *g);
+}
+
+size_t scc_grid_memory(const scc_grid* g)
+{
+    size_t b = sizeof *g + (size_t)g->field_count * sizeof *g->fields;
+    for (uint32_t f = 0; f < g->field_count; ++f) {
+        const scc_grid_field* fd = &g->fields[f];
+        b += (size_t)fd->node_count * sizeof(double) + (size_t)fd->cell_count * 32 * sizeof(uint32_t)
+           + (fd->map ? (size_t)g->n_cells * sizeof(uint32_t) : 0);
+    }
+    if (g->cell_lipschitz) b += (size_t)g->fields[0].cell_count * sizeof(float);
+    if (g->hole_source) b += (size_t)g->n_cells * sizeof(uint32_t);
+    return b;
+}
+
+/* ---- dense numbering (notes section 2 and 4) ---- */
+
+uint64_t scc_grid_dense_node_count(const uint32_t res[3])
+{
+    const uint64_t nx = res[0], ny = res[1], nz = res[2];
+    const uint64_t nv = (nx + 1) * (ny + 1) * (nz + 1);
+    const uint64_t ex = nx * (ny + 1) * (nz + 1), ey = (nx + 1) * ny * (nz + 1), ez = (nx + 1) * (ny + 1) * nz;
+    return nv + 2 * (ex + ey + ez);
+}
+
+scc_vec3 scc_grid_dense_node_position(const scc_grid* g, uint64_t l)
+{
+    const uint64_t nx = g->res[0], ny = g->res[1], nz = g->res[2];
+    const uint64_t nv = (nx + 1) * (ny + 1) * (nz + 1);
+    const uint64_t ex = nx * (ny + 1) * (nz + 1), ey = (nx + 1) * ny * (nz + 1);
+    uint64_t i, j, k;
+    int axis = -1;
+    double s = 0.0;
+    if (l < nv) {
+        k = l / ((nx + 1) * (ny + 1));
+        uint64_t r = l % ((nx + 1) * (ny + 1));
+        j = r / (nx + 1); i = r % (nx + 1);
+    } else if (l < nv + 2 * ex) {
+        uint64_t e = (l - nv) / 2;
+        s = (double)((l - nv) % 2);
+        k = e / (nx * (ny + 1));
+        uint64_t r = e % (nx * (ny + 1));
+        j = r / nx; i = r % nx;
+        axis = 0;
+    } else if (l < nv + 2 * (ex + ey)) {
+        uint64_t e = (l - nv - 2 * ex) / 2;
+        s = (double)((l - nv - 2 * ex) % 2);
+        /* y edges: j fastest, then k, then i */
+        i = e / (ny * (nz + 1));
+        uint64_t r = e % (ny * (nz + 1));
+        k = r / ny; j = r % ny;
+        axis = 1;
+    } else {
+        uint64_t e = (l - nv - 2 * (ex + ey)) / 2;
+        s = (double)((l - nv - 2 * (ex + ey)) % 2);
+        /* z edges: k fastest, then i, then j */
+        j = e / (nz * (nx + 1));
+        uint64_t r = e % (nz * (nx + 1));
+        i = r / nz; k = r % nz;
+        axis = 2;
+    }
+    scc_vec3 x = scc_v3(g->lo.x + g->h.x * (double)i, g->lo.y + g->h.y * (double)j, g->lo.z + g->h.z * (double)k);
+    const double f = (1.0 + s) / 3.0;
+    if (axis == 0) x.x += f * g->h.x;
+    else if (axis == 1) x.y += f * g->h.y;
+    else if (axis == 2) x.z += f * g->h.z;
+    return x;
+}
+
+void scc_grid_dense_cell_nodes(const uint32_t res[3], uint32_t i, uint32_t j, uint32_t k, uint32_t out[32])
+{
+    const uint64_t nx = res[0], ny = res[1], nz = res[2];
+    const uint64_t nv = (nx + 1) * (ny + 1) * (nz + 1);
+    const uint64_t ex = nx * (ny + 1) * (nz + 1), ey = (nx + 1) * ny * (nz + 1);
+    for (int dk = 0; dk < 2; ++dk)
+        for (int dj = 0; dj < 2; ++dj)
+            for (int di = 0; di < 2; ++di)
+                out[di + 2 * dj + 4 * dk] = (uint32_t)((i + di) + (nx + 1) * ((j + dj) + (ny + 1) * (uint64_t)(k + dk)));
+    for (int dj = 0; dj < 2; ++dj)
+        for (int dk = 0; dk < 2; ++dk)
+            for (int s = 0; s < 2; ++s)
+                out[8 + 4 * dj + 2 * dk + s] = (uint32_t)(nv + 2 * (i + nx * ((j + dj) + (ny + 1) * (uint64_t)(k + dk))) + s);
+    for (int dk = 0; dk < 2; ++dk)
+        for (int di = 0; di < 2; ++di)
+            for (int s = 0; s < 2; ++s)
+                out[16 + 4 * dk + 2 * di + s] = (uint32_t)(nv + 2 * ex + 2 * (j + ny * ((k + dk) + (nz + 1) * (uint64_t)(i + di))) + s);
+    for (int di = 0; di < 2; ++di)
+        for (int dj = 0; dj < 2; ++dj)
+            for (int s = 0; s < 2; ++s)
+                out[24 + 4 * di + 2 * dj + s] = (uint32_t)(nv + 2 * (ex + ey) + 2 * (k + nz * ((i + di) + (nx + 1) * (uint64_t)(j + dj))) + s);
+}
+
+/* ------------------------------------------------------------------------------------------
+ * Evaluation
+ * ---------------------------------------------------------------------------------------- */
+
+static inline void cell_ijk(const scc_grid* g, uint64_t l, uint32_t ijk[3])
+{
+    ijk[0] = (uint32_t)(l % g->res[0]);
+    ijk[1] = (uint32_t)((l / g->res[0]) % g->res[1]);
+    ijk[2] = (uint32_t)(l / ((uint64_t)g->res[0] * g->res[1]));
+}
+
+static inline scc_aabb cell_box(const scc_grid* g, const uint32_t ijk[3])
+{
+    scc_aabb b;
+    b.lo = scc_v3(g->lo.x + (double)ijk[0] * g->h.x, g->lo.y + (double)ijk[1] * g->h.y, g->lo.z + (double)ijk[2] * g->h.z);
+    b.hi = scc_add(b.lo, g->h);
+    return b;
+}
+
+/* Locates the cell of p (p inside the domain) the way Discregrid and Bullet do. */
+static inline uint64_t locate(const scc_grid* g, scc_vec3 p, uint32_t ijk[3])
+{
+    const double r[3] = { (p.x - g->lo.x) * g->inv_h.x, (p.y - g->lo.y) * g->inv_h.y, (p.z - g->lo.z) * g->inv_h.z };
+    for (int d = 0; d < 3; ++d) {
+        double v = r[d] > 0.0 ? r[d] : 0.0;
+        uint32_t m = v >= (double)g->res[d] ? g->res[d] - 1 : (uint32_t)v;
+        ijk[d] = m;
+    }
+    return ijk[0] + (uint64_t)g->res[0] * (ijk[1] + (uint64_t)g->res[1] * ijk[2]);
+}
+
+uint64_t scc_grid_cell_of(const scc_grid* g, scc_vec3 p)
+{
+    uint32_t ijk[3];
+    return locate(g, p, ijk);
+}
+
+/* Interpolates stored cell c (whose full-grid position is ijk) at p. Returns 0 when a node is
+ * not sampled. */
+static int interpolate_cell(const scc_grid* g, const scc_grid_field* fd, uint32_t c, const uint32_t ijk[3], scc_vec3 p,
+                            double* out_value, scc_vec3* out_grad)
+{
+    const scc_aabb b = cell_box(g, ijk);
+    const double den[3] = { b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z };
+    const double c0[3] = { 2.0 / den[0], 2.0 / den[1], 2.0 / den[2] };
+    const double c1[3] = { (b.hi.x + b.lo.x) / den[0], (b.hi.y + b.lo.y) / den[1], (b.hi.z + b.lo.z) / den[2] };
+    const scc_vec3 xi = scc_v3(c0[0] * p.x - c1[0], c0[1] * p.y - c1[1], c0[2] * p.z - c1[2]);
+    double N[32], dN[32][3];
+    scc_cell_shape(xi, N, out_grad ? dN : NULL);
+    const uint32_t* ids = fd->cells + (size_t)c * 32;
+    double phi = 0.0, gx = 0.0, gy = 0.0, gz = 0.0;
+    for (int a = 0; a < 32; ++a) {
+        const double v = fd->nodes[ids[a]];
+        if (v == SCC_GRID_NO_VALUE) return 0;
+        phi += v * N[a];
+        if (out_grad) { gx += v * dN[a][0]; gy += v * dN[a][1]; gz += v * dN[a][2]; }
+    }
+    *out_value = phi;
+    if (out_grad) *out_grad = scc_v3(gx * c0[0], gy * c0[1], gz * c0[2]);
+    return 1;
+}
+
+int scc_grid_interpolate(const scc_grid* g, uint32_t field, scc_vec3 p, double* out_value, scc_vec3* out_grad)
+{
+    if (field >= g->field_count) return 0;
+    if (!(p.x >= g->lo.x && p.x <= g->hi.x && p.y >= g->lo.y && p.y <= g->hi.y && p.z >= g->lo.z && p.z <= g->hi.z)) return 0;
+    const scc_grid_field* fd = &g->fields[field];
+    uint32_t ijk[3];
+    const uint64_t l = locate(g, p, ijk);
+    const uint32_t c = fd->map[l];
+    if (c == SCC_GRID_NO_CELL) return 0;
+    return interpolate_cell(g, fd, c, ijk, p, out_value, out_grad);
+}
+
+static inline scc_vec3 clamp_box(scc_vec3 p, const scc_aabb* b)
+{
+    return scc_v3(scc_clamp(p.x, b->lo.x, b->hi.x), scc_clamp(p.y, b->lo.y, b->hi.y), scc_clamp(p.z, b->lo.z, b->hi.z));
+}
+
+static inline double hmin(const scc_grid* g) { return fmin(g->h.x, fmin(g->h.y, g->h.z)); }
+
+/* Conservative value in a cell without values (full index l, position ijk). */
+static double eval_hole(const scc_grid* g, uint64_t l, const uint32_t ijk[3], scc_vec3 p, scc_vec3* out_grad)
+{
+    const uint32_t code = g->hole_source[l];
+    const double s = (code & 0x80000000u) ? -1.0 : 1.0;
+    const uint64_t src = code & 0x7FFFFFFFu;
+    uint32_t sijk[3];
+    cell_ijk(g, src, sijk);
+    uint32_t cheb = 0;
+    for (int d = 0; d < 3; ++d) {
+        uint32_t dd = ijk[d] > sijk[d] ? ijk[d] - sijk[d] : sijk[d] - ijk[d];
+        if (dd > cheb) cheb = dd;
+    }
+    double lb = g->band;
+    if (cheb >= 1) lb = fmax(lb, (double)(cheb - 1) * hmin(g));
+    /* 1-Lipschitz bound from the nearest point q of the source cell: |phi(p)| >= |phi(q)| - |p - q|. */
+    const scc_aabb sb = cell_box(g, sijk);
+    const scc_vec3 q = clamp_box(p, &sb);
+    const scc_vec3 dq = scc_sub(p, q);
+    const double dist = scc_len(dq);
+    double vq;
+    if (interpolate_cell(g, &g->fields[0], g->fields[0].map[src], sijk, q, &vq, NULL)) lb = fmax(lb, fabs(vq) - dist);
+    if (out_grad) {
+        scc_vec3 dir;
+        if (dist > 0.0) dir = scc_scale(dq, 1.0 / dist);
+        else {
+            const scc_aabb cb = cell_box(g, ijk);
+            dir = scc_normalize_or(scc_sub(scc_scale(scc_add(cb.lo, cb.hi), 0.5), scc_scale(scc_add(sb.lo, sb.hi), 0.5)), scc_v3(0, 0, 1));
+        }
+        *out_grad = scc_scale(dir, s);
+    }
+    return s * lb;
+}
+
+/* Field 0 at p inside the (closed) domain box. */
+static double eval_inside(const scc_grid* g, scc_vec3 p, scc_vec3* out_grad)
+{
+    const scc_grid_field* fd = &g->fields[0];
+    uint32_t ijk[3];
+    const uint64_t l = locate(g, p, ijk);
+    const uint32_t c = fd->map[l];
+    double v;
+    if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f && interpolate_cell(g, fd, c, ijk, p, &v, out_grad)) return v;
+    return eval_hole(g, l, ijk, p, out_grad);
+}
+
+double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
+{
+    const scc_grid* g = (const scc_grid*)self;
+    if (!scc_vfinite(p)) {
+        if (out_grad) *out_grad = scc_v3(0, 0, 1);
+        return INFINITY;
+    }
+    const scc_aabb dom = { g->lo, g->hi };
+    const scc_vec3 q = clamp_box(p, &dom);
+    const scc_vec3 dq = scc_sub(p, q);
+    const double d2 = scc_len2(dq);
+    if (d2 == 0.0) return eval_inside(g, p, out_grad);
+
+    /* Outside the domain: d = |p - q| to the nearest box point q, phi_q = phi(q).
+     * phi_q >= 0: sqrt(d^2 + phi_q^2) is a lower bound on the distance to a surface that lies
+     *             inside the box (any path to it crosses the box at some b with
+     *             |p - b| >= sqrt(d^2 + |q - b|^2) and phi(b) >= phi_q - |q - b|).
+     * phi_q < 0:  the box cuts the shape; continue with d + phi_q (continuous with the above).
+     * The gradient is that of these expressions; the part of grad phi(q) along clamped axes
+     * drops out. */
+    const double d = sqrt(d2);
+    scc_vec3 gq;
+    const double vq = eval_inside(g, q, out_grad ? &gq : NULL);
+    if (!out_grad) return vq >= 0.0 ? sqrt(d2 + vq * vq) : d + vq;
+    if (p.x != q.x) gq.x = 0.0;
+    if (p.y != q.y) gq.y = 0.0;
+    if (p.z != q.z) gq.z = 0.0;
+    if (vq >= 0.0) {
+        const double v = sqrt(d2 + vq * vq);
+        *out_grad = scc_scale(scc_madd(dq, gq, vq), 1.0 / v);
+        return v;
+    }
+    *out_grad = scc_add(scc_scale(dq, 1.0 / d), gq);
+    return d + vq;
+}
+
+double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
+{
+    const scc_grid* g = (const scc_grid*)self;
+    const double global = fmax(g->lipschitz_max, g->hole_source ? 1.0 : 0.0);
+    const double outside_global = sqrt(1.0 + global * global);
+    if (!box || !scc_vfinite(box->lo) || !scc_vfinite(box->hi) || box->lo.x > box->hi.x || box->lo.y > box->hi.y || box->lo.z > box->hi.z)
+        return outside_global;
+    const int leaves = box->lo.x < g->lo.x || box->lo.y < g->lo.y || box->lo.z < g->lo.z ||
+                       box->hi.x > g->hi.x || box->hi.y > g->hi.y || box->hi.z > g->hi.z;
+    const scc_aabb dom = { g->lo, g->hi };
+    uint32_t a[3], b[3];
+    locate(g, clamp_box(box->lo, &dom), a);
+    locate(g, clamp_box(box->hi, &dom), b);
+    const uint64_t count = (uint64_t)(b[0] - a[0] + 1) * (b[1] - a[1] + 1) * (b[2] - a[2] + 1);
+    double L = 0.0;
+    if (count > 32768) L = global;
+    else {
+        const scc_grid_field* fd = &g->fields[0];
+        for (uint32_t k = a[2]; k <= b[2]; ++k)
+            for (uint32_t j = a[1]; j <= b[1]; ++j)
+                for (uint32_t i = a[0]; i <= b[0]; ++i) {
+                    const uint64_t l = i + (uint64_t)g->res[0] * (j + (uint64_t)g->res[1] * k);
+                    const uint32_t c = fd->map[l];
+                    const double cl = (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) ? 1.0 : (double)g->cell_lipschitz[c];
+                    if (cl > L) L = cl;
+                }
+    }
+    return leaves ? sqrt(1.0 + L * L) : L;
+}
+
+/* ------------------------------------------------------------------------------------------
+ * Finalisation: per-cell gradient bounds and hole sources.
+ *
+ * Gradient bound: each component of grad phi in a cell is c0_d * dphi/dxi_d, a polynomial of
+ * degree <= 3 in each local coordinate. Sampled at the 4^3 tensor points {-1,-1/3,1/3,1}^3 and
+ * converted per axis to the cubic Bernstein basis on [-1,1], its coefficients enclose its
+ * range (convex hull property), so max |coefficient| bounds |dphi/dxi_d| on the whole cell.
+ * The map from the 32 node values to the 64 coefficients is a fixed 64x32 matrix per axis.
+ * ---------------------------------------------------------------------------------------- */
+
+typedef struct bern_tables { double m[3][64][32]; } bern_tables;
+
+static void bern_tables_init(bern_tables* t)
+{
+    static const double pts[4] = { -1.0, -1.0 / 3.0, 1.0 / 3.0, 1.0 };
+    /* Values at the 4 points above -> cubic Bernstein coefficients on [-1,1] (the inverse of
+     * the Bernstein basis sampled at those points). */
+    static const double conv[4][4] = {
+        { 1.0, 0.0, 0.0, 0.0 },
+        { -5.0 / 6.0, 3.0, -1.5, 1.0 / 3.0 },
+        { 1.0 / 3.0, -1.5, 3.0, -5.0 / 6.0 },
+        { 0.0, 0.0, 0.0, 1.0 },
+    };
+    double N[32], dN[32][3];
+    for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) {
+                scc_cell_shape(scc_v3(pts[i], pts[j], pts[k]), N, dN);
+                for (int a = 0; a < 32; ++a)
+                    for (int d = 0; d < 3; ++d) t->m[d][i + 4 * j + 16 * k][a] = dN[a][d];
+            }
+    for (int d = 0; d < 3; ++d)
+        for (int a = 0; a < 32; ++a) {
+            double f[64], g[64];
+            for (int s = 0; s < 64; ++s) f[s] = t->m[d][s][a];
+            for (int axis = 0; axis < 3; ++axis) {
+                const int stride = axis == 0 ? 1 : (axis == 1 ? 4 : 16);
+                for (int s = 0; s < 64; ++s) {
+                    const int idx = (s / stride) % 4;
+                    const int base = s - idx * stride;
+                    double acc = 0.0;
+                    for (int m = 0; m < 4; ++m) acc += conv[idx][m] * f[base + m * stride];
+                    g[s] = acc;
+                }
+                memcpy(f, g, sizeof f);
+            }
+            for (int s = 0; s < 64; ++s) t->m[d][s][a] = f[s];
+        }
+}
+
+typedef struct finalize_ctx {
+    scc_grid* g;
+    const bern_tables* bt;
+    uint64_t chunk;
+} finalize_ctx;
+
+static float round_up_float(double v)
+{
+    float f = (float)v;
+    if ((double)f < v) f = nextafterf(f, INFINITY);
+    return f;
+}
+
+static void cell_bound_task(void* vctx, uint32_t task)
+{
+    finalize_ctx* ctx = vctx;
+    scc_grid* g = ctx->g;
+    const scc_grid_field* fd = &g->fields[0];
+    const uint64_t begin = (uint64_t)task * ctx->chunk;
+    uint64_t end = begin + ctx->chunk;
+    if (end > fd->cell_count) end = fd->cell_count;
+    const double c0[3] = { 2.0 / g->h.x, 2.0 / g->h.y, 2.0 / g->h.z };
+    for (uint64_t c = begin; c < end; ++c) {
+        const uint32_t* ids = fd->cells + c * 32;
+        double v[32];
+        int hole = 0;
+        for (int a = 0; a < 32; ++a) {
+            v[a] = fd->nodes[ids[a]];
+            if (v[a] == SCC_GRID_NO_VALUE) hole = 1;
+        }
+        if (hole) { g->cell_lipschitz[c] = -1.0f; continue; }
+        double sum2 = 0.0;
+        for (int d = 0; d < 3; ++d) {
+            double bmax = 0.0;
+            for (int s = 0; s < 64; ++s) {
+                const double* row = ctx->bt->m[d][s];
+                double acc = 0.0;
+                for (int a = 0; a < 32; ++a) acc += row[a] * v[a];
+                if (fabs(acc) > bmax) bmax = fabs(acc);
+            }
+            sum2 += (c0[d] * bmax) * (c0[d] * bmax);
+        }
+        /* Small relative margin for rounding in the sums above. */
+        g->cell_lipschitz[c] = round_up_float(sqrt(sum2) * (1.0 + 1e-9) + 1e-300);
+    }
+}
+
+static int run_tasks(scc_parallel_for_fn* pf, void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx)
+{
+    if (pf) return pf(user, stage, count, task, ctx);
+    for (uint32_t i = 0; i < count; ++i) task(ctx, i);
+    return 0;
+}
+
+scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn* parallel_for, void* parallel_user)
+{
+    const scc_allocator* a = &g->allocator;
+    scc_grid_field* fd = &g->fields[0];
+    if (g->n_cells > 0x7FFFFFFEu) return SCC_GRID_TOO_LARGE;
+    g->band = band > 0.0 && isfinite(band) ? band : 0.0;
+
+    /* Per-cell gradient bounds. */
+    g->cell_lipschitz = scc_alloc(a, (size_t)fd->cell_count * sizeof(float));
+    bern_tables* bt = scc_alloc(a, sizeof *bt);
+    if ((fd->cell_count && !g->cell_lipschitz) || !bt) { scc_free(a, bt, sizeof *bt); return SCC_GRID_OUT_OF_MEMORY; }
+    bern_tables_init(bt);
+    finalize_ctx ctx = { g, bt, 2048 };
+    const uint32_t tasks = (uint32_t)((fd->cell_count + ctx.chunk - 1) / ctx.chunk);
+    const int cancelled = run_tasks(parallel_for, parallel_user, SCC_GRID_STAGE_CELLS, tasks, cell_bound_task, &ctx);
+    scc_free(a, bt, sizeof *bt);
+    if (cancelled) return SCC_GRID_CANCELLED;
+
+    g->lipschitz_max = 0.0;
+    g->valued_cells = 0;
+    for (uint64_t l = 0; l < g->n_cells; ++l) {
+        const uint32_t c = fd->map[l];
+        if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) continue;
+        g->valued_cells++;
+        if (g->cell_lipschitz[c] > g->lipschitz_max) g->lipschitz_max = g->cell_lipschitz[c];
+    }
+    if (g->valued_cells == 0) return SCC_GRID_EMPTY;
+
+    /* Hole sources: multi-source breadth-first search over the 26-neighbourhood from every
+     * cell with values, so each hole cell learns a valued cell at the least Chebyshev
+     * distance; then the side (sign) from that cell's value at the point nearest the hole's
+     * centre. */
+    if (g->valued_cells < g->n_cells) {
+        g->hole_source = scc_alloc(a, (size_t)g->n_cells * sizeof(uint32_t));
+        uint32_t* queue = scc_alloc(a, (size_t)g->n_cells * sizeof(uint32_t));
+        if (!g->hole_source || !queue) { scc_free(a, queue, (size_t)g->n_cells * sizeof(uint32_t)); return SCC_GRID_OUT_OF_MEMORY; }
+        uint64_t head = 0, tail = 0;
+        for (uint64_t l = 0; l < g->n_cells; ++l) {
+            const uint32_t c = fd->map[l];
+            if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f) { g->hole_source[l] = (uint32_t)l; queue[tail++] = (uint32_t)l; }
+            else g->hole_source[l] = 0xFFFFFFFFu;
+        }
+        while (head < tail) {
+            const uint32_t l = queue[head++];
+            uint32_t ijk[3];
+            cell_ijk(g, l, ijk);
+            for (int dk = -1; dk <= 1; ++dk)
+                for (int dj = -1; dj <= 1; ++dj)
+                    for (int di = -1; di <= 1; ++di) {
+                        const int64_t ni = (int64_t)ijk[0] + di, nj = (int64_t)ijk[1] + dj, nk = (int64_t)ijk[2] + dk;
+                        if (ni < 0 || nj < 0 || nk < 0 || ni >= g->res[0] || nj >= g->res[1] || nk >= g->res[2]) continue;
+                        const uint64_t n = (uint64_t)ni + g->res[0] * ((uint64_t)nj + (uint64_t)g->res[1] * (uint64_t)nk);
+                        if (g->hole_source[n] != 0xFFFFFFFFu) continue;
+                        g->hole_source[n] = g->hole_source[l];
+                        queue[tail++] = (uint32_t)n;
+                    }
+        }
+        scc_free(a, queue, (size_t)g->n_cells * sizeof(uint32_t));
+        for (uint64_t l = 0; l < g->n_cells; ++l) {
+            const uint32_t c = fd->map[l];
+            if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f) continue;
+            const uint32_t src = g->hole_source[l];
+            uint32_t ijk[3], sijk[3];
+            cell_ijk(g, l, ijk);
+            cell_ijk(g, src, sijk);
+            const scc_aabb cb = cell_box(g, ijk), sb = cell_box(g, sijk);
+            const scc_vec3 q = clamp_box(scc_scale(scc_add(cb.lo, cb.hi), 0.5), &sb);
+            double v = 0.0;
+            interpolate_cell(g, fd, fd->map[src], sijk, q, &v, NULL);
+            if (v < 0.0) g->hole_source[l] = src | 0x80000000u;
+        }
+    }
+
+    /* The scc_sdf interface. bounds must contain every point with phi <= 0: the domain, grown
+     * when the field may be negative on the domain boundary (the outside continuation is
+     * d + phi(q) there). */
+    double grow = 0.0;
+    {
+        const double half_diag = 0.5 * scc_len(g->h);
+        double max_abs = 0.0;
+        for (uint64_t i = 0; i < fd->node_count; ++i)
+            if (fd->nodes[i] != SCC_GRID_NO_VALUE && fabs(fd->nodes[i]) > max_abs) max_abs = fabs(fd->nodes[i]);
+        for (uint64_t l = 0; l < g->n_cells; ++l) {
+            uint32_t ijk[3];
+            cell_ijk(g, l, ijk);
+            if (ijk[0] != 0 && ijk[1] != 0 && ijk[2] != 0 && ijk[0] != g->res[0] - 1 && ijk[1] != g->res[1] - 1 && ijk[2] != g->res[2] - 1) continue;
+            const uint32_t c = fd->map[l];
+            if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f) {
+                double vmin = INFINITY;
+                for (int s = 0; s < 8; ++s) vmin = fmin(vmin, fd->nodes[fd->cells[(size_t)c * 32 + s]]);
+                grow = fmax(grow, -(vmin - g->cell_lipschitz[c] * half_diag));
+            } else if (g->hole_source[l] & 0x80000000u) {
+                grow = fmax(grow, max_abs + g->band + scc_len(scc_sub(g->hi, g->lo)));
+            }
+        }
+    }
+    g->base.eval = scc_grid_eval;
+    g->base.lipschitz_in = scc_grid_lipschitz_in;
+    g->base.domain.lo = g->lo;
+    g->base.domain.hi = g->hi;
+    g->base.bounds.lo = scc_sub(g->lo, scc_v3(grow, grow, grow));
+    g->base.bounds.hi = scc_add(g->hi, scc_v3(grow, grow, grow));
+    g->base.lipschitz = sqrt(1.0 + fmax(g->lipschitz_max, 1.0) * fmax(g->lipschitz_max, 1.0));
+    g->base.kind = SCC_SDF_GRID;
+    return SCC_GRID_OK;
+}
+
+scc_aabb scc_grid_fit_domain(scc_aabb box)
+{
+    scc_vec3 d = scc_sub(box.hi, box.lo);
+    double e = 1.0e-3 * sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    box.hi = scc_add(box.hi, scc_v3(e, e, e));
+    d = scc_sub(box.hi, box.lo);
+    e = 1.0e-3 * sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    box.lo = scc_sub(box.lo, scc_v3(e, e, e));
+    return box;
+}

@@ -1,0 +1,138 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: building a cubic Lagrange grid by sampling a function at the nodes, in
+ * Discregrid's dense layout (GenerateSDF: every node sampled, identity cell map), optionally
+ * reduced to a narrow band (cells whose 32 node values all lie at least band + |h| from the
+ * surface are culled, the referenced nodes are kept and renumbered). Shared notes
+ * sdf-format-and-assets.md sections 2, 4, 6 and 7.
+ */
+#include "grid.h"
+
+#include <string.h>
+
+typedef struct node_ctx {
+    const scc_grid_build_def* def;
+    const scc_grid* g;
+    double* nodes;
+    uint64_t count;
+    uint64_t chunk;
+} node_ctx;
+
+static void node_task(void* vctx, uint32_t task)
+{
+    node_ctx* c = vctx;
+    const uint64_t begin = (uint64_t)task * c->chunk;
+    uint64_t end = begin + c->chunk;
+    if (end > c->count) end = c->count;
+    for (uint64_t l = begin; l < end; ++l) c->nodes[l] = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l));
+}
+
+scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_build_def* def, scc_grid** out_grid)
+{
+    *out_grid = NULL;
+    const uint64_t n_nodes = scc_grid_dense_node_count(def->res);
+    const uint64_t n_cells = (uint64_t)def->res[0] * def->res[1] * def->res[2];
+    if (n_nodes >= 0xFFFFFFFFull || n_cells > 0x7FFFFFFEull) return SCC_GRID_BUILD_TOO_LARGE;
+    if ((size_t)n_nodes != n_nodes || (size_t)(n_cells * 128) / 128 != n_cells) return SCC_GRID_BUILD_TOO_LARGE;
+
+    scc_grid* g = scc_grid_create(a, def->lo, def->hi, def->res, 1);
+    if (!g) return SCC_GRID_BUILD_OUT_OF_MEMORY;
+    scc_grid_field* fd = &g->fields[0];
+    double* nodes = scc_alloc(a, (size_t)n_nodes * sizeof(double));
+    if (!nodes) { scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+
+    node_ctx nc = { def, g, nodes, n_nodes, 1024 };
+    const uint32_t tasks = (uint32_t)((n_nodes + nc.chunk - 1) / nc.chunk);
+    int cancelled;
+    if (def->parallel_for) cancelled = def->parallel_for(def->parallel_user, SCC_GRID_STAGE_NODES, tasks, node_task, &nc);
+    else {
+        cancelled = 0;
+        for (uint32_t t = 0; t < tasks; ++t) node_task(&nc, t);
+    }
+    if (cancelled) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED; }
+    for (uint64_t l = 0; l < n_nodes; ++l)
+        if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
+
+    const int banded = def->band > 0.0 && isfinite(def->band);
+    fd->map = scc_alloc(a, (size_t)n_cells * sizeof(uint32_t));
+    if (!fd->map) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+
+    if (!banded) {
+        fd->nodes = nodes;
+        fd->node_count = n_nodes;
+        fd->cells = scc_alloc(a, (size_t)n_cells * 32 * sizeof(uint32_t));
+        if (!fd->cells) { scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+        fd->cell_count = n_cells;
+        uint64_t l = 0;
+        for (uint32_t k = 0; k < def->res[2]; ++k)
+            for (uint32_t j = 0; j < def->res[1]; ++j)
+                for (uint32_t i = 0; i < def->res[0]; ++i, ++l) {
+                    scc_grid_dense_cell_nodes(def->res, i, j, k, fd->cells + l * 32);
+                    fd->map[l] = (uint32_t)l;
+                }
+    } else {
+        /* Narrow band: keep a cell when any of its nodes is nearer than band + |h| to the
+         * surface. Culled cells then satisfy |phi| >= band everywhere (every point of a cell
+         * lies within |h| of one of its corners and the samples are exact distances). */
+        const double keep_below = def->band + scc_len(g->h);
+        uint32_t* renumber = scc_alloc(a, (size_t)n_nodes * sizeof(uint32_t));
+        if (!renumber) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+        memset(renumber, 0xFF, (size_t)n_nodes * sizeof(uint32_t));
+        uint64_t kept = 0, l = 0;
+        uint32_t ids[32];
+        for (uint32_t k = 0; k < def->res[2]; ++k)
+            for (uint32_t j = 0; j < def->res[1]; ++j)
+                for (uint32_t i = 0; i < def->res[0]; ++i, ++l) {
+                    scc_grid_dense_cell_nodes(def->res, i, j, k, ids);
+                    int keep = 0;
+                    for (int s = 0; s < 32 && !keep; ++s) keep = fabs(nodes[ids[s]]) < keep_below;
+                    if (!keep) { fd->map[l] = SCC_GRID_NO_CELL; continue; }
+                    fd->map[l] = (uint32_t)kept++;
+                    for (int s = 0; s < 32; ++s) renumber[ids[s]] = 0; /* mark used */
+                }
+        if (kept == 0) {
+            scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
+            scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+            scc_grid_destroy(g);
+            return SCC_GRID_BUILD_EMPTY_BAND;
+        }
+        uint64_t used = 0;
+        for (uint64_t n = 0; n < n_nodes; ++n)
+            if (renumber[n] == 0) renumber[n] = (uint32_t)used++;
+        fd->nodes = scc_alloc(a, (size_t)used * sizeof(double));
+        fd->cells = scc_alloc(a, (size_t)kept * 32 * sizeof(uint32_t));
+        if (!fd->nodes || !fd->cells) {
+            scc_free(a, fd->nodes, (size_t)used * sizeof(double));
+            scc_free(a, fd->cells, (size_t)kept * 32 * sizeof(uint32_t));
+            fd->nodes = NULL; fd->cells = NULL;
+            scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
+            scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+            scc_grid_destroy(g);
+            return SCC_GRID_BUILD_OUT_OF_MEMORY;
+        }
+        fd->node_count = used;
+        fd->cell_count = kept;
+        for (uint64_t n = 0; n < n_nodes; ++n)
+            if (renumber[n] != 0xFFFFFFFFu) fd->nodes[renumber[n]] = nodes[n];
+        l = 0;
+        for (uint32_t k = 0; k < def->res[2]; ++k)
+            for (uint32_t j = 0; j < def->res[1]; ++j)
+                for (uint32_t i = 0; i < def->res[0]; ++i, ++l) {
+                    const uint32_t c = fd->map[l];
+                    if (c == SCC_GRID_NO_CELL) continue;
+                    scc_grid_dense_cell_nodes(def->res, i, j, k, ids);
+                    for (int s = 0; s < 32; ++s) fd->cells[(size_t)c * 32 + s] = renumber[ids[s]];
+                }
+        scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
+        scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+    }
+
+    switch (scc_grid_finalize(g, banded ? def->band : 0.0, def->parallel_for, def->parallel_user)) {
+    case SCC_GRID_OK: break;
+    case SCC_GRID_CANCELLED: scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED;
+    case SCC_GRID_EMPTY: scc_grid_destroy(g); return SCC_GRID_BUILD_EMPTY_BAND;
+    case SCC_GRID_TOO_LARGE: scc_grid_destroy(g); return SCC_GRID_BUILD_TOO_LARGE;
+    default: scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY;
+    }
+    *out_grid = g;
+    return SCC_GRID_BUILD_OK;
+}
