@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -205,37 +207,43 @@ struct Candidate {
 
 double triArea(const btVector3& a, const btVector3& b, const btVector3& c) { return (double)(b - a).cross(c - a).length(); }
 
-// Up to `k` well-spread candidates: the deepest, the farthest from it, the one maximising the
-// triangle, the one maximising the quad (sum of the three triangles it forms with the others).
+// Up to `k` well-spread candidates: the deepest (smallest gap), then the one farthest from it,
+// the one maximising the triangle, the one maximising the quad (sum of the three triangles it
+// forms with the others). Spread is measured in the plane of the first contact (points projected
+// along its normal), so a point right above another adds nothing; among candidates within 5% of
+// the best spread the one with the smallest gap wins (it is the one the solver must respect).
 std::vector<int> selectSpread(const std::vector<Candidate>& c, int k)
 {
     std::vector<int> out;
     if (c.empty() || k <= 0) return out;
-    int best = 0;
+    int first = 0;
     for (int i = 1; i < (int)c.size(); ++i)
-        if (c[i].d < c[best].d) best = i;
-    out.push_back(best);
-    const double dup = 1e-6;
-    auto used = [&](int i) {
-        for (int j : out)
-            if ((c[i].pA0 - c[j].pA0).length() <= dup) return true;
-        return false;
-    };
+        if (c[i].d < c[first].d) first = i;
+    out.push_back(first);
+    const btVector3 nref = c[first].n0;
+    std::vector<btVector3> p(c.size());
+    for (size_t i = 0; i < c.size(); ++i) p[i] = c[i].pA0 - nref * nref.dot(c[i].pA0);
+    std::vector<char> taken(c.size(), 0);
+    taken[first] = 1;
+    std::vector<double> score(c.size());
     while ((int)out.size() < k) {
-        int pick = -1;
-        double score = 0;
-        for (int i = 0; i < (int)c.size(); ++i) {
-            if (used(i)) continue;
+        double best = 0;
+        for (size_t i = 0; i < c.size(); ++i) {
+            if (taken[i]) continue;
+            const btVector3& q = p[i];
             double s;
-            const btVector3& p = c[i].pA0;
-            if (out.size() == 1) s = (double)(p - c[out[0]].pA0).length();
-            else if (out.size() == 2) s = triArea(c[out[0]].pA0, c[out[1]].pA0, p);
-            else s = triArea(c[out[0]].pA0, c[out[1]].pA0, p) + triArea(c[out[1]].pA0, c[out[2]].pA0, p) +
-                     triArea(c[out[2]].pA0, c[out[0]].pA0, p);
-            if (pick < 0 || s > score) { pick = i; score = s; }
+            if (out.size() == 1) s = (double)(q - p[out[0]]).length();
+            else if (out.size() == 2) s = triArea(p[out[0]], p[out[1]], q);
+            else s = triArea(p[out[0]], p[out[1]], q) + triArea(p[out[1]], p[out[2]], q) + triArea(p[out[2]], p[out[0]], q);
+            score[i] = s;
+            best = std::max(best, s);
         }
-        if (pick < 0) break;
-        if (out.size() >= 2 && score <= 1e-12) break; // collinear or coplanar-inside: adds nothing
+        // Nothing adds spread: a single point (distance 1e-6) or all on a line/inside (area 1e-12).
+        if (best <= (out.size() == 1 ? 1e-6 : 1e-12)) break;
+        int pick = -1;
+        for (size_t i = 0; i < c.size(); ++i)
+            if (!taken[i] && score[i] >= 0.95 * best && (pick < 0 || c[i].d < c[pick].d)) pick = (int)i;
+        taken[pick] = 1;
         out.push_back(pick);
     }
     return out;
@@ -374,9 +382,11 @@ public:
         const btTransform St_inv = St.inverse();
         const btTransform Mt_inv = Mt.inverse();
 
-        // Maps a contact at the TOI (mesh-local material point, SDF-local surface point and
-        // normal) to the manifold's frame at the start of the step.
+        // Maps a contact (mesh-local material point, SDF-local surface point and normal, at the
+        // TOI or at the end of the step) to the manifold's frame at the start of the step.
         auto add = [&](const btVector3& local, const btVector3& qB, const btVector3& nL, int tri) {
+            for (const Candidate& o : cands)
+                if ((o.local - local).length2() <= btScalar(1e-12)) return; // same material point
             Candidate c;
             c.local = local;
             c.pA0 = M.t0 * local;
@@ -413,6 +423,28 @@ public:
                 if (!(len > btScalar(0))) continue;
                 nL /= len;
                 add(local, q - nL * (btScalar)phi, nL, (int)t);
+            }
+        }
+        // Vertices in contact at the END of the step get speculative constraints too (the classic
+        // speculative-contact rule: anything the predicted motion would push in is limited to
+        // its current gap). Without them a body that pivots about its first contact swings its
+        // other end into the SDF when it rotates fast.
+        if (dt > 0) {
+            const btTransform& M1 = M.t1;
+            const btTransform S1_inv = S.t1.inverse();
+            const size_t nv = me->vertices.size() / 3;
+            for (size_t i = 0; i < nv; ++i) {
+                const double* v = &me->vertices[3 * i];
+                btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
+                btVector3 q = S1_inv * (M1 * local);
+                double phi = 0;
+                sdfccd_Vec3 g;
+                if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !(phi <= margin)) continue;
+                btVector3 nL = bt(g);
+                btScalar len = nL.length();
+                if (!(len > btScalar(0))) continue;
+                nL /= len;
+                add(local, q - nL * (btScalar)phi, nL, -1);
             }
         }
         return !cands.empty();
@@ -603,6 +635,10 @@ void BridgeImpl::process(MeshSdfAlgorithm&, const btCollisionObjectWrapper* mw, 
         return;
     }
     std::vector<int> pick = selectSpread(scratch, cfg.max_contacts);
+    if (getenv("SDFCCD_BRIDGE_DEBUG")) {
+        fprintf(stderr, "query state %d toi %.4f frac %.4f found %d cands %d\n", res.state, res.toi, res.fraction, res.contacts_found, (int)scratch.size());
+        for (size_t i = 0; i < scratch.size(); ++i) { const Candidate& c = scratch[i]; fprintf(stderr, "  %s cand tri %d local (%.3f %.3f %.3f) pA0 (%.3f %.3f %.3f) pB0 (%.3f %.3f %.3f) n (%.3f %.3f %.3f) d %.4f\n", std::find(pick.begin(), pick.end(), (int)i) != pick.end() ? "*" : " ", c.triangle, c.local.x(), c.local.y(), c.local.z(), c.pA0.x(), c.pA0.y(), c.pA0.z(), c.pB0.x(), c.pB0.y(), c.pB0.z(), c.n0.x(), c.n0.y(), c.n0.z(), c.d); }
+    }
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;

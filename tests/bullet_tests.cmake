@@ -1,0 +1,32 @@
+# SPDX-License-Identifier: MIT
+# Isosurface extraction (Check) and the Bullet bridge tests, run for every Bullet precision built.
+sdfccd_add_check_test(test_extract bullet/test_extract.c)
+target_include_directories(test_extract PRIVATE ${PROJECT_SOURCE_DIR}/core)
+
+if(SDFCCD_BUILD_BULLET_BRIDGE)
+  foreach(_tgt IN LISTS SDFCCD_BULLET_TARGETS)
+    string(REPLACE "sdfccd_bullet" "bridge_tests" _exe ${_tgt})   # bridge_tests, bridge_tests_f64
+    if(_exe STREQUAL "bridge_tests")
+      set(_exe bridge_tests_f32)
+    endif()
+    add_executable(${_exe} bullet/bridge_tests.cpp)
+    target_link_libraries(${_exe} PRIVATE ${_tgt})
+    target_compile_definitions(${_exe} PRIVATE SDFCCD_DATA_DIR="${SDFCCD_DATA_DIR}")
+    sdfccd_target_defaults(${_exe})
+    # One ctest per scene, so a failure names the scene.
+    foreach(_case cube_mesh_first cube_sdf_first cube_tunnels_without_bridge torus_spinning cdf_concave_box
+                  convex_box_on_triangulation shape_aabb registration closest_points_and_toi hard_clamp)
+      add_test(NAME ${_exe}.${_case} COMMAND ${_exe} ${_case})
+      set_tests_properties(${_exe}.${_case} PROPERTIES LABELS bullet)
+    endforeach()
+  endforeach()
+
+  # The README example, compiled and run.
+  if(TARGET sdfccd::bullet)
+    add_executable(bullet_hello ${PROJECT_SOURCE_DIR}/samples/bullet_hello.cpp)
+    target_link_libraries(bullet_hello PRIVATE sdfccd::bullet)
+    sdfccd_target_defaults(bullet_hello)
+    add_test(NAME bullet_hello COMMAND bullet_hello)
+    set_tests_properties(bullet_hello PROPERTIES LABELS bullet)
+  endif()
+endif()
