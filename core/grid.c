@@ -373,16 +373,18 @@ double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
     if (d2 == 0.0) return eval_inside(g, p, out_grad);
 
     /* Outside the domain: d = |p - q| to the nearest box point q, phi_q = phi(q).
-     * phi_q >= 0: sqrt(d^2 + phi_q^2) is a lower bound on the distance to a surface that lies
+     * phi_q >= 0: sqrt(d^2 + phi_q^2), a lower bound on the distance to a surface that lies
      *             inside the box (any path to it crosses the box at some b with
      *             |p - b| >= sqrt(d^2 + |q - b|^2) and phi(b) >= phi_q - |q - b|).
-     * phi_q < 0:  the box cuts the shape; continue with d + phi_q (continuous with the above).
+     * phi_q < 0:  the box cuts the shape; phi_q - d, the 1-Lipschitz lower bound, which keeps
+     *             points beyond an inside boundary inside. Discontinuous where the surface
+     *             crosses the boundary (phi_q = 0).
      * The gradient is that of these expressions; the part of grad phi(q) along clamped axes
      * drops out. */
     const double d = sqrt(d2);
     scc_vec3 gq;
     const double vq = eval_inside(g, q, out_grad ? &gq : NULL);
-    if (!out_grad) return vq >= 0.0 ? sqrt(d2 + vq * vq) : d + vq;
+    if (!out_grad) return vq >= 0.0 ? sqrt(d2 + vq * vq) : vq - d;
     if (p.x != q.x) gq.x = 0.0;
     if (p.y != q.y) gq.y = 0.0;
     if (p.z != q.z) gq.z = 0.0;
@@ -391,8 +393,8 @@ double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
         *out_grad = scc_scale(scc_madd(dq, gq, vq), 1.0 / v);
         return v;
     }
-    *out_grad = scc_add(scc_scale(dq, 1.0 / d), gq);
-    return d + vq;
+    *out_grad = scc_sub(gq, scc_scale(dq, 1.0 / d));
+    return vq - d;
 }
 
 double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
@@ -435,7 +437,7 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
  * The map from the 32 node values to the 64 coefficients is a fixed 64x32 matrix per axis.
  * ---------------------------------------------------------------------------------------- */
 
-typedef struct bern_tables { double m[3][64][32]; } bern_tables;
+typedef struct bern_tables { double m[3][64][32]; double val[64][32]; } bern_tables;
 
 static void bern_tables_init(bern_tables* t)
 {
@@ -453,13 +455,15 @@ static void bern_tables_init(bern_tables* t)
         for (int j = 0; j < 4; ++j)
             for (int i = 0; i < 4; ++i) {
                 scc_cell_shape(scc_v3(pts[i], pts[j], pts[k]), N, dN);
-                for (int a = 0; a < 32; ++a)
+                for (int a = 0; a < 32; ++a) {
                     for (int d = 0; d < 3; ++d) t->m[d][i + 4 * j + 16 * k][a] = dN[a][d];
+                    t->val[i + 4 * j + 16 * k][a] = N[a];
+                }
             }
-    for (int d = 0; d < 3; ++d)
+    for (int d = 0; d < 4; ++d)
         for (int a = 0; a < 32; ++a) {
             double f[64], g[64];
-            for (int s = 0; s < 64; ++s) f[s] = t->m[d][s][a];
+            for (int s = 0; s < 64; ++s) f[s] = d < 3 ? t->m[d][s][a] : t->val[s][a];
             for (int axis = 0; axis < 3; ++axis) {
                 const int stride = axis == 0 ? 1 : (axis == 1 ? 4 : 16);
                 for (int s = 0; s < 64; ++s) {
@@ -471,7 +475,10 @@ static void bern_tables_init(bern_tables* t)
                 }
                 memcpy(f, g, sizeof f);
             }
-            for (int s = 0; s < 64; ++s) t->m[d][s][a] = f[s];
+            for (int s = 0; s < 64; ++s) {
+                if (d < 3) t->m[d][s][a] = f[s];
+                else t->val[s][a] = f[s];
+            }
         }
 }
 
@@ -544,8 +551,7 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     finalize_ctx ctx = { g, bt, 2048 };
     const uint32_t tasks = (uint32_t)((fd->cell_count + ctx.chunk - 1) / ctx.chunk);
     const int cancelled = run_tasks(parallel_for, parallel_user, SCC_GRID_STAGE_CELLS, tasks, cell_bound_task, &ctx);
-    scc_free(a, bt, sizeof *bt);
-    if (cancelled) return SCC_GRID_CANCELLED;
+    if (cancelled) { scc_free(a, bt, sizeof *bt); return SCC_GRID_CANCELLED; }
 
     g->lipschitz_max = 0.0;
     g->valued_cells = 0;
@@ -555,7 +561,7 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
         g->valued_cells++;
         if (g->cell_lipschitz[c] > g->lipschitz_max) g->lipschitz_max = g->cell_lipschitz[c];
     }
-    if (g->valued_cells == 0) return SCC_GRID_EMPTY;
+    if (g->valued_cells == 0) { scc_free(a, bt, sizeof *bt); return SCC_GRID_EMPTY; }
 
     /* Hole sources: multi-source breadth-first search over the 26-neighbourhood from every
      * cell with values, so each hole cell learns a valued cell at the least Chebyshev
@@ -564,7 +570,11 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     if (g->valued_cells < g->n_cells) {
         g->hole_source = scc_alloc(a, (size_t)g->n_cells * sizeof(uint32_t));
         uint32_t* queue = scc_alloc(a, (size_t)g->n_cells * sizeof(uint32_t));
-        if (!g->hole_source || !queue) { scc_free(a, queue, (size_t)g->n_cells * sizeof(uint32_t)); return SCC_GRID_OUT_OF_MEMORY; }
+        if (!g->hole_source || !queue) {
+            scc_free(a, queue, (size_t)g->n_cells * sizeof(uint32_t));
+            scc_free(a, bt, sizeof *bt);
+            return SCC_GRID_OUT_OF_MEMORY;
+        }
         uint64_t head = 0, tail = 0;
         for (uint64_t l = 0; l < g->n_cells; ++l) {
             const uint32_t c = fd->map[l];
@@ -602,35 +612,51 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
         }
     }
 
-    /* The scc_sdf interface. bounds must contain every point with phi <= 0: the domain, grown
-     * when the field may be negative on the domain boundary (the outside continuation is
-     * d + phi(q) there). */
-    double grow = 0.0;
-    {
-        const double half_diag = 0.5 * scc_len(g->h);
-        double max_abs = 0.0;
-        for (uint64_t i = 0; i < fd->node_count; ++i)
-            if (fd->nodes[i] != SCC_GRID_NO_VALUE && fabs(fd->nodes[i]) > max_abs) max_abs = fabs(fd->nodes[i]);
-        for (uint64_t l = 0; l < g->n_cells; ++l) {
-            uint32_t ijk[3];
-            cell_ijk(g, l, ijk);
-            if (ijk[0] != 0 && ijk[1] != 0 && ijk[2] != 0 && ijk[0] != g->res[0] - 1 && ijk[1] != g->res[1] - 1 && ijk[2] != g->res[2] - 1) continue;
-            const uint32_t c = fd->map[l];
-            if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f) {
-                double vmin = INFINITY;
-                for (int s = 0; s < 8; ++s) vmin = fmin(vmin, fd->nodes[fd->cells[(size_t)c * 32 + s]]);
-                grow = fmax(grow, -(vmin - g->cell_lipschitz[c] * half_diag));
-            } else if (g->hole_source[l] & 0x80000000u) {
-                grow = fmax(grow, max_abs + g->band + scc_len(scc_sub(g->hi, g->lo)));
-            }
+    /* The scc_sdf interface. bounds must contain every point with phi <= 0: the domain when
+     * phi >= 0 on the whole domain boundary (then the outside continuation is positive), else
+     * unbounded (phi_q - d continues the inside). Non-negativity of each boundary face is
+     * proved with the face's Bernstein coefficients (the face restriction of the cell's
+     * tensor Bernstein form), which enclose the interpolant on the face. */
+    int boundary_nonneg = 1;
+    for (uint64_t l = 0; l < g->n_cells && boundary_nonneg; ++l) {
+        uint32_t ijk[3];
+        cell_ijk(g, l, ijk);
+        int lo_face[3], hi_face[3], any = 0;
+        for (int d = 0; d < 3; ++d) {
+            lo_face[d] = ijk[d] == 0;
+            hi_face[d] = ijk[d] == g->res[d] - 1;
+            any |= lo_face[d] | hi_face[d];
+        }
+        if (!any) continue;
+        const uint32_t c = fd->map[l];
+        if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) {
+            if (g->hole_source[l] & 0x80000000u) boundary_nonneg = 0;
+            continue;
+        }
+        double v[32];
+        for (int s = 0; s < 32; ++s) v[s] = fd->nodes[fd->cells[(size_t)c * 32 + s]];
+        for (int s = 0; s < 64 && boundary_nonneg; ++s) {
+            const int idx[3] = { s % 4, (s / 4) % 4, s / 16 };
+            int on_face = 0;
+            for (int d = 0; d < 3; ++d) on_face |= (lo_face[d] && idx[d] == 0) || (hi_face[d] && idx[d] == 3);
+            if (!on_face) continue;
+            double acc = 0.0;
+            for (int k = 0; k < 32; ++k) acc += bt->val[s][k] * v[k];
+            if (acc < 0.0) boundary_nonneg = 0;
         }
     }
+    scc_free(a, bt, sizeof *bt);
     g->base.eval = scc_grid_eval;
     g->base.lipschitz_in = scc_grid_lipschitz_in;
     g->base.domain.lo = g->lo;
     g->base.domain.hi = g->hi;
-    g->base.bounds.lo = scc_sub(g->lo, scc_v3(grow, grow, grow));
-    g->base.bounds.hi = scc_add(g->hi, scc_v3(grow, grow, grow));
+    if (boundary_nonneg) {
+        g->base.bounds.lo = g->lo;
+        g->base.bounds.hi = g->hi;
+    } else {
+        g->base.bounds.lo = scc_v3(-INFINITY, -INFINITY, -INFINITY);
+        g->base.bounds.hi = scc_v3(INFINITY, INFINITY, INFINITY);
+    }
     g->base.lipschitz = sqrt(1.0 + fmax(g->lipschitz_max, 1.0) * fmax(g->lipschitz_max, 1.0));
     g->base.kind = SCC_SDF_GRID;
     return SCC_GRID_OK;

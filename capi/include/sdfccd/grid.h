@@ -17,8 +17,12 @@
  *    gradient pointing away from the nearest cell with values. Not continuous across cells;
  *  - outside the domain box, at distance d from its nearest point q: sqrt(d^2 + phi(q)^2) where
  *    phi(q) >= 0 (a lower bound on the distance when the surface lies inside the box, as it does
- *    for grids built from closed meshes with the default domain), and d + phi(q) where phi(q) < 0
- *    (the box cuts the shape; continuous with the first rule).
+ *    for grids built from closed meshes with the default domain), and phi(q) - d where phi(q) < 0
+ *    (the box cuts the shape: a 1-Lipschitz lower bound that keeps points beyond an inside
+ *    boundary inside). The two rules meet discontinuously where the surface crosses the domain
+ *    boundary; keep shapes inside the domain where that matters (certified queries). The SDF's
+ *    `bounds` are the domain when phi >= 0 on the whole boundary (proved per boundary face), else
+ *    infinite.
  * The per-cell bound on |grad phi| used by the certified method is exact for the interpolant in
  * cells with values (a Bernstein enclosure), 1 in culled cells (sound for the true distance the
  * conservative value bounds from below) and sqrt(1 + L^2) outside the domain.

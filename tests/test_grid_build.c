@@ -1,0 +1,518 @@
+/* SPDX-License-Identifier: MIT
+ * Grid SDFs, part 2: building from analytic SDFs and meshes (accuracy and convergence against
+ * closed forms, thread-count independence, progress), the narrow band (memory, conservative
+ * culled values against the exact mesh distance), values outside the domain (lower bounds),
+ * the per-cell gradient bounds against sampled gradients, the grid inside CCD queries, mesh
+ * import of several formats, and argument errors. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "test_util.h"
+#include "grid_internal.h"
+
+#ifndef SDFCCD_TEST_TMP_DIR
+#define SDFCCD_TEST_TMP_DIR "."
+#endif
+
+static sdfccd_MeshId load_mesh(const char* rel)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", SDFCCD_DATA_DIR, rel);
+    sdfccd_MeshId m;
+    sdfccd_Status st = sdfccd_load_mesh(path, NULL, &m);
+    ck_assert_msg(st == SDFCCD_OK, "load %s: %s", path, sdfccd_last_error());
+    return m;
+}
+
+static sdfccd_SdfId sphere_grid(double radius, int res, int threads, double band)
+{
+    sdfccd_SdfId s, g;
+    ck_assert_int_eq(sdfccd_create_sphere(radius, &s), SDFCCD_OK);
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = res;
+    def.fit_domain = 0;
+    def.domain = (sdfccd_Aabb){ { -1.5 * radius, -1.5 * radius, -1.5 * radius }, { 1.5 * radius, 1.5 * radius, 1.5 * radius } };
+    def.threads = threads;
+    def.band = band;
+    ck_assert_msg(sdfccd_create_grid_from_sdf(s, &def, &g) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert_int_eq(sdfccd_destroy_sdf(s), SDFCCD_OK);
+    return g;
+}
+
+static double max_sphere_error(sdfccd_SdfId g, double r, double* out_grad_err)
+{
+    test_rng rng = { 21 };
+    double e = 0, ge = 0;
+    for (int i = 0; i < 4000; ++i) {
+        sdfccd_Vec3 p = { test_rng_uniform(&rng, -1.2 * r, 1.2 * r), test_rng_uniform(&rng, -1.2 * r, 1.2 * r), test_rng_uniform(&rng, -1.2 * r, 1.2 * r) };
+        double v;
+        sdfccd_Vec3 gr;
+        ck_assert_int_eq(sdfccd_sdf_eval(g, p, &v, &gr), SDFCCD_OK);
+        double l = sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+        if (l < 0.3 * r) continue; /* the cone point at the centre is not smooth */
+        e = fmax(e, fabs(v - (l - r)));
+        ge = fmax(ge, fabs(gr.x - p.x / l) + fabs(gr.y - p.y / l) + fabs(gr.z - p.z / l));
+    }
+    if (out_grad_err) *out_grad_err = ge;
+    return e;
+}
+
+/* A sphere sampled on grids of 8^3, 16^3 and 32^3 cells: errors against the closed form drop at
+ * least 8-fold per halving of h (the cubic element converges like h^4 on smooth fields). */
+START_TEST(test_sphere_convergence)
+{
+    double prev = INFINITY;
+    for (int res = 8; res <= 32; res *= 2) {
+        sdfccd_SdfId g = sphere_grid(0.5, res, 0, 0.0);
+        double ge;
+        double e = max_sphere_error(g, 0.5, &ge);
+        fprintf(stderr, "sphere r=0.5 on %d^3: max |phi error| %.3g, max gradient error %.3g\n", res, e, ge);
+        ck_assert(e < prev / 8.0);
+        if (res == 32) { ck_assert(e < 5e-5); ck_assert(ge < 5e-3); }
+        prev = e;
+        ck_assert_int_eq(sdfccd_destroy_sdf(g), SDFCCD_OK);
+    }
+}
+END_TEST
+
+typedef struct progress_log { int calls; double last; int monotone; } progress_log;
+static void on_progress(double f, void* user)
+{
+    progress_log* p = user;
+    if (f < p->last) p->monotone = 0;
+    p->last = f;
+    p->calls++;
+}
+
+/* 1 and 2 threads give bit-identical grids; progress rises to 1. */
+START_TEST(test_threads_identical_and_progress)
+{
+    sdfccd_MeshId mesh = load_mesh("bullet3/torus_textured.obj");
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = 12; def.resolution[1] = 20; def.resolution[2] = 9;
+    sdfccd_SdfId a, b;
+    def.threads = 1;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &a), SDFCCD_OK);
+    progress_log log = { 0, -1.0, 1 };
+    def.threads = 2;
+    def.progress = on_progress;
+    def.progress_user = &log;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &b), SDFCCD_OK);
+    scc_grid *ga, *gb;
+    ck_assert_int_eq(capi_grid_lookup(a, "t", &ga), SDFCCD_OK);
+    ck_assert_int_eq(capi_grid_lookup(b, "t", &gb), SDFCCD_OK);
+    ck_assert_uint_eq(ga->fields[0].node_count, gb->fields[0].node_count);
+    ck_assert_int_eq(memcmp(ga->fields[0].nodes, gb->fields[0].nodes, ga->fields[0].node_count * 8), 0);
+    ck_assert_int_eq(memcmp(ga->cell_lipschitz, gb->cell_lipschitz, ga->fields[0].cell_count * 4), 0);
+    ck_assert_int_gt(log.calls, 2);
+    ck_assert_int_eq(log.monotone, 1);
+    ck_assert_double_eq(log.last, 1.0);
+    sdfccd_GridInfo info;
+    ck_assert_int_eq(sdfccd_grid_get_info(b, &info), SDFCCD_OK);
+    ck_assert_int_eq(info.resolution[1], 20);
+    ck_assert_int_eq(info.cell_count, 12 * 20 * 9);
+    ck_assert_int_eq(sdfccd_destroy_sdf(a), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(b), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
+}
+END_TEST
+
+/* Narrow band on the bunny: fewer cells and bytes than dense; kept cells equal the dense grid;
+ * in culled cells band <= |value| <= |exact distance| with the exact sign, unit gradient. The
+ * band grid saves and reloads (sparse file), and the reloaded grid keeps the sign and the lower
+ * bound (its band is unknown, so only |value| <= |exact| is required). */
+START_TEST(test_narrow_band)
+{
+    sdfccd_MeshId mesh = load_mesh("bullet3/bunny.obj");
+    sdfccd_MeshInfo mi;
+    ck_assert_int_eq(sdfccd_mesh_get_info(mesh, &mi), SDFCCD_OK);
+    /* a domain with room around the bunny, as a scene would use */
+    const scc_vec3 ext = scc_sub(capi_v(mi.bounds.hi), capi_v(mi.bounds.lo));
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 40;
+    def.fit_domain = 0;
+    def.domain.lo = capi_pv(scc_sub(capi_v(mi.bounds.lo), scc_scale(ext, 0.3)));
+    def.domain.hi = capi_pv(scc_add(capi_v(mi.bounds.hi), scc_scale(ext, 0.3)));
+    sdfccd_SdfId dense, band;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &dense), SDFCCD_OK);
+    sdfccd_GridInfo di, bi;
+    ck_assert_int_eq(sdfccd_grid_get_info(dense, &di), SDFCCD_OK);
+    const double w = di.cell_size.x;
+    def.band = w;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &band), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_grid_get_info(band, &bi), SDFCCD_OK);
+    fprintf(stderr, "bunny 40^3: dense %lld cells %lld nodes %lld bytes; band %.3g m: %lld cells %lld nodes %lld bytes\n",
+            (long long)di.stored_cells, (long long)di.node_count, (long long)di.memory_bytes, w, (long long)bi.stored_cells,
+            (long long)bi.node_count, (long long)bi.memory_bytes);
+    ck_assert_int_lt(bi.stored_cells, di.stored_cells / 3);
+    ck_assert_int_lt(bi.memory_bytes, di.memory_bytes / 3);
+    ck_assert_double_eq(bi.band, w);
+
+    char path[512];
+    snprintf(path, sizeof path, "%s/grid_band.cdf", SDFCCD_TEST_TMP_DIR);
+    ck_assert_int_eq(sdfccd_save_grid(band, path), SDFCCD_OK);
+    sdfccd_SdfId reloaded;
+    ck_assert_int_eq(sdfccd_load_grid(path, &reloaded), SDFCCD_OK);
+    remove(path);
+
+    enum { N = 3000 };
+    sdfccd_Vec3* p = malloc(N * sizeof *p);
+    double* exact = malloc(N * sizeof *exact);
+    test_rng rng = { 31 };
+    for (int i = 0; i < N; ++i)
+        p[i] = (sdfccd_Vec3){ test_rng_uniform(&rng, di.domain.lo.x, di.domain.hi.x), test_rng_uniform(&rng, di.domain.lo.y, di.domain.hi.y),
+                              test_rng_uniform(&rng, di.domain.lo.z, di.domain.hi.z) };
+    ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, p, N, 0, exact, NULL), SDFCCD_OK);
+    int culled = 0;
+    for (int i = 0; i < N; ++i) {
+        double vb, vd, vr, raw;
+        sdfccd_Vec3 gb, gr;
+        int32_t has;
+        ck_assert_int_eq(sdfccd_sdf_eval(band, p[i], &vb, &gb), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_sdf_eval(dense, p[i], &vd, NULL), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_sdf_eval(reloaded, p[i], &vr, &gr), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_grid_interpolate(band, 0, p[i], &raw, NULL, &has), SDFCCD_OK);
+        if (has) {
+            ck_assert_double_eq(vb, vd);
+            ck_assert_double_eq(vr, vd);
+            continue;
+        }
+        ++culled;
+        ck_assert_msg((vb < 0) == (exact[i] < 0), "culled sign %g vs exact %g", vb, exact[i]);
+        ck_assert(fabs(vb) >= w - 1e-12);
+        ck_assert_msg(fabs(vb) <= fabs(exact[i]) + 1e-12, "culled |%g| above exact %g", vb, exact[i]);
+        ck_assert_double_near(gb.x * gb.x + gb.y * gb.y + gb.z * gb.z, 1.0, 1e-9);
+        ck_assert((vr < 0) == (exact[i] < 0));
+        ck_assert(fabs(vr) <= fabs(exact[i]) + 1e-12);
+        ck_assert(fabs(vr) > 0.0);
+    }
+    ck_assert_int_gt(culled, N / 3);
+    free(p);
+    free(exact);
+    ck_assert_int_eq(sdfccd_destroy_sdf(reloaded), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(band), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(dense), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
+}
+END_TEST
+
+/* Outside the domain the value is a lower bound on the exact distance (up to the grid's own
+ * error at the boundary), at least the distance to the box, with a finite non-zero gradient;
+ * it is continuous across the boundary. */
+START_TEST(test_outside_domain)
+{
+    sdfccd_MeshId mesh = load_mesh("bullet3/bunny.obj");
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 24;
+    sdfccd_SdfId g;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_OK);
+    sdfccd_GridInfo info;
+    ck_assert_int_eq(sdfccd_grid_get_info(g, &info), SDFCCD_OK);
+    const scc_aabb dom = capi_box(info.domain);
+    const scc_vec3 c = scc_scale(scc_add(dom.lo, dom.hi), 0.5), e = scc_sub(dom.hi, dom.lo);
+    enum { N = 3000 };
+    sdfccd_Vec3* p = malloc(N * sizeof *p);
+    double* exact = malloc(N * sizeof *exact);
+    test_rng rng = { 41 };
+    int n = 0;
+    while (n < N) {
+        scc_vec3 q = scc_v3(c.x + e.x * test_rng_uniform(&rng, -1.5, 1.5), c.y + e.y * test_rng_uniform(&rng, -1.5, 1.5), c.z + e.z * test_rng_uniform(&rng, -1.5, 1.5));
+        if (scc_aabb_distance(&dom, q) > 0) p[n++] = capi_pv(q);
+    }
+    ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, p, N, 0, exact, NULL), SDFCCD_OK);
+    for (int i = 0; i < N; ++i) {
+        double v;
+        sdfccd_Vec3 gr;
+        ck_assert_int_eq(sdfccd_sdf_eval(g, p[i], &v, &gr), SDFCCD_OK);
+        const double d = scc_aabb_distance(&dom, capi_v(p[i]));
+        ck_assert(v >= d - 1e-12);
+        ck_assert_msg(v <= exact[i] + 1e-3, "outside value %g above exact %g", v, exact[i]); /* 1e-3: grid error at 24^3 */
+        const double gl = sqrt(gr.x * gr.x + gr.y * gr.y + gr.z * gr.z);
+        ck_assert(isfinite(gl) && gl > 0.1 && gl <= 1.5);
+    }
+    /* continuity across the max-x face */
+    for (int i = 0; i < 200; ++i) {
+        sdfccd_Vec3 q = { dom.hi.x, test_rng_uniform(&rng, dom.lo.y, dom.hi.y), test_rng_uniform(&rng, dom.lo.z, dom.hi.z) };
+        double v0, v1;
+        ck_assert_int_eq(sdfccd_sdf_eval(g, q, &v0, NULL), SDFCCD_OK);
+        q.x += 1e-9;
+        ck_assert_int_eq(sdfccd_sdf_eval(g, q, &v1, NULL), SDFCCD_OK);
+        ck_assert_double_near(v0, v1, 1e-8);
+    }
+    free(p);
+    free(exact);
+    ck_assert_int_eq(sdfccd_destroy_sdf(g), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
+}
+END_TEST
+
+/* Per-cell bounds: in every cell of a coarse torus grid, |grad phi| sampled on a 6^3 lattice
+ * stays below the cell's bound, and the bound of a box covers finite differences of points
+ * inside it. */
+START_TEST(test_lipschitz_bounds)
+{
+    sdfccd_MeshId mesh = load_mesh("bullet3/torus_textured.obj");
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 10;
+    sdfccd_SdfId id;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &id), SDFCCD_OK);
+    scc_grid* g;
+    ck_assert_int_eq(capi_grid_lookup(id, "t", &g), SDFCCD_OK);
+    double worst_ratio = 0, sum_ratio = 0;
+    for (uint64_t l = 0; l < g->n_cells; ++l) {
+        const uint32_t i = (uint32_t)(l % 10), j = (uint32_t)(l / 10 % 10), k = (uint32_t)(l / 100);
+        const scc_vec3 lo = scc_v3(g->lo.x + i * g->h.x, g->lo.y + j * g->h.y, g->lo.z + k * g->h.z);
+        double mx = 0;
+        for (int a = 0; a < 6; ++a)
+            for (int b = 0; b < 6; ++b)
+                for (int c = 0; c < 6; ++c) {
+                    scc_vec3 p = scc_v3(lo.x + g->h.x * (0.01 + 0.98 * a / 5.0), lo.y + g->h.y * (0.01 + 0.98 * b / 5.0), lo.z + g->h.z * (0.01 + 0.98 * c / 5.0));
+                    scc_vec3 gr;
+                    scc_grid_eval(&g->base, p, &gr);
+                    mx = fmax(mx, scc_len(gr));
+                }
+        const double bound = g->cell_lipschitz[g->fields[0].map[l]];
+        ck_assert_msg(mx <= bound, "cell %llu: sampled |grad| %g above bound %g", (unsigned long long)l, mx, bound);
+        worst_ratio = fmax(worst_ratio, bound / mx);
+        sum_ratio += bound / mx;
+    }
+    fprintf(stderr, "torus 10^3 per-cell gradient bounds: mean bound/sampled max %.3f, worst %.3f, global %.3f\n",
+            sum_ratio / (double)g->n_cells, worst_ratio, g->lipschitz_max);
+    test_rng rng = { 51 };
+    for (int it = 0; it < 300; ++it) {
+        scc_vec3 c = scc_v3(test_rng_uniform(&rng, g->lo.x, g->hi.x), test_rng_uniform(&rng, g->lo.y, g->hi.y), test_rng_uniform(&rng, g->lo.z, g->hi.z));
+        const double r = test_rng_uniform(&rng, 0.01, 0.3);
+        sdfccd_Aabb box = { capi_pv(scc_sub(c, scc_v3(r, r, r))), capi_pv(scc_add(c, scc_v3(r, r, r))) };
+        double L;
+        ck_assert_int_eq(sdfccd_grid_lipschitz_bound(id, box, &L), SDFCCD_OK);
+        for (int s = 0; s < 20; ++s) {
+            scc_vec3 x = scc_v3(test_rng_uniform(&rng, box.lo.x, box.hi.x), test_rng_uniform(&rng, box.lo.y, box.hi.y), test_rng_uniform(&rng, box.lo.z, box.hi.z));
+            scc_vec3 y = scc_v3(test_rng_uniform(&rng, box.lo.x, box.hi.x), test_rng_uniform(&rng, box.lo.y, box.hi.y), test_rng_uniform(&rng, box.lo.z, box.hi.z));
+            const double fx = scc_grid_eval(&g->base, x, NULL), fy = scc_grid_eval(&g->base, y, NULL);
+            ck_assert(fabs(fx - fy) <= L * scc_dist(x, y) + 1e-12);
+        }
+    }
+    ck_assert_int_eq(sdfccd_destroy_sdf(id), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
+}
+END_TEST
+
+/* The grid runs through the CCD queries unchanged: a triangle falling onto a sphere grid gets
+ * the same TOI as on the analytic sphere, within the grid error over the speed. */
+START_TEST(test_ccd_on_grid)
+{
+    sdfccd_SdfId sphere, grid = sphere_grid(0.5, 32, 0, 0.0);
+    ck_assert_int_eq(sdfccd_create_sphere(0.5, &sphere), SDFCCD_OK);
+    sdfccd_Vec3 tri[3] = { { -0.1, -0.1, 0.7 }, { 0.1, -0.1, 0.7 }, { 0.0, 0.12, 0.7 } };
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.linear_velocity = (sdfccd_Vec3){ 0.0, 0.0, -12.0 };
+    const sdfccd_Method methods[] = { SDFCCD_METHOD_FWGSS, SDFCCD_METHOD_DCD, SDFCCD_METHOD_CERTIFIED };
+    const double toi = (0.7 - 0.5) / 12.0; /* the lowest point (0, -0.1, 0.7) is at |p| = 0.707: first contact near t = 0.0167 */
+    for (size_t k = 0; k < sizeof methods / sizeof methods[0]; ++k) {
+        sdfccd_QueryParams qp = sdfccd_default_query_params();
+        qp.method = methods[k];
+        qp.certified_max_regions = 200000;
+        sdfccd_QueryResult ra, rg;
+        sdfccd_Contact ca[4], cg[4];
+        ck_assert_int_eq(sdfccd_query_triangle(sphere, NULL, tri, &m, 0.0, 1.0 / 30.0, &qp, ca, 4, &ra), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_query_triangle(grid, NULL, tri, &m, 0.0, 1.0 / 30.0, &qp, cg, 4, &rg), SDFCCD_OK);
+        ck_assert_msg(ra.hit && rg.hit, "method %d: analytic hit %d, grid hit %d", methods[k], ra.hit, rg.hit);
+        if (methods[k] == SDFCCD_METHOD_CERTIFIED) {
+            /* the certified lower end of the bracket: no contact before it on either field */
+            ck_assert_msg(rg.toi_lower <= toi + 1e-7 && rg.toi_lower > toi - 1e-4, "certified lower %.9g (analytic %.9g)", rg.toi_lower, ra.toi_lower);
+        } else {
+            ck_assert_msg(fabs(ra.toi - rg.toi) < 1e-5 / 12.0 + 2e-6, "method %d: toi %.9g vs %.9g", methods[k], ra.toi, rg.toi);
+        }
+        if (methods[k] == SDFCCD_METHOD_FWGSS) ck_assert_double_near(rg.toi, toi, 1e-5);
+    }
+    ck_assert_int_eq(sdfccd_destroy_sdf(sphere), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(grid), SDFCCD_OK);
+}
+END_TEST
+
+/* ---------------- mesh import ---------------- */
+
+static void write_text(const char* path, const char* text)
+{
+    FILE* f = fopen(path, "wb");
+    ck_assert(f != NULL);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void expect_mesh(const char* path, uint32_t tris, int closed)
+{
+    sdfccd_MeshId m;
+    sdfccd_Status st = sdfccd_load_mesh(path, NULL, &m);
+    ck_assert_msg(st == SDFCCD_OK, "%s: %s", path, sdfccd_last_error());
+    sdfccd_MeshInfo info;
+    ck_assert_int_eq(sdfccd_mesh_get_info(m, &info), SDFCCD_OK);
+    ck_assert_uint_eq(info.triangle_count, tris);
+    sdfccd_MeshTopology t;
+    ck_assert_int_eq(sdfccd_mesh_get_topology(m, &t), SDFCCD_OK);
+    ck_assert_int_eq(t.closed, closed);
+    if (closed) ck_assert_double_near(t.volume, 1.0, 1e-6);
+    ck_assert_int_eq(sdfccd_destroy_mesh(m), SDFCCD_OK);
+}
+
+START_TEST(test_mesh_import_formats)
+{
+    char path[512];
+    /* unit cube as quads in OBJ (with texture/normal indices and a negative index), OFF, ASCII STL and PLY */
+    snprintf(path, sizeof path, "%s/grid_cube_quads.obj", SDFCCD_TEST_TMP_DIR);
+    write_text(path, "# unit cube, quads\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nvt 0 0\nvn 0 0 1\n"
+                     "f 1/1/1 4/1/1 3/1/1 2/1/1\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf -8 -4 -1 -5\n");
+    expect_mesh(path, 12, 1);
+    remove(path);
+    snprintf(path, sizeof path, "%s/grid_cube.off", SDFCCD_TEST_TMP_DIR);
+    write_text(path, "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n");
+    expect_mesh(path, 12, 1);
+    remove(path);
+    snprintf(path, sizeof path, "%s/grid_cube.stl", SDFCCD_TEST_TMP_DIR);
+    {
+        const int q[6][4] = { { 0, 3, 2, 1 }, { 4, 5, 6, 7 }, { 0, 1, 5, 4 }, { 1, 2, 6, 5 }, { 2, 3, 7, 6 }, { 3, 0, 4, 7 } };
+        const int vv[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { 1, 0, 1 }, { 1, 1, 1 }, { 0, 1, 1 } };
+        FILE* f = fopen(path, "wb");
+        fprintf(f, "solid cube\n");
+        for (int i = 0; i < 6; ++i)
+            for (int t = 0; t < 2; ++t) {
+                const int idx[3] = { q[i][0], q[i][1 + t], q[i][2 + t] };
+                fprintf(f, " facet normal 0 0 0\n  outer loop\n");
+                for (int k = 0; k < 3; ++k) fprintf(f, "   vertex %d %d %d\n", vv[idx[k]][0], vv[idx[k]][1], vv[idx[k]][2]);
+                fprintf(f, "  endloop\n endfacet\n");
+            }
+        fprintf(f, "endsolid cube\n");
+        fclose(f);
+    }
+    expect_mesh(path, 12, 1); /* STL stores every triangle's corners: merging makes it closed */
+    remove(path);
+    snprintf(path, sizeof path, "%s/grid_cube.ply", SDFCCD_TEST_TMP_DIR);
+    write_text(path, "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\nelement face 6\n"
+                     "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                     "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n");
+    expect_mesh(path, 12, 1);
+    remove(path);
+
+    /* errors: missing, unreadable, no triangles, bad index */
+    sdfccd_MeshId m;
+    ck_assert_int_eq(sdfccd_load_mesh(SDFCCD_TEST_TMP_DIR "/no_such_mesh.ply", NULL, &m), SDFCCD_IO_ERROR);
+    ck_assert_int_eq(sdfccd_load_mesh(SDFCCD_TEST_TMP_DIR "/no_such_mesh.obj", NULL, &m), SDFCCD_IO_ERROR);
+    snprintf(path, sizeof path, "%s/grid_garbage.ply", SDFCCD_TEST_TMP_DIR);
+    write_text(path, "this is not a mesh file \x01\x02\x03\n");
+    ck_assert_int_eq(sdfccd_load_mesh(path, NULL, &m), SDFCCD_FORMAT_ERROR);
+    ck_assert(strlen(sdfccd_last_error()) > 10);
+    remove(path);
+    snprintf(path, sizeof path, "%s/grid_points.obj", SDFCCD_TEST_TMP_DIR);
+    write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    ck_assert_int_eq(sdfccd_load_mesh(path, NULL, &m), SDFCCD_DEGENERATE);
+    ck_assert(strstr(sdfccd_last_error(), "no triangles") != NULL);
+    write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    ck_assert_int_eq(sdfccd_load_mesh(path, NULL, &m), SDFCCD_FORMAT_ERROR);
+    write_text(path, "v 0 0 0\nv 1 0 x\n");
+    ck_assert_int_eq(sdfccd_load_mesh(path, NULL, &m), SDFCCD_FORMAT_ERROR);
+    remove(path);
+    snprintf(path, sizeof path, "%s/grid_empty.stl", SDFCCD_TEST_TMP_DIR);
+    write_text(path, "solid empty\nendsolid empty\n");
+    sdfccd_Status st = sdfccd_load_mesh(path, NULL, &m);
+    ck_assert_msg(st == SDFCCD_DEGENERATE || st == SDFCCD_FORMAT_ERROR, "empty STL: %s", sdfccd_status_string(st));
+    remove(path);
+    ck_assert_int_eq(sdfccd_load_mesh(NULL, NULL, &m), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_MeshLoadDef ld = sdfccd_default_mesh_load_def();
+    ld.scale = 0.0;
+    ck_assert_int_eq(sdfccd_load_mesh(SDFCCD_DATA_DIR "/bullet3/cube.obj", &ld, &m), SDFCCD_INVALID_ARGUMENT);
+    ld.scale = 2.0;
+    ck_assert_int_eq(sdfccd_load_mesh(SDFCCD_DATA_DIR "/bullet3/cube.obj", &ld, &m), SDFCCD_OK);
+    sdfccd_MeshInfo info;
+    ck_assert_int_eq(sdfccd_mesh_get_info(m, &info), SDFCCD_OK);
+    ck_assert_double_eq(info.bounds.hi.x, 1.0);
+    ck_assert_int_eq(sdfccd_destroy_mesh(m), SDFCCD_OK);
+    /* the textured torus (v/vt/vn faces) welds to its 501 positions and is closed */
+    sdfccd_MeshId tor = load_mesh("bullet3/torus_textured.obj");
+    sdfccd_MeshTopology t;
+    ck_assert_int_eq(sdfccd_mesh_get_topology(tor, &t), SDFCCD_OK);
+    ck_assert_int_eq(t.closed, 1);
+    ck_assert_int_eq(sdfccd_mesh_get_info(tor, &info), SDFCCD_OK);
+    ck_assert_uint_eq(info.vertex_count, 501);
+    ck_assert_uint_eq(info.triangle_count, 1002);
+    ck_assert_int_eq(sdfccd_destroy_mesh(tor), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_bad_defs)
+{
+    sdfccd_MeshId mesh = load_mesh("bullet3/cube.obj");
+    sdfccd_SdfId g, sphere, plane;
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[1] = 0;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
+    def = sdfccd_default_grid_def();
+    def.band = NAN;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
+    def = sdfccd_default_grid_def();
+    def.fit_domain = 0;
+    def.domain = (sdfccd_Aabb){ { 1, 0, 0 }, { 0, 1, 1 } };
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
+    def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 2000;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_GridDef junk;
+    memset(&junk, 0, sizeof junk);
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &junk, &g), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, NULL, &g), SDFCCD_INVALID_ARGUMENT);
+    def = sdfccd_default_grid_def();
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh((sdfccd_MeshId){ 0, 0 }, &def, &g), SDFCCD_INVALID_HANDLE);
+    /* a band that leaves no cell: a tiny band far from the surface */
+    def.fit_domain = 0;
+    def.domain = (sdfccd_Aabb){ { 5, 5, 5 }, { 6, 6, 6 } };
+    def.band = 1e-3;
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 4;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
+    /* an unbounded SDF needs an explicit domain */
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, 0.0, &plane), SDFCCD_OK);
+    def = sdfccd_default_grid_def();
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(plane, &def, &g), SDFCCD_INVALID_ARGUMENT);
+    def.fit_domain = 0;
+    def.domain = (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } };
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 4;
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(plane, &def, &g), SDFCCD_OK);
+    /* the half-space grid: exact inside the domain (phi is linear); above it the lower bound
+     * sqrt(d^2 + phi(q)^2), below it phi(q) - d (exact here), and infinite bounds since the
+     * surface crosses the domain boundary */
+    double v;
+    ck_assert_int_eq(sdfccd_sdf_eval(g, (sdfccd_Vec3){ 0.3, -0.2, 0.4 }, &v, NULL), SDFCCD_OK);
+    ck_assert_double_near(v, 0.4, 1e-12);
+    ck_assert_int_eq(sdfccd_sdf_eval(g, (sdfccd_Vec3){ 0.3, -0.2, 3.0 }, &v, NULL), SDFCCD_OK);
+    ck_assert_double_near(v, sqrt(5.0), 1e-12);
+    ck_assert_int_eq(sdfccd_sdf_eval(g, (sdfccd_Vec3){ 0.3, -0.2, -3.0 }, &v, NULL), SDFCCD_OK);
+    ck_assert_double_near(v, -3.0, 1e-12);
+    sdfccd_SdfInfo si;
+    ck_assert_int_eq(sdfccd_sdf_get_info(g, &si), SDFCCD_OK);
+    ck_assert(isinf(si.bounds.hi.z));
+    ck_assert_int_eq(sdfccd_destroy_sdf(g), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(plane), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_sphere(1.0, &sphere), SDFCCD_OK);
+    double b;
+    ck_assert_int_eq(sdfccd_grid_lipschitz_bound(sphere, (sdfccd_Aabb){ { 0, 0, 0 }, { 1, 1, 1 } }, &b), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_destroy_sdf(sphere), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
+}
+END_TEST
+
+int main(void)
+{
+    Suite* s = suite_create("grid_build");
+    TCase* tc = tcase_create("build");
+    test_add_memory_fixture(tc);
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, test_sphere_convergence);
+    tcase_add_test(tc, test_threads_identical_and_progress);
+    tcase_add_test(tc, test_narrow_band);
+    tcase_add_test(tc, test_outside_domain);
+    tcase_add_test(tc, test_lipschitz_bounds);
+    tcase_add_test(tc, test_ccd_on_grid);
+    tcase_add_test(tc, test_mesh_import_formats);
+    tcase_add_test(tc, test_bad_defs);
+    suite_add_tcase(s, tc);
+    return test_run_suite(s);
+}
