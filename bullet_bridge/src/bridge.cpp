@@ -8,8 +8,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -379,8 +377,6 @@ public:
         speculative = res.state != SDFCCD_STATE_PENETRATING && res.toi > 0;
         const double toi = res.toi;
         const btTransform Mt = M.at(toi), St = S.at(toi);
-        const btTransform St_inv = St.inverse();
-        const btTransform Mt_inv = Mt.inverse();
 
         // Maps a contact (mesh-local material point, SDF-local surface point and normal, at the
         // TOI or at the end of the step) to the manifold's frame at the start of the step.
@@ -396,56 +392,87 @@ public:
             c.triangle = tri;
             cands.push_back(c);
         };
-        const int n = std::min(res.contact_count, kQueryCapacity);
-        std::vector<uint32_t> tris;
-        for (int i = 0; i < n; ++i) {
-            const sdfccd_Contact& k = contacts[i];
-            btVector3 p = bt(k.point), nw = bt(k.normal);
-            btVector3 q = St_inv * p;
-            btVector3 nL = St.getBasis().transpose() * nw;
-            add(Mt_inv * p, q - nL * (btScalar)k.distance, nL, (int)k.triangle);
-            if (k.triangle < me->indices.size() / 3 && std::find(tris.begin(), tris.end(), k.triangle) == tris.end())
-                tris.push_back(k.triangle);
-        }
-        // The vertices of the contacted triangles that are also in contact at the TOI: a face
-        // landing flat gives its corners, which the solver needs for a stable rest.
+        // A material point constrained by its own closest surface point at the START of the step
+        // (gap phi(t0), normal grad phi(t0)): the form used for features found at the end pose,
+        // whose end-pose normal may point out of the wrong side when the prediction is deep.
+        const btTransform S0_inv = S.t0.inverse();
+        auto addFromStart = [&](const btVector3& local, int tri) {
+            btVector3 q = S0_inv * (M.t0 * local);
+            double phi = 0;
+            sdfccd_Vec3 g;
+            if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK) return;
+            btVector3 nL = bt(g);
+            btScalar len = nL.length();
+            if (!(len > btScalar(0))) return;
+            nL /= len;
+            add(local, q - nL * (btScalar)phi, nL, tri);
+        };
+        // The vertices of the triangles `tris` that are within `accept` of the SDF at pose (Mx, Sx):
+        // a face landing flat gives its corners, which the solver needs for a stable rest.
         const double accept = margin + std::max(params.contact_slop, 1e-4);
-        for (uint32_t t : tris) {
-            for (int j = 0; j < 3; ++j) {
-                const double* v = &me->vertices[3 * me->indices[3 * t + j]];
-                btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
-                btVector3 q = St_inv * (Mt * local);
-                double phi = 0;
-                sdfccd_Vec3 g;
-                if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !(phi <= accept)) continue;
-                btVector3 nL = bt(g);
-                btScalar len = nL.length();
-                if (!(len > btScalar(0))) continue;
-                nL /= len;
-                add(local, q - nL * (btScalar)phi, nL, (int)t);
+        auto addVertices = [&](const std::vector<uint32_t>& tris, const btTransform& Mx, const btTransform& Sx, bool from_start) {
+            const btTransform Sx_inv = Sx.inverse();
+            for (uint32_t t : tris) {
+                for (int j = 0; j < 3; ++j) {
+                    const double* v = &me->vertices[3 * me->indices[3 * t + j]];
+                    btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
+                    btVector3 q = Sx_inv * (Mx * local);
+                    double phi = 0;
+                    sdfccd_Vec3 g;
+                    if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !(phi <= accept)) continue;
+                    if (from_start) {
+                        addFromStart(local, (int)t);
+                        continue;
+                    }
+                    btVector3 nL = bt(g);
+                    btScalar len = nL.length();
+                    if (!(len > btScalar(0))) continue;
+                    nL /= len;
+                    add(local, q - nL * (btScalar)phi, nL, (int)t);
+                }
             }
-        }
-        // Vertices in contact at the END of the step get speculative constraints too (the classic
-        // speculative-contact rule: anything the predicted motion would push in is limited to
-        // its current gap). Without them a body that pivots about its first contact swings its
-        // other end into the SDF when it rotates fast.
-        if (dt > 0) {
-            const btTransform& M1 = M.t1;
-            const btTransform S1_inv = S.t1.inverse();
-            const size_t nv = me->vertices.size() / 3;
-            for (size_t i = 0; i < nv; ++i) {
-                const double* v = &me->vertices[3 * i];
-                btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
-                btVector3 q = S1_inv * (M1 * local);
-                double phi = 0;
-                sdfccd_Vec3 g;
-                if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !(phi <= margin)) continue;
-                btVector3 nL = bt(g);
-                btScalar len = nL.length();
-                if (!(len > btScalar(0))) continue;
-                nL /= len;
-                add(local, q - nL * (btScalar)phi, nL, -1);
+        };
+        // Contacts reported at pose (Mx, Sx) -> candidates, plus their triangles' vertices.
+        auto addContacts = [&](const sdfccd_Contact* cs, int count, const btTransform& Mx, const btTransform& Sx, bool from_start) {
+            const btTransform Sx_inv = Sx.inverse(), Mx_inv = Mx.inverse();
+            std::vector<uint32_t> tris;
+            for (int i = 0; i < count; ++i) {
+                const sdfccd_Contact& k = cs[i];
+                btVector3 p = bt(k.point), nw = bt(k.normal);
+                if (from_start) {
+                    addFromStart(Mx_inv * p, (int)k.triangle);
+                } else {
+                    btVector3 q = Sx_inv * p;
+                    btVector3 nL = Sx.getBasis().transpose() * nw;
+                    add(Mx_inv * p, q - nL * (btScalar)k.distance, nL, (int)k.triangle);
+                }
+                if (k.triangle < me->indices.size() / 3 && std::find(tris.begin(), tris.end(), k.triangle) == tris.end())
+                    tris.push_back(k.triangle);
             }
+            addVertices(tris, Mx, Sx, from_start);
+        };
+        addContacts(contacts, std::min(res.contact_count, kQueryCapacity), Mt, St, false);
+
+        // For an impact inside the step, the features in contact at the END of the step get
+        // speculative constraints too (the classic speculative-contact rule: whatever the
+        // predicted motion would push in is limited to its gap at the start of the step, along
+        // its normal at the start). Without them a body that pivots about its first contact
+        // swings the rest of itself into the SDF when it rotates fast. One discrete (DCD) query
+        // at the predicted end pose, in impact steps only.
+        if (dt > 0 && speculative) {
+            sdfccd_RigidMotion m1 = sdfccd_default_rigid_motion(), s1 = sdfccd_default_rigid_motion();
+            m1.pose = toPose(M.t1);
+            s1.pose = toPose(S.t1);
+            sdfccd_QueryParams dcd = params;
+            dcd.method = SDFCCD_METHOD_DCD;
+            sdfccd_QueryResult r1;
+            sdfccd_Contact end_contacts[kQueryCapacity];
+            auto t_start = std::chrono::steady_clock::now();
+            sdfccd_Status st1 = sdfccd_query_mesh(sdf, &s1, me->id, &m1, 0.0, 0.0, &dcd, end_contacts, kQueryCapacity, &r1);
+            stats.query_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+            stats.end_pose_queries++;
+            if (st1 == SDFCCD_OK && r1.hit)
+                addContacts(end_contacts, std::min(r1.contact_count, kQueryCapacity), M.t1, S.t1, true);
         }
         return !cands.empty();
     }
@@ -502,17 +529,28 @@ public:
             sdfccd_QueryResult res;
             if (sdfccd_query_mesh(sdf, &sm, me->id, &end, 0, 0, &params, nullptr, 0, &res) != SDFCCD_OK || !res.hit)
                 continue;
-            // 2. First contact along the step's motion; move the body back to it.
+            // 2. The first time along the step's motion at which the penetration reaches the
+            //    tolerance (same margin); move the body back to that pose. A body that already
+            //    started the step that deep is left to the ordinary contacts.
             BodyMotion M;
             M.t0 = it->second;
             M.t1 = body->getWorldTransform();
             btTransformUtil::calculateVelocity(M.t0, M.t1, (btScalar)dt, M.v, M.w);
             sdfccd_RigidMotion mm = M.rigid();
-            params.margin = 0;
             sdfccd_Contact c[4];
-            if (sdfccd_query_mesh(sdf, &sm, me->id, &mm, 0, dt, &params, c, 4, &res) != SDFCCD_OK || !res.hit ||
-                res.state == SDFCCD_STATE_PENETRATING)
-                continue;
+            // Back to where the penetration was half the tolerance (so the next step does not
+            // start at the threshold), or to the tolerance itself if the step began deeper.
+            bool found = false;
+            const double margins[2] = { -0.5 * clamp_tolerance, -clamp_tolerance };
+            for (double mg : margins) {
+                params.margin = mg;
+                sdfccd_Status cst = sdfccd_query_mesh(sdf, &sm, me->id, &mm, 0, dt, &params, c, 4, &res);
+                if (cst == SDFCCD_OK && res.hit && res.state != SDFCCD_STATE_PENETRATING) {
+                    found = true;
+                    break;
+                }
+            }
+            if (!found) continue;
             body->setCenterOfMassTransform(M.at(res.toi));
             if (res.contact_count > 0) {
                 btVector3 nrm = bt(c[0].normal);
@@ -635,10 +673,6 @@ void BridgeImpl::process(MeshSdfAlgorithm&, const btCollisionObjectWrapper* mw, 
         return;
     }
     std::vector<int> pick = selectSpread(scratch, cfg.max_contacts);
-    if (getenv("SDFCCD_BRIDGE_DEBUG")) {
-        fprintf(stderr, "query state %d toi %.4f frac %.4f found %d cands %d\n", res.state, res.toi, res.fraction, res.contacts_found, (int)scratch.size());
-        for (size_t i = 0; i < scratch.size(); ++i) { const Candidate& c = scratch[i]; fprintf(stderr, "  %s cand tri %d local (%.3f %.3f %.3f) pA0 (%.3f %.3f %.3f) pB0 (%.3f %.3f %.3f) n (%.3f %.3f %.3f) d %.4f\n", std::find(pick.begin(), pick.end(), (int)i) != pick.end() ? "*" : " ", c.triangle, c.local.x(), c.local.y(), c.local.z(), c.pA0.x(), c.pA0.y(), c.pA0.z(), c.pB0.x(), c.pB0.y(), c.pB0.z(), c.n0.x(), c.n0.y(), c.n0.z(), c.d); }
-    }
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;

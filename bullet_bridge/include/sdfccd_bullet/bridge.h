@@ -8,7 +8,8 @@
  *  - registers the same pairs in the closest-points table, so contactTest/contactPairTest work;
  *  - per step and pair: takes the mesh's start pose (world transform) and predicted end pose
  *    (interpolation transform), the SDF body's likewise (static: fixed; kinematic: rebuilt
- *    backwards from its velocities), runs ONE sdfccd_query_mesh over [0, dt], and writes at
+ *    backwards from its velocities), runs ONE CCD sdfccd_query_mesh over [0, dt] (plus, in a
+ *    step with an impact, one discrete query at the predicted end pose), and writes at
  *    most four well-spread contacts straight into the pair's manifold. Each contact's distance
  *    is the gap at the start of the step along the contact normal, so the solver lets the mesh
  *    travel exactly to the surface in the impact step. Contacts of an impact inside the step
@@ -79,8 +80,9 @@ struct Config {
 
 /** Counters for measurements (all since construction or resetStats()). */
 struct Stats {
-    int64_t queries = 0;               /**< sdfccd_query_mesh calls made by the algorithm. */
-    double query_seconds = 0;          /**< Wall time inside those calls. */
+    int64_t queries = 0;               /**< CCD queries (sdfccd_query_mesh over the step) made by the algorithm. */
+    int64_t end_pose_queries = 0;      /**< Discrete queries at the predicted end pose (impact steps only). */
+    double query_seconds = 0;          /**< Wall time inside all those calls. */
     int64_t hits = 0;                  /**< Queries that found contact (hit). */
     int64_t speculative_contacts = 0;  /**< Contacts written for impacts inside a step. */
     int64_t ordinary_contacts = 0;     /**< Contacts written for features in contact at step start. */
