@@ -73,7 +73,11 @@ struct Config {
     double contact_margin = 0.01;
     /** Contacts written per pair and step, 1..4 (the manifold holds 4). Default 4. */
     int max_contacts = 4;
-    /** Query parameters passed to sdfccd_query_mesh (margin is replaced by contact_margin). */
+    /** Query parameters passed to sdfccd_query_mesh (margin is replaced by contact_margin).
+     * The library's defaults. Keep subdivision on: a long triangle lying across two separate
+     * contact regions (a bar across a torus's ring) has only one primary contact, and
+     * subdivision finds the other (without it that test scene falls through). It is also the
+     * main cost: 180 instead of 40 us per step in the 200 m/s cube scene. */
     sdfccd_QueryParams query;
     Config() : query(sdfccd_default_query_params()) {}
 };
