@@ -20,6 +20,7 @@ typedef struct scc_params {
     double dist_tol;        /* absolute (m) */
     int max_iter;
     int max_ls_iter;
+    int fwgss_restarts;     /* extra FWGSS descents from the other vertices (0..2) */
     int subdivision;
     double sub_min_area;    /* m^2 */
     double contact_slop;    /* m */

@@ -18,22 +18,33 @@ void scc_fw_begin(scc_fw_state* s, const scc_sdf* sdf, const scc_tri_motion* m, 
     s->b[0] = 1.0; s->b[1] = 0.0; s->b[2] = 0.0;
 }
 
-void scc_fw_start_vertex(scc_fw_state* s)
+void scc_fw_start_order(scc_fw_state* s, int order[3])
 {
     scc_tri_state st;
     scc_tri_state_at(s->m, s->ts, &st);
-    int best = 0;
-    double best_score = INFINITY;
+    double score[3];
     for (int i = 0; i < 3; ++i) {
         double b[3] = { i == 0, i == 1, i == 2 };
         scc_vec3 g;
         double phi = scc_sdf_eval(s->sdf, st.x[i], &g);
         s->evals++;
         scc_fw_witness(s, s->ts, b, phi);
-        double score = scc_dot(st.v[i], g);
-        if (score < best_score) { best_score = score; best = i; }
+        score[i] = scc_dot(st.v[i], g);
+        order[i] = i;
     }
-    s->b[0] = best == 0; s->b[1] = best == 1; s->b[2] = best == 2;
+    for (int i = 1; i < 3; ++i)
+        for (int j = i; j > 0 && score[order[j]] < score[order[j - 1]]; --j) {
+            int tmp = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = tmp;
+        }
+}
+
+void scc_fw_start_vertex(scc_fw_state* s)
+{
+    int order[3];
+    scc_fw_start_order(s, order);
+    s->b[0] = order[0] == 0; s->b[1] = order[0] == 1; s->b[2] = order[0] == 2;
 }
 
 int scc_fw_support(const scc_tri_state* st, scc_vec3 g)

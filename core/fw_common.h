@@ -41,6 +41,8 @@ static inline double scc_fw_eval(scc_fw_state* s, const double b[3], double t, s
 void scc_fw_begin(scc_fw_state* s, const scc_sdf* sdf, const scc_tri_motion* m, const scc_params* p, double ta, double tb);
 /* Section 4.4: the vertex minimising v . grad phi at ts; sets s->b. */
 void scc_fw_start_vertex(scc_fw_state* s);
+/* The three vertices ordered by the Section 4.4 score (most promising first). */
+void scc_fw_start_order(scc_fw_state* s, int order[3]);
 /* Index of the vertex of `st` minimising grad . vertex (Eq. 15). */
 int scc_fw_support(const scc_tri_state* st, scc_vec3 g);
 /* Fills `out` from the solver state once the iterations end. */

@@ -20,6 +20,35 @@ static double phi_at_time(double t, void* c)
 
 static double unsigned_phi_at_time(double t, void* c) { return fabs(phi_at_time(t, c)); }
 
+/* Algorithm 2 line 13 minimises |phi| over [ts, t_i] to find where the current point enters the
+ * contact surface. When its path first grazes the surface and re-enters later (rotation, thin
+ * features), |phi| has a second local minimum away from zero and the golden-section search can
+ * settle there; the solver then cycles between the graze and the entry. phi is in contact at
+ * t_i, so when it is not in contact at ts a sign change is bracketed: bisection then lands on a
+ * true crossing. (Ours; the paper's conclusion also suggests bisection.) */
+static scc_gss_result crossing_by_bisection(scc_fw_state* s, double lo, double hi, const scc_params* p)
+{
+    scc_gss_result r;
+    r.evals = 0;
+    r.converged = 1;
+    double flo = phi_at_time(lo, s);
+    if (flo <= 0.0) { /* in contact already at the interval start */
+        r.l = lo;
+        r.f = fabs(flo);
+        return r;
+    }
+    int it = 0;
+    while (hi - lo > p->time_tol && it++ < p->max_ls_iter) {
+        double mid = 0.5 * (lo + hi);
+        if (phi_at_time(mid, s) > 0.0) lo = mid;
+        else hi = mid;
+    }
+    r.converged = hi - lo <= p->time_tol;
+    r.l = hi;
+    r.f = fabs(phi_at_time(hi, s));
+    return r;
+}
+
 typedef struct space_ctx {
     scc_fw_state* s;
     scc_vec3 a, b;      /* segment from the iterate to the support vertex */
@@ -40,45 +69,84 @@ static double phi_on_segment(double l, void* c)
     return phi;
 }
 
-void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out)
+/* One FWGSS descent from the weights in s->b (Algorithm 2 lines 4-33). Returns 1 if it converged. */
+static int descend(scc_fw_state* s, int64_t* io_iterations)
 {
-    scc_fw_state s;
-    scc_fw_begin(&s, sdf, m, p, ta, tb);
-    scc_fw_start_vertex(&s);
-    double t = ta;
-    int converged = 0;
+    const scc_params* p = s->p;
+    double t = s->ts;
     int64_t it = 0;
     while (it < p->max_iter) {
         ++it;
         /* Temporal sub-problem (lines 5-21). */
         scc_vec3 x, g, v;
-        double phi = scc_fw_eval(&s, s.b, t, &x, &g, &v);
+        double phi = scc_fw_eval(s, s->b, t, &x, &g, &v);
         scc_gss_result ls;
-        if (phi <= p->margin)
-            ls = scc_gss_minimize(s.ts, t, p->time_tol, p->max_ls_iter, unsigned_phi_at_time, &s);
-        else if (scc_dot(g, v) > 0.0) /* d = -1: moving away, look back in time */
-            ls = scc_gss_minimize(s.ts, t, p->time_tol, p->max_ls_iter, phi_at_time, &s);
-        else
-            ls = scc_gss_minimize(t, s.te, p->time_tol, p->max_ls_iter, phi_at_time, &s);
-        double tn = fmin(ls.l, s.te);
+        if (phi <= p->margin) {
+            ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, unsigned_phi_at_time, s);
+            if (ls.f > p->dist_tol) ls = crossing_by_bisection(s, s->ts, fmin(t, s->te), p);
+        } else if (scc_dot(g, v) > 0.0) { /* d = -1: moving away, look back in time */
+            ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, phi_at_time, s);
+        } else {
+            ls = scc_gss_minimize(t, s->te, p->time_tol, p->max_ls_iter, phi_at_time, s);
+        }
+        double tn = fmin(ls.l, s->te);
 
-        /* Spatial sub-problem at the new time (lines 22-31). */
+        /* Spatial sub-problem at the new time (lines 22-31), as a pairwise step: weight moves
+         * from the active vertex with the largest grad . vertex (the "away" vertex) to the
+         * support vertex of Eq. 15. When the iterate is a vertex this is the paper's step towards
+         * the support vertex; inside the triangle it avoids Frank-Wolfe's zig-zag towards an
+         * optimum on an edge. */
         scc_vec3 xn, gn;
-        scc_fw_eval(&s, s.b, tn, &xn, &gn, &v);
+        scc_fw_eval(s, s->b, tn, &xn, &gn, &v);
         scc_tri_state st;
-        scc_tri_state_at(m, tn, &st);
+        scc_tri_state_at(s->m, tn, &st);
         int sv = scc_fw_support(&st, gn);
-        double len = scc_dist(st.x[sv], xn);
+        int av = sv;
+        double best = -INFINITY;
+        for (int j = 0; j < 3; ++j) {
+            double d = scc_dot(gn, st.x[j]);
+            if (s->b[j] > 0.0 && d > best) { best = d; av = j; }
+        }
         double step = 0.0;
-        if (len > p->dist_tol) {
-            space_ctx k = { &s, xn, st.x[sv], { s.b[0], s.b[1], s.b[2] }, { sv == 0, sv == 1, sv == 2 }, tn };
-            scc_gss_result sp = scc_gss_minimize(0.0, 1.0, p->dist_tol / len, p->max_ls_iter, phi_on_segment, &k);
-            for (int j = 0; j < 3; ++j) s.b[j] = (1.0 - sp.l) * s.b[j] + sp.l * (j == sv);
-            step = sp.l * len;
+        if (av != sv) {
+            double wa = s->b[av];
+            scc_vec3 end = scc_madd(xn, scc_sub(st.x[sv], st.x[av]), wa);
+            double len = scc_dist(end, xn);
+            if (len > p->dist_tol) {
+                double bb[3] = { s->b[0], s->b[1], s->b[2] };
+                bb[sv] += wa;
+                bb[av] = 0.0;
+                space_ctx k = { s, xn, end, { s->b[0], s->b[1], s->b[2] }, { bb[0], bb[1], bb[2] }, tn };
+                scc_gss_result sp = scc_gss_minimize(0.0, 1.0, p->dist_tol / len, p->max_ls_iter, phi_on_segment, &k);
+                for (int j = 0; j < 3; ++j) s->b[j] = (1.0 - sp.l) * s->b[j] + sp.l * bb[j];
+                s->b[av] = fmax(s->b[av], 0.0);
+                step = sp.l * len;
+            }
         }
         int small = fabs(tn - t) <= p->time_tol && step <= p->dist_tol; /* line 32 */
         t = tn;
-        if (small) { converged = 1; break; }
+        if (small) { *io_iterations += it; return 1; }
+    }
+    *io_iterations += it;
+    return 0;
+}
+
+void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out)
+{
+    scc_fw_state s;
+    scc_fw_begin(&s, sdf, m, p, ta, tb);
+    int order[3];
+    scc_fw_start_order(&s, order);
+    int converged = 1;
+    int64_t it = 0;
+    /* Section 4.4 picks the most promising vertex; the other vertices are tried next (ours),
+     * sharing the shrinking interval, so a local minimum or a later entry of the first descent
+     * is corrected and every later descent only searches before the earliest witness. */
+    int starts = 1 + (p->fwgss_restarts < 2 ? p->fwgss_restarts : 2);
+    for (int k = 0; k < starts; ++k) {
+        s.b[0] = order[k] == 0; s.b[1] = order[k] == 1; s.b[2] = order[k] == 2;
+        if (!descend(&s, &it)) converged = 0;
+        if (s.hit && s.hit_t <= s.ts) break; /* in contact at the start: nothing is earlier */
     }
     scc_fw_finish(&s, converged, it, out);
 }

@@ -125,6 +125,34 @@ double scc_tri_speed_bound(const scc_tri_motion* m)
     return speed;
 }
 
+double scc_tri_accel_bound(const scc_tri_motion* m)
+{
+    /* World acceleration of a point of a body spinning at constant w about a centre moving at
+     * constant velocity: w x (w x r), so |a| <= |w|^2 r. In a frame rotating at constant w_s the
+     * apparent acceleration adds Coriolis and centripetal terms: 2 |w_s| |v_rel| + |w_s|^2 |r_s|. */
+    double a = 0.0, r = 0.0;
+    if (m->kind == SCC_TRI_RIGID) {
+        for (int i = 0; i < 3; ++i) r = fmax(r, scc_dist(m->local[i], m->body->c_local));
+        a = scc_len2(m->body->w) * r;
+    }
+    if (m->sdf) {
+        double ws = scc_len(m->sdf->w);
+        if (ws > 0.0) {
+            double S = scc_tri_speed_bound(m);
+            double T = fabs(m->t1 - m->t0);
+            scc_vec3 gs0 = scc_rigid_center_at(m->sdf, m->t0);
+            double reach = 0.0;
+            for (int i = 0; i < 3; ++i) {
+                scc_vec3 x0 = m->kind == SCC_TRI_RIGID ? scc_xform_apply((scc_xform){ m->body->q0, m->body->p0 }, m->local[i]) : m->start[i];
+                reach = fmax(reach, scc_dist(x0, gs0));
+            }
+            reach += (S + scc_len(m->sdf->v)) * T;
+            a += 2.0 * ws * S + ws * ws * reach;
+        }
+    }
+    return a;
+}
+
 double scc_tri_rotation_angle(const scc_tri_motion* m, double ta, double tb)
 {
     double w = 0.0;

@@ -55,6 +55,9 @@ scc_vec3 scc_tri_point_at(const scc_tri_motion* m, const double b[3], double t, 
 /* Upper bound on the speed (SDF frame) of any point of the triangle over [m->t0, m->t1]. */
 double scc_tri_speed_bound(const scc_tri_motion* m);
 
+/* Upper bound on the acceleration (SDF frame) of any point of the triangle over [m->t0, m->t1]. */
+double scc_tri_accel_bound(const scc_tri_motion* m);
+
 /* Total relative rotation angle over [ta, tb] (radians, an upper bound). */
 double scc_tri_rotation_angle(const scc_tri_motion* m, double ta, double tb);
 

@@ -23,6 +23,9 @@ typedef double scc_sdf_eval_fn(const scc_sdf* self, scc_vec3 p, scc_vec3* out_gr
  * Grids use it to give per-cell bounds; when NULL the global `lipschitz` is used. */
 typedef double scc_sdf_lipschitz_fn(const scc_sdf* self, const scc_aabb* box);
 
+/* Optional: 1 when phi is convex on the whole box (NULL: use the global `convex` flag). */
+typedef int scc_sdf_convex_fn(const scc_sdf* self, const scc_aabb* box);
+
 typedef enum scc_sdf_kind {
     SCC_SDF_SPHERE, SCC_SDF_BOX, SCC_SDF_ROUNDED_BOX, SCC_SDF_TORUS, SCC_SDF_CAPSULE,
     SCC_SDF_CYLINDER, SCC_SDF_HALF_SPACE, SCC_SDF_SPIKE_GRID, SCC_SDF_CSG, SCC_SDF_TRANSFORM,
@@ -38,6 +41,10 @@ struct scc_sdf {
     scc_aabb bounds;
     /* Global bound on |grad phi|: 1 for exact distance fields and their min/max/rigid combos. */
     double lipschitz;
+    /* 1 when phi is a convex function (the signed distance of a convex shape): then
+     * phi(x) >= phi(c) + grad(c) . (x - c), which the certified TOI uses. 0 when unknown. */
+    int convex;
+    scc_sdf_convex_fn* convex_in; /* may be NULL */
     scc_sdf_kind kind;
 };
 
@@ -50,6 +57,12 @@ static inline double scc_sdf_eval(const scc_sdf* s, scc_vec3 p, scc_vec3* out_gr
 static inline double scc_sdf_lipschitz(const scc_sdf* s, const scc_aabb* box)
 {
     return s->lipschitz_in ? s->lipschitz_in(s, box) : s->lipschitz;
+}
+
+/* 1 when phi is known to be convex on `box`. */
+static inline int scc_sdf_convex_in(const scc_sdf* s, const scc_aabb* box)
+{
+    return s->convex || (s->convex_in && s->convex_in(s, box));
 }
 
 #endif

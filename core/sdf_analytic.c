@@ -23,10 +23,14 @@ static void base_init(scc_sdf* b, scc_sdf_eval_fn* fn, scc_sdf_kind kind, scc_aa
 {
     b->eval = fn;
     b->lipschitz_in = NULL;
+    b->convex_in = NULL;
     b->domain = box_infinite();
     b->bounds = bounds;
     b->lipschitz = 1.0;
     b->kind = kind;
+    /* The signed distance of a convex shape is a convex function. */
+    b->convex = kind == SCC_SDF_SPHERE || kind == SCC_SDF_BOX || kind == SCC_SDF_ROUNDED_BOX || kind == SCC_SDF_CAPSULE ||
+                kind == SCC_SDF_CYLINDER || kind == SCC_SDF_HALF_SPACE;
 }
 
 static double sign_of(double x) { return x < 0.0 ? -1.0 : 1.0; }
@@ -85,10 +89,21 @@ static double torus_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
     if (g) *g = l > 0.0 ? scc_v3(qx / l * ex, qx / l * ey, qz / l) : scc_v3(ex, ey, 0.0);
     return l - s->minor;
 }
+/* phi = h(rho, z) with h(a, z) = |(a - R, z)| - r convex, and nondecreasing in a where a >= R; rho
+ * is convex, so phi is convex wherever rho >= R on a convex set (the outer half of the torus). */
+static int torus_convex_in(const scc_sdf* self, const scc_aabb* b)
+{
+    const scc_sdf_torus* s = (const scc_sdf_torus*)self;
+    double dx = b->lo.x > 0.0 ? b->lo.x : (b->hi.x < 0.0 ? -b->hi.x : 0.0);
+    double dy = b->lo.y > 0.0 ? b->lo.y : (b->hi.y < 0.0 ? -b->hi.y : 0.0);
+    return dx * dx + dy * dy >= s->major * s->major;
+}
+
 void scc_sdf_torus_init(scc_sdf_torus* s, double major, double minor)
 {
     double e = major + minor;
     base_init(&s->base, torus_eval, SCC_SDF_TORUS, box_sym(scc_v3(e, e, minor)));
+    s->base.convex_in = torus_convex_in;
     s->major = major;
     s->minor = minor;
 }
@@ -269,6 +284,7 @@ void scc_sdf_csg_init(scc_sdf_csg* s, scc_csg_op op, const scc_sdf* a, const scc
     base_init(&s->base, csg_eval, SCC_SDF_CSG, bounds);
     s->base.domain = aabb_intersection(a->domain, b->domain);
     s->base.lipschitz = fmax(a->lipschitz, b->lipschitz);
+    s->base.convex = op == SCC_CSG_INTERSECTION && a->convex && b->convex; /* max of convex functions */
     s->op = op;
     s->a = a;
     s->b = b;
@@ -299,11 +315,24 @@ static scc_aabb transform_box(scc_aabb b, scc_xform xf, double scale)
     return r;
 }
 
+static int transform_convex_in(const scc_sdf* self, const scc_aabb* box)
+{
+    const scc_sdf_transform* s = (const scc_sdf_transform*)self;
+    if (!s->child->convex_in) return 0;
+    scc_xform inv = { scc_quat_conj(s->xf.q), scc_quat_rotate(scc_quat_conj(s->xf.q), scc_scale(s->xf.p, -1.0)) };
+    scc_aabb local = transform_box(*box, inv, 1.0);
+    local.lo = scc_scale(local.lo, 1.0 / s->scale);
+    local.hi = scc_scale(local.hi, 1.0 / s->scale);
+    return s->child->convex_in(s->child, &local);
+}
+
 void scc_sdf_transform_init(scc_sdf_transform* s, const scc_sdf* child, scc_xform xf, double scale)
 {
     base_init(&s->base, transform_eval, SCC_SDF_TRANSFORM, transform_box(child->bounds, xf, scale));
     s->base.domain = transform_box(child->domain, xf, scale);
     s->base.lipschitz = child->lipschitz;
+    s->base.convex = child->convex; /* an affine change of variables keeps convexity */
+    s->base.convex_in = transform_convex_in;
     s->child = child;
     s->xf = xf;
     s->scale = scale;

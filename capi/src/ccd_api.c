@@ -19,6 +19,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.distance_tolerance = 1e-7;
     p.max_iterations = 32;
     p.max_line_search_iterations = 64;
+    p.fwgss_restarts = 2;
     p.subdivision = 1;
     p.subdivision_min_area = 1e-6;
     p.contact_slop = 1e-4;
@@ -68,6 +69,9 @@ static sdfccd_Status convert_params(const sdfccd_QueryParams* in, const char* fn
     out->dist_tol = in->distance_tolerance;
     out->max_iter = in->max_iterations;
     out->max_ls_iter = in->max_line_search_iterations;
+    if (in->fwgss_restarts < 0 || in->fwgss_restarts > 2)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_restarts must be 0, 1 or 2 (got %d)", fn, in->fwgss_restarts);
+    out->fwgss_restarts = in->fwgss_restarts;
     out->subdivision = in->subdivision != 0;
     out->sub_min_area = in->subdivision_min_area;
     out->contact_slop = in->contact_slop;

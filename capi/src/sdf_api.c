@@ -250,6 +250,8 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
     c->base.domain.hi = scc_v3(INFINITY, INFINITY, INFINITY);
     c->base.bounds = capi_box(def->bounds);
     c->base.lipschitz = def->lipschitz;
+    c->base.convex = 0;
+    c->base.convex_in = NULL;
     c->base.kind = SCC_SDF_CALLBACK;
     c->fn = def->eval;
     c->user = def->user;

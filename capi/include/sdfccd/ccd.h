@@ -47,6 +47,9 @@ typedef struct sdfccd_QueryParams {
     double distance_tolerance;     /**< Spatial convergence tolerance (m). Default 1e-7. */
     int32_t max_iterations;        /**< Frank-Wolfe outer iterations. Default 32. */
     int32_t max_line_search_iterations; /**< Golden-section iterations per line search. Default 64. */
+    int32_t fwgss_restarts;        /**< FWGSS: extra descents from the other two vertices after the Section 4.4 start
+                                        (0 = the paper's single descent, up to 2). They share the shrinking interval and
+                                        correct local minima and later entries. Default 2. */
     int32_t subdivision;           /**< Adaptive triangle subdivision at the TOI (Section 4.5). Default 1 (on). */
     double subdivision_min_area;   /**< Smallest sub-triangle area searched (m^2). Default 1e-6. */
     double contact_slop;           /**< Extra contacts at the TOI are kept when phi <= margin + contact_slop (m). Default 1e-4. */
