@@ -80,7 +80,9 @@ BodyMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_tran
     m.t0 = m.t1 = wrapper_transform;
     m.v.setZero();
     m.w.setZero();
-    if (!(dt > 0) || co->isStaticObject()) return m;
+    if (!(dt > 0)) return m;
+    // Kinematic first: Bullet's idiom for a kinematic body (mass 0 plus CF_KINEMATIC_OBJECT)
+    // leaves CF_STATIC_OBJECT set as well.
     if (co->isKinematicObject()) {
         // saveKinematicState has already moved the world transform to the END of the step and
         // set the interpolation velocities; rebuild the start pose by integrating backwards.
@@ -91,6 +93,7 @@ BodyMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_tran
         btTransformUtil::calculateVelocity(m.t0, m.t1, (btScalar)dt, m.v, m.w);
         return m;
     }
+    if (co->isStaticObject()) return m;
     // Dynamic: world transform = start, interpolation transform = predicted end (set by
     // predictUnconstraintMotion before the narrow phase). A child offset (compound) is kept.
     btTransform child = co->getWorldTransform().inverseTimes(wrapper_transform);

@@ -290,6 +290,48 @@ static void test_torus_spinning()
     sdfccd_destroy_sdf(torus);
 }
 
+// ---- a moving (kinematic) SDF body: a slab rising at 20 m/s lifts a resting cube ----
+
+static void test_kinematic_sdf()
+{
+    sdfccd_SdfId slab = makeBoxSdf(3, 3, 0.05);
+    double worst_gap = 1e9, final_gap = 0;
+    sdfccd_bullet::Stats stats;
+    {
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        btRigidBody* platform = w.add(&shape, 0, btVector3(0, 0, 0));
+        platform->setCollisionFlags(platform->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+        platform->setActivationState(DISABLE_DEACTIVATION);
+        btRigidBody* body = w.add(cube->shape.get(), 1, btVector3(0, 0, 1.2), btVector3(0.5, 0.5, 0.5));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        const double speed = 20; // 0.33 m per step: more than three slab thicknesses
+        for (int i = 0; i < 30; ++i) {
+            btTransform t;
+            t.setIdentity();
+            t.setOrigin(btVector3(0, 0, (btScalar)(speed * kDt * (i + 1))));
+            platform->getMotionState()->setWorldTransform(t); // kinematic: the motion state drives it
+            w.step();
+            double gap = body->getCenterOfMassPosition().z() - 0.5 - (platform->getCenterOfMassPosition().z() + 0.05);
+            worst_gap = std::min(worst_gap, gap);
+            final_gap = gap;
+            if (kVerbose)
+                std::printf("  kinematic step %d: platform %.4f cube %.4f gap %.5f\n", i, platform->getCenterOfMassPosition().z(),
+                            body->getCenterOfMassPosition().z(), gap);
+        }
+        stats = bridge.stats();
+    }
+    CHECK(stats.hits > 0, "no contact with the moving slab");
+    CHECK(worst_gap >= -0.01, "the cube sank %.4f m into the rising slab", -worst_gap);
+    CHECK(final_gap <= 0.05, "the cube is not riding on the slab (gap %.4f m)", final_gap);
+    std::printf("kinematic slab at 20 m/s: cube-slab gap min %.5f m, final %.5f m, %lld queries\n", worst_gap, final_gap,
+                (long long)stats.queries);
+    sdfccd_destroy_sdf(slab);
+}
+
 // ---- a GImpact mesh dropped into the concave box .cdf through Bullet's btSdfCollisionShape ----
 
 static bool loadFile(const std::string& path, std::vector<char>& out)
@@ -598,6 +640,7 @@ static const Test kTests[] = {
     { "cube_sdf_first", test_cube_sdf_first },
     { "cube_tunnels_without_bridge", test_cube_tunnels_without_bridge },
     { "torus_spinning", test_torus_spinning },
+    { "kinematic_sdf", test_kinematic_sdf },
     { "cdf_concave_box", test_cdf_concave_box },
     { "convex_box_on_triangulation", test_convex_box_on_triangulation },
     { "shape_aabb", test_shape_aabb },
