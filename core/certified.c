@@ -113,19 +113,29 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
         scc_aabb box = { scc_sub(c, scc_v3(rho, rho, rho)), scc_add(c, scc_v3(rho, rho, rho)) };
         double L = scc_sdf_lipschitz(sdf, &box);
         if (phi - L * rho > p->margin) continue; /* pruned: no contact anywhere in the region */
+        /* Which part of the bound's slack to refine: the Lipschitz ball's spatial and temporal
+         * radii, or, for a convex phi, the spatial and temporal parts of the first-order bound. */
+        double slack_space = rs, slack_time = rt;
         if (scc_sdf_convex_in(sdf, &box)) {
             /* First-order bound of a convex phi: phi(x) >= phi(c) + g.(x - c). Over the region,
              * x(b, ta + s) - c = sum_i b_i (x_i(ta) - c + s v_i(ta)) + e with |e| <= A s^2 / 2, and
              * the bilinear part is smallest at a corner and at s = 0 or s = tb - ta. Tangential
              * sliding therefore costs nothing, unlike in the Lipschitz ball. */
-            double dt = r.tb - r.ta, lin = INFINITY;
+            double dt = r.tb - r.ta, lin = INFINITY, lin_space = INFINITY, lin_time = INFINITY;
             for (int i = 0; i < 3; ++i) {
                 scc_vec3 xi = corner(&st, r.u[i], r.v[i]);
                 scc_vec3 vi = scc_add(scc_add(scc_scale(st.v[0], r.u[i]), scc_scale(st.v[1], r.v[i])), scc_scale(st.v[2], 1.0 - r.u[i] - r.v[i]));
-                double at0 = scc_dot(gc, scc_sub(xi, c));
-                lin = fmin(lin, fmin(at0, at0 + dt * scc_dot(gc, vi)));
+                double at0 = scc_dot(gc, scc_sub(xi, c)), drift = dt * scc_dot(gc, vi);
+                lin = fmin(lin, fmin(at0, at0 + drift));
+                lin_space = fmin(lin_space, at0);
+                lin_time = fmin(lin_time, drift);
             }
-            if (phi + lin - scc_len(gc) * 0.5 * accel * dt * dt > p->margin) continue;
+            double curve = scc_len(gc) * 0.5 * accel * dt * dt;
+            if (phi + lin - curve > p->margin) continue;
+            if (phi + lin - curve > phi - L * rho) {
+                slack_space = -fmin(lin_space, 0.0);
+                slack_time = -fmin(lin_time, 0.0) + curve;
+            }
         }
         /* Unresolved: look for witnesses at the corners at ta (a contact there is exact: nothing
          * earlier is unresolved) and at the centroid and corners at tb (an upper bound). Corners
@@ -153,7 +163,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
                 }
             }
         }
-        if (rt >= rs) {
+        if (slack_time >= slack_space) {
             double tm = 0.5 * (r.ta + r.tb);
             region a = r, b = r;
             a.tb = tm;
