@@ -30,3 +30,29 @@ if(SDFCCD_BUILD_BULLET_BRIDGE)
     set_tests_properties(bullet_hello PROPERTIES LABELS bullet)
   endif()
 endif()
+
+# The compile-time precision check: the bridge's headers compiled with a btScalar that differs
+# from the bridge library's (SDFCCD_BULLET_SCALAR_BYTES) must fail with config.h's message; the
+# matching combination must compile (so the failure is the check's, not a broken command).
+if(SDFCCD_BUILD_BULLET_BRIDGE)
+  foreach(_tgt IN LISTS SDFCCD_BULLET_TARGETS)
+    if(_tgt STREQUAL "sdfccd_bullet_f64")
+      set(_right 8)
+      set(_wrong 4)
+    else()
+      set(_right 4)
+      set(_wrong 8)
+    endif()
+    set(_inc -I${PROJECT_SOURCE_DIR}/capi/include -I${PROJECT_SOURCE_DIR}/bullet_bridge/include)
+    foreach(_d IN LISTS SDFCCD_BULLET_INCLUDE_DIRS_${_tgt})
+      list(APPEND _inc -I${_d})
+    endforeach()
+    set(_cmd ${CMAKE_CXX_COMPILER} -std=c++11 -fsyntax-only ${SDFCCD_BULLET_CFLAGS_${_tgt}} ${_inc}
+             ${CMAKE_CURRENT_SOURCE_DIR}/bullet/precision_check.cpp)
+    add_test(NAME ${_tgt}.precision_match COMMAND ${_cmd} -DSDFCCD_BULLET_SCALAR_BYTES=${_right})
+    add_test(NAME ${_tgt}.precision_mismatch_rejected COMMAND ${_cmd} -DSDFCCD_BULLET_SCALAR_BYTES=${_wrong})
+    set_tests_properties(${_tgt}.precision_match ${_tgt}.precision_mismatch_rejected PROPERTIES LABELS bullet)
+    set_tests_properties(${_tgt}.precision_mismatch_rejected PROPERTIES
+      PASS_REGULAR_EXPRESSION "BT_USE_DOUBLE_PRECISION does not match the bridge library")
+  endforeach()
+endif()
