@@ -186,10 +186,12 @@ static void closest_on_segment2(double px, double pz, double ax, double az, doub
 /* Signed distance from (rho, z) to the cone's meridian triangle, gradient in (rho, z). */
 static double cone_distance2(double rho, double z, double R, double H, double* grho, double* gz)
 {
+    /* Boundary edges of the meridian triangle: the base (0,0)-(R,0) and the slant (R,0)-(0,H).
+     * The third edge lies on the axis of revolution and is not part of the surface. */
     const double vx[3] = { 0.0, R, 0.0 }, vz[3] = { 0.0, 0.0, H };
     double best = INFINITY, bx = 0.0, bz = 0.0;
-    for (int i = 0; i < 3; ++i) {
-        int j = (i + 1) % 3;
+    for (int i = 0; i < 2; ++i) {
+        int j = i + 1;
         double cx, cz;
         closest_on_segment2(rho, z, vx[i], vz[i], vx[j], vz[j], &cx, &cz);
         double d2 = (rho - cx) * (rho - cx) + (z - cz) * (z - cz);

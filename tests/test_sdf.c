@@ -1,0 +1,293 @@
+/* SPDX-License-Identifier: MIT
+ * Analytic SDFs against closed-form distances and central finite differences of their
+ * gradients; CSG, transforms and uniform scale; the spike grid against a brute-force minimum
+ * over all cones; bad parameters. */
+#include <math.h>
+#include "test_util.h"
+
+static double eval(sdfccd_SdfId s, double x, double y, double z, sdfccd_Vec3* g)
+{
+    double v = NAN;
+    ck_assert_int_eq(sdfccd_sdf_eval(s, (sdfccd_Vec3){ x, y, z }, &v, g), SDFCCD_OK);
+    return v;
+}
+
+/* Gradient against central differences (h = 1e-6) at random points away from kinks, and unit length. */
+static void check_gradient(sdfccd_SdfId s, test_rng* rng, double extent)
+{
+    int checked = 0;
+    for (int i = 0; i < 400; ++i) {
+        double x = test_rng_uniform(rng, -extent, extent), y = test_rng_uniform(rng, -extent, extent), z = test_rng_uniform(rng, -extent, extent);
+        sdfccd_Vec3 g;
+        eval(s, x, y, z, &g);
+        const double h = 1e-6;
+        double fd[3] = { (eval(s, x + h, y, z, NULL) - eval(s, x - h, y, z, NULL)) / (2 * h),
+                         (eval(s, x, y + h, z, NULL) - eval(s, x, y - h, z, NULL)) / (2 * h),
+                         (eval(s, x, y, z + h, NULL) - eval(s, x, y, z - h, NULL)) / (2 * h) };
+        /* Skip points within h of a gradient discontinuity (medial axis, edges): the one-sided
+         * differences disagree there. */
+        double fdl = sqrt(fd[0] * fd[0] + fd[1] * fd[1] + fd[2] * fd[2]);
+        if (fabs(fdl - 1.0) > 1e-4) continue;
+        ck_assert_double_near(g.x, fd[0], 1e-5);
+        ck_assert_double_near(g.y, fd[1], 1e-5);
+        ck_assert_double_near(g.z, fd[2], 1e-5);
+        ck_assert_double_near(sqrt(g.x * g.x + g.y * g.y + g.z * g.z), 1.0, 1e-12);
+        ++checked;
+    }
+    ck_assert_int_ge(checked, 300);
+}
+
+START_TEST(test_sphere)
+{
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_sphere(0.5, &s), SDFCCD_OK);
+    ck_assert_double_near(eval(s, 0, 0, 0, NULL), -0.5, 1e-15);
+    ck_assert_double_near(eval(s, 1, 2, 2, NULL), 2.5, 1e-15);
+    sdfccd_Vec3 g;
+    eval(s, 0, 3, 4, &g);
+    ck_assert_double_near(g.y, 0.6, 1e-15);
+    ck_assert_double_near(g.z, 0.8, 1e-15);
+    test_rng rng = { 1 };
+    check_gradient(s, &rng, 1.0);
+    sdfccd_SdfInfo info;
+    ck_assert_int_eq(sdfccd_sdf_get_info(s, &info), SDFCCD_OK);
+    ck_assert_int_eq(info.kind, SDFCCD_SDF_SPHERE);
+    ck_assert_double_eq(info.bounds.hi.x, 0.5);
+    ck_assert_double_eq(info.lipschitz, 1.0);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
+START_TEST(test_box)
+{
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 1, 2, 3 }, &s), SDFCCD_OK);
+    ck_assert_double_near(eval(s, 0, 0, 0, NULL), -1.0, 1e-15);       /* nearest face x = +-1 */
+    ck_assert_double_near(eval(s, 0, 0, 2.5, NULL), -0.5, 1e-15);
+    ck_assert_double_near(eval(s, 4, 0, 0, NULL), 3.0, 1e-15);        /* face region */
+    ck_assert_double_near(eval(s, 4, 6, 0, NULL), 5.0, 1e-15);        /* edge region: (3, 4) */
+    ck_assert_double_near(eval(s, 2, 3, 4, NULL), sqrt(3.0), 1e-15);  /* corner region */
+    sdfccd_Vec3 g;
+    eval(s, 4, 6, 0, &g);
+    ck_assert_double_near(g.x, 0.6, 1e-15);
+    ck_assert_double_near(g.y, 0.8, 1e-15);
+    eval(s, 0.1, 0.1, -2.9, &g);
+    ck_assert_double_eq(g.z, -1.0);
+    test_rng rng = { 2 };
+    check_gradient(s, &rng, 4.0);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
+START_TEST(test_rounded_box)
+{
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_rounded_box((sdfccd_Vec3){ 1, 1, 1 }, 0.25, &s), SDFCCD_OK);
+    ck_assert_double_near(eval(s, 2, 0, 0, NULL), 1.0, 1e-15);                 /* face unchanged */
+    ck_assert_double_near(eval(s, 2, 2, 2, NULL), sqrt(3.0) * 1.25 - 0.25, 1e-14); /* corner sphere at 0.75 */
+    ck_assert_double_near(eval(s, 0, 0, 0, NULL), -1.0, 1e-15);
+    test_rng rng = { 3 };
+    check_gradient(s, &rng, 2.0);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
+START_TEST(test_torus)
+{
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_torus(1.0, 0.25, &s), SDFCCD_OK);
+    ck_assert_double_near(eval(s, 1, 0, 0, NULL), -0.25, 1e-15);
+    ck_assert_double_near(eval(s, 0, 0, 0, NULL), 0.75, 1e-15);
+    ck_assert_double_near(eval(s, 0, 2, 0, NULL), 0.75, 1e-15);
+    ck_assert_double_near(eval(s, 0, 1, 1, NULL), 0.75, 1e-15);
+    ck_assert_double_near(eval(s, 3, 4, 0, NULL), 3.75, 1e-14); /* rho = 5 */
+    test_rng rng = { 4 };
+    check_gradient(s, &rng, 1.5);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
+START_TEST(test_capsule_cylinder_halfspace)
+{
+    sdfccd_SdfId c, y, h;
+    ck_assert_int_eq(sdfccd_create_capsule(1.0, 0.5, &c), SDFCCD_OK);
+    ck_assert_double_near(eval(c, 2, 0, 0.5, NULL), 1.5, 1e-15);
+    ck_assert_double_near(eval(c, 0, 0, 3, NULL), 1.5, 1e-15);
+    ck_assert_double_near(eval(c, 0, 0, 0, NULL), -0.5, 1e-15);
+    ck_assert_int_eq(sdfccd_create_cylinder(1.0, 0.5, &y), SDFCCD_OK);
+    ck_assert_double_near(eval(y, 2, 0, 0.5, NULL), 1.5, 1e-15);
+    ck_assert_double_near(eval(y, 0, 0, 3, NULL), 2.0, 1e-15);
+    ck_assert_double_near(eval(y, 3.5, 0, 5, NULL), 5.0, 1e-15); /* rim: (3, 4) */
+    ck_assert_double_near(eval(y, 0, 0, 0.8, NULL), -0.2, 1e-15);
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 2 }, 1.0, &h), SDFCCD_OK);
+    ck_assert_double_near(eval(h, 5, 5, 1.5, NULL), 1.0, 1e-15); /* normal normalised: z <= 0.5 */
+    test_rng rng = { 5 };
+    check_gradient(c, &rng, 2.0);
+    check_gradient(y, &rng, 2.0);
+    check_gradient(h, &rng, 2.0);
+    sdfccd_destroy_sdf(c);
+    sdfccd_destroy_sdf(y);
+    sdfccd_destroy_sdf(h);
+}
+END_TEST
+
+/* The spike grid against a brute-force minimum over the ground and every cone (each cone's
+ * distance from its meridian triangle, computed independently here by dense sampling). */
+static double seg_dist(double px, double pz, double ax, double az, double bx, double bz)
+{
+    double dx = bx - ax, dz = bz - az, t = ((px - ax) * dx + (pz - az) * dz) / (dx * dx + dz * dz);
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    return hypot(px - ax - t * dx, pz - az - t * dz);
+}
+START_TEST(test_spike_grid)
+{
+    sdfccd_SpikeGridDef d = sdfccd_default_spike_grid_def();
+    d.count_x = 4;
+    d.count_y = 3;
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_spike_grid(&d, &s), SDFCCD_OK);
+    test_rng rng = { 6 };
+    for (int i = 0; i < 2000; ++i) {
+        double x = test_rng_uniform(&rng, -0.4, 0.4), y = test_rng_uniform(&rng, -0.3, 0.3), z = test_rng_uniform(&rng, 0.001, 0.3);
+        double best = z;
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 3; ++b) {
+                double cx = (a - 1.5) * d.spacing, cy = (b - 1.0) * d.spacing, rho = hypot(x - cx, y - cy);
+                double dist = fmin(seg_dist(rho, z, d.base_radius, 0, 0, d.height), seg_dist(rho, z, 0, 0, d.base_radius, 0));
+                int inside = rho / d.base_radius + z / d.height <= 1.0;
+                best = fmin(best, inside ? -dist : dist);
+            }
+        ck_assert_double_near(eval(s, x, y, z, NULL), best, 1e-12);
+    }
+    check_gradient(s, &rng, 0.3);
+    ck_assert_int_eq(sdfccd_create_spike_grid(NULL, &s), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_SpikeGridDef bad = d;
+    bad.base_radius = d.spacing;
+    ck_assert_int_eq(sdfccd_create_spike_grid(&bad, &s), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
+/* CSG: the paper's hoop (Fig. 8): a thick ring = cylinder minus a smaller cylinder; plus union
+ * and intersection identities, and a transformed, scaled copy. */
+START_TEST(test_csg_and_transform)
+{
+    sdfccd_SdfId outer, inner, hoop, a, b, u, in, moved;
+    ck_assert_int_eq(sdfccd_create_cylinder(0.1, 1.5, &outer), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_cylinder(0.2, 1.0, &inner), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_DIFFERENCE, outer, inner, &hoop), SDFCCD_OK);
+    /* max(a, -b) is a lower bound on the distance, exact where one operand is active alone:
+     * at the hole's centre the true distance is 1 (the inner wall); the field says 0.2 (the
+     * inner cylinder's caps), a valid lower bound. */
+    ck_assert_double_near(eval(hoop, 0, 0, 0, NULL), 0.2, 1e-15);
+    ck_assert_double_near(eval(hoop, 0.9, 0, 0, NULL), 0.1, 1e-15);   /* 0.1 m from the inner wall */
+    ck_assert_double_near(eval(hoop, 1.25, 0, 0, NULL), -0.1, 1e-15); /* inside the ring material */
+    ck_assert_double_near(eval(hoop, 3.0, 0, 0, NULL), 1.5, 1e-15);
+    ck_assert_int_eq(sdfccd_create_sphere(1.0, &a), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.5, 0.5, 0.5 }, &b), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_UNION, a, b, &u), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_INTERSECTION, a, b, &in), SDFCCD_OK);
+    test_rng rng = { 7 };
+    for (int i = 0; i < 500; ++i) {
+        double x = test_rng_uniform(&rng, -2, 2), y = test_rng_uniform(&rng, -2, 2), z = test_rng_uniform(&rng, -2, 2);
+        double va = eval(a, x, y, z, NULL), vb = eval(b, x, y, z, NULL);
+        ck_assert_double_eq(eval(u, x, y, z, NULL), fmin(va, vb));
+        ck_assert_double_eq(eval(in, x, y, z, NULL), fmax(va, vb));
+    }
+    /* Destroying the children keeps the combination alive. */
+    sdfccd_destroy_sdf(a);
+    sdfccd_destroy_sdf(b);
+    ck_assert_double_near(eval(u, 3, 0, 0, NULL), 2.0, 1e-15);
+    /* A torus turned 90 degrees about x, moved to (1, 2, 3) and scaled by 2. */
+    sdfccd_SdfId t;
+    ck_assert_int_eq(sdfccd_create_torus(1.0, 0.25, &t), SDFCCD_OK);
+    sdfccd_Pose pose = { { 1, 2, 3 }, { cos(M_PI / 4), sin(M_PI / 4), 0, 0 } };
+    ck_assert_int_eq(sdfccd_create_transformed(t, pose, 2.0, &moved), SDFCCD_OK);
+    for (int i = 0; i < 500; ++i) {
+        double x = test_rng_uniform(&rng, -3, 3), y = test_rng_uniform(&rng, -3, 3), z = test_rng_uniform(&rng, -3, 3);
+        /* Inverse: subtract the position, rotate by -90 deg about x: (x, y, z) -> (x, z, -y), divide by 2. */
+        double lx = (x - 1) / 2, ly = (z - 3) / 2, lz = -(y - 2) / 2;
+        ck_assert_double_near(eval(moved, x, y, z, NULL), 2.0 * eval(t, lx, ly, lz, NULL), 1e-12);
+    }
+    check_gradient(moved, &rng, 3.0);
+    sdfccd_SdfInfo info;
+    ck_assert_int_eq(sdfccd_sdf_get_info(moved, &info), SDFCCD_OK);
+    ck_assert_double_near(info.bounds.lo.z, 3.0 - 2.5, 1e-12); /* ring now in the xz plane, radius 2.5 */
+    ck_assert_double_near(info.bounds.lo.y, 2.0 - 0.5, 1e-12);
+    sdfccd_SdfId ids[] = { outer, inner, hoop, u, in, t, moved };
+    for (unsigned i = 0; i < sizeof ids / sizeof ids[0]; ++i) ck_assert_int_eq(sdfccd_destroy_sdf(ids[i]), SDFCCD_OK);
+}
+END_TEST
+
+/* A user callback SDF behaves as the built-in it mimics, and a NaN gradient is replaced. */
+static double user_sphere(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
+{
+    double r = *(const double*)user, l = sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+    if (g) *g = (sdfccd_Vec3){ p.x / l, p.y / l, p.z / l }; /* NaN at the centre */
+    return l - r;
+}
+START_TEST(test_callback)
+{
+    double r = 0.3;
+    sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
+    def.eval = user_sphere;
+    def.user = &r;
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_callback_sdf(&def, &s), SDFCCD_OK);
+    ck_assert_double_near(eval(s, 1, 0, 0, NULL), 0.7, 1e-15);
+    sdfccd_Vec3 g;
+    eval(s, 0, 0, 0, &g);
+    ck_assert(isfinite(g.x) && isfinite(g.y) && isfinite(g.z));
+    sdfccd_CallbackSdfDef bad = def;
+    bad.eval = NULL;
+    ck_assert_int_eq(sdfccd_create_callback_sdf(&bad, &s), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
+START_TEST(test_bad_parameters)
+{
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_sphere(0.0, &s), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_sphere(NAN, &s), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_sphere(INFINITY, &s), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_sphere(1.0, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 1, -1, 1 }, &s), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_rounded_box((sdfccd_Vec3){ 1, 1, 1 }, 2.0, &s), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_torus(0.5, 1.0, &s), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 0 }, 0.0, &s), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_csg((sdfccd_CsgOp)7, s, s, &s), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_SdfId unknown = { 12345, 1 };
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_UNION, unknown, unknown, &s), SDFCCD_INVALID_HANDLE);
+    ck_assert_int_eq(sdfccd_create_transformed(unknown, sdfccd_pose_identity(), 1.0, &s), SDFCCD_INVALID_HANDLE);
+    ck_assert_str_ne(sdfccd_last_error(), "");
+    sdfccd_Pose zero = { { 0, 0, 0 }, { 0, 0, 0, 0 } };
+    sdfccd_SdfId ball;
+    ck_assert_int_eq(sdfccd_create_sphere(1.0, &ball), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_transformed(ball, zero, 1.0, &s), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_transformed(ball, sdfccd_pose_identity(), -1.0, &s), SDFCCD_INVALID_ARGUMENT);
+    double v;
+    ck_assert_int_eq(sdfccd_sdf_eval(ball, (sdfccd_Vec3){ NAN, 0, 0 }, &v, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_destroy_sdf(ball), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(ball), SDFCCD_INVALID_HANDLE); /* stale after destroy */
+    ck_assert_int_eq(sdfccd_sdf_eval(ball, (sdfccd_Vec3){ 0, 0, 0 }, &v, NULL), SDFCCD_INVALID_HANDLE);
+}
+END_TEST
+
+int main(void)
+{
+    Suite* s = suite_create("sdf");
+    TCase* tc = tcase_create("analytic");
+    test_add_memory_fixture(tc);
+    tcase_add_test(tc, test_sphere);
+    tcase_add_test(tc, test_box);
+    tcase_add_test(tc, test_rounded_box);
+    tcase_add_test(tc, test_torus);
+    tcase_add_test(tc, test_capsule_cylinder_halfspace);
+    tcase_add_test(tc, test_spike_grid);
+    tcase_add_test(tc, test_csg_and_transform);
+    tcase_add_test(tc, test_callback);
+    tcase_add_test(tc, test_bad_parameters);
+    suite_add_tcase(s, tc);
+    return test_run_suite(s);
+}

@@ -1,0 +1,132 @@
+/* SPDX-License-Identifier: MIT
+ * Golden-section search (Algorithm 1) on functions with known minima, and DCD (Section 3.2)
+ * against known deepest points. Uses the core's internal headers. */
+#include <math.h>
+#include "test_util.h"
+#include "ccd.h"
+#include "gss.h"
+#include "sdf_analytic.h"
+
+/* No constant offset: with one, f differences below the offset's ulp hide the minimum (sqrt(eps) limit). */
+static double quad(double x, void* c) { double m = *(double*)c; return (x - m) * (x - m); }
+static double vee(double x, void* c) { (void)c; return fabs(x - 0.7); }
+static double rising(double x, void* c) { (void)c; return x; }
+static double cosine(double x, void* c) { (void)c; return cos(x); }
+
+START_TEST(test_gss_known_minima)
+{
+    double m = 0.3;
+    scc_gss_result r = scc_gss_minimize(0.0, 1.0, 1e-9, 200, quad, &m);
+    ck_assert_double_near(r.l, 0.3, 1e-8);
+    ck_assert_double_near(r.f, 0.0, 1e-15);
+    ck_assert(r.converged);
+    /* One new evaluation per iteration: about log(1e9) / log(phi) = 43 of them, plus 5. */
+    ck_assert_int_le(r.evals, 50);
+    r = scc_gss_minimize(0.0, 1.0, 1e-9, 200, vee, NULL);
+    ck_assert_double_near(r.l, 0.7, 1e-8);
+    r = scc_gss_minimize(2.0, 5.0, 1e-10, 200, cosine, NULL);
+    /* cos(pi + d) = -1 + d^2 / 2: values cannot separate d below sqrt(eps) ~ 1.5e-8. */
+    ck_assert_double_near(r.l, M_PI, 5e-8);
+    /* Monotone: the minimum is at the interval start (Algorithm 1 returns l0). */
+    r = scc_gss_minimize(-1.0, 1.0, 1e-9, 200, rising, NULL);
+    ck_assert_double_near(r.l, -1.0, 1e-8);
+    /* Reversed interval and zero width. */
+    m = 0.25;
+    r = scc_gss_minimize(1.0, 0.0, 1e-9, 200, quad, &m);
+    ck_assert_double_near(r.l, 0.25, 1e-8);
+    r = scc_gss_minimize(0.4, 0.4, 1e-9, 200, quad, &m);
+    ck_assert_double_eq(r.l, 0.4);
+    ck_assert_int_eq(r.evals, 1);
+    /* Absolute tolerance near zero (a relative one never stops there): minimum at 1e-12. */
+    m = 1e-12;
+    r = scc_gss_minimize(0.0, 1e-6, 1e-15, 200, quad, &m);
+    ck_assert_double_near(r.l, 1e-12, 2e-15);
+    /* The cap is reported. */
+    m = 0.3;
+    r = scc_gss_minimize(0.0, 1.0, 1e-12, 5, quad, &m);
+    ck_assert(!r.converged);
+    ck_assert_int_eq(r.evals, 4 + 5 + 1);
+}
+END_TEST
+
+static scc_params default_params(void)
+{
+    scc_params p = { 0 };
+    p.method = SCC_METHOD_DCD;
+    p.time_tol = 1e-7;
+    p.dist_tol = 1e-9;
+    p.max_iter = 64;
+    p.max_ls_iter = 100;
+    return p;
+}
+
+START_TEST(test_dcd_deepest_vertex)
+{
+    scc_sdf_half_space plane;
+    scc_sdf_half_space_init(&plane, scc_v3(0, 0, 1), 0.0);
+    scc_vec3 tri[3] = { { 0, 0, 0.1 }, { 1, 0, -0.2 }, { 0, 1, 0.05 } };
+    scc_params p = default_params();
+    scc_dcd_result r = scc_dcd(&plane.base, tri, &p);
+    ck_assert_double_near(r.phi, -0.2, 1e-12);
+    ck_assert_double_near(r.bary[1], 1.0, 1e-12);
+    ck_assert_double_near(r.normal.z, 1.0, 1e-15);
+}
+END_TEST
+
+/* A flat triangle over a sphere: the deepest point is the projection of the centre. */
+START_TEST(test_dcd_face_interior)
+{
+    scc_sdf_sphere s;
+    scc_sdf_sphere_init(&s, 1.0);
+    scc_vec3 tri[3] = { { -1, -1, 0.9 }, { 1.5, -0.5, 0.9 }, { -0.5, 1.5, 0.9 } };
+    scc_params p = default_params();
+    scc_dcd_result r = scc_dcd(&s.base, tri, &p);
+    ck_assert_double_near(r.phi, -0.1, 1e-9);
+    ck_assert_double_near(r.point.x, 0.0, 1e-5);
+    ck_assert_double_near(r.point.y, 0.0, 1e-5);
+    ck_assert(r.converged);
+}
+END_TEST
+
+/* A long edge dips into a sphere: the deepest point is the edge point nearest the centre. */
+START_TEST(test_dcd_edge_interior)
+{
+    scc_sdf_sphere s;
+    scc_sdf_sphere_init(&s, 1.0);
+    scc_vec3 tri[3] = { { -2, 0, 0.8 }, { 2, 0, 0.8 }, { 0, 0.5, 2.5 } };
+    scc_params p = default_params();
+    scc_dcd_result r = scc_dcd(&s.base, tri, &p);
+    ck_assert_double_near(r.phi, -0.2, 1e-9);
+    ck_assert_double_near(r.point.x, 0.0, 1e-5);
+    ck_assert_double_near(r.point.z, 0.8, 1e-5);
+    ck_assert_double_near(r.bary[2], 0.0, 1e-6);
+}
+END_TEST
+
+/* A triangle over a box edge: the deepest point is on the triangle edge above the box edge. */
+START_TEST(test_dcd_box_separated)
+{
+    scc_sdf_box b;
+    scc_sdf_box_init(&b, scc_v3(1, 1, 1), 0.0);
+    scc_vec3 tri[3] = { { 3, 0, 0 }, { 4, 1, 0 }, { 4, -1, 0 } };
+    scc_params p = default_params();
+    scc_dcd_result r = scc_dcd(&b.base, tri, &p);
+    ck_assert_double_near(r.phi, 2.0, 1e-12); /* separated: the nearest point is vertex 0 */
+    ck_assert_double_near(r.bary[0], 1.0, 1e-12);
+}
+END_TEST
+
+int main(void)
+{
+    Suite* s = suite_create("solvers");
+    TCase* g = tcase_create("gss");
+    tcase_add_test(g, test_gss_known_minima);
+    suite_add_tcase(s, g);
+    TCase* d = tcase_create("dcd");
+    tcase_add_test(d, test_dcd_deepest_vertex);
+    tcase_add_test(d, test_dcd_face_interior);
+    tcase_add_test(d, test_dcd_edge_interior);
+    tcase_add_test(d, test_dcd_box_separated);
+    suite_add_tcase(s, d);
+    return test_run_suite(s);
+}
