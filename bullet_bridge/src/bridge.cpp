@@ -771,6 +771,8 @@ const char* statusString(Status s)
     return "?";
 }
 
+std::size_t collisionAlgorithmSize() { return sizeof(MeshSdfAlgorithm); }
+
 Bridge::Bridge(const Config& config) : m_impl(new BridgeImpl(config))
 {
     m_impl->fn[0].reset(new BridgeImpl::CreateFunc(m_impl, false, false));

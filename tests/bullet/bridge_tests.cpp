@@ -17,6 +17,7 @@
 #include <BulletCollision/CollisionShapes/btSdfCollisionShape.h>
 #include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
 #include <BulletCollision/Gimpact/btGImpactShape.h>
+#include <LinearMath/btPoolAllocator.h>
 
 #include "sdfccd_bullet/sdfccd_bullet.h"
 
@@ -508,6 +509,14 @@ static void test_registration()
         CHECK(bridge.verify() == Status::NotRegistered, "a refused registration must change nothing");
     }
     {
+        // The algorithm object fits Bullet's collision-algorithm pool element.
+        btDefaultCollisionConfiguration config;
+        int element = config.getCollisionAlgorithmPool()->getElementSize();
+        CHECK(sdfccd_bullet::collisionAlgorithmSize() <= (size_t)element, "algorithm %zu B, pool element %d B",
+              sdfccd_bullet::collisionAlgorithmSize(), element);
+        std::printf("collision algorithm %zu B, Bullet pool element %d B\n", sdfccd_bullet::collisionAlgorithmSize(), element);
+    }
+    {
         // A non-concave type id is refused.
         sdfccd_bullet::Config cfg;
         cfg.sdf_shape_type = BOX_SHAPE_PROXYTYPE;
@@ -547,6 +556,11 @@ static void test_closest_points_and_toi()
         CHECK(pair.n >= 3 && pair.n <= 4, "contactPairTest found %d points", pair.n);
         CHECK(pair.dmin >= -1.5e-3 && pair.dmax <= -0.5e-3, "contactPairTest distances [%.5f, %.5f], expected -0.001", pair.dmin,
               pair.dmax);
+        CountContacts swapped; // the SDF as the first object of the query
+        swapped.m_closestDistanceThreshold = 0.005;
+        w.world.contactPairTest(ground, body, swapped);
+        CHECK(swapped.n == pair.n && swapped.dmin >= -1.5e-3 && swapped.dmax <= -0.5e-3,
+              "contactPairTest(sdf, mesh): %d points in [%.5f, %.5f]", swapped.n, swapped.dmin, swapped.dmax);
         CountContacts all;
         all.m_closestDistanceThreshold = 0.005;
         w.world.contactTest(body, all);

@@ -31,6 +31,7 @@
 #ifndef SDFCCD_BULLET_BRIDGE_H
 #define SDFCCD_BULLET_BRIDGE_H
 
+#include <cstddef>
 #include <cstdint>
 
 #include "sdfccd/sdfccd.h"
@@ -60,6 +61,11 @@ enum class Status {
 
 /** Constant name of a status, e.g. "TooLate". */
 const char* statusString(Status s);
+
+/** Size in bytes of the bridge's collision-algorithm object. It is taken from Bullet's
+ * collision-algorithm pool when it fits the pool's element size (192 B in Debian's float and
+ * float64 builds; a static_assert keeps it within that), and from btAlignedAlloc otherwise. */
+std::size_t collisionAlgorithmSize();
 
 struct Config {
     /** Shape type id of SdfShape bodies (default 23, FAST_CONCAVE_MESH_PROXYTYPE). */
@@ -104,7 +110,11 @@ class BridgeImpl;
  *
  * Lifetime: the dispatcher keeps pointers into the bridge, so the bridge must outlive every use
  * of the dispatcher (create it before the world and destroy it after), or call unregister()
- * while the dispatcher still exists. The destructor never touches the dispatcher. */
+ * while the dispatcher still exists. The destructor never touches the dispatcher.
+ *
+ * Threads: the bridge's caches and counters are not locked. Bullet's narrow phase runs on one
+ * thread in the Debian builds (no BT_THREADSAFE); with a multithreaded dispatcher, use one
+ * bridge per world and do not step worlds that share a bridge concurrently. */
 class Bridge
 {
 public:
