@@ -473,6 +473,26 @@ static void test_shape_aabb()
         CHECK(v <= 1.0 + 1e-9 && v > 0, "stretched sphere phi(0,0,4) = %g, expected in (0, 1]", v);
     }
     sdfccd_destroy_sdf(ball);
+
+    // An unbounded SDF (a half-space) has an infinite box and no triangulation until bounds are set.
+    sdfccd_SdfId ground = { 0, 0 };
+    sdfccd_Vec3 up = { 0, 0, 1 };
+    CHECK(sdfccd_create_half_space(up, 0.0, &ground) == SDFCCD_OK, "half-space");
+    {
+        SdfShape s(ground);
+        CHECK(!s.hasFiniteBounds(), "half-space bounds should be infinite");
+        CHECK(s.buildTriangulation() == 0, "no triangulation without bounds");
+        SdfShape t(ground);
+        t.setLocalBounds(btVector3(-2, -2, -1), btVector3(2, 2, 0));
+        btTransform id;
+        id.setIdentity();
+        btVector3 lo, hi;
+        t.getAabb(id, lo, hi);
+        CHECK(t.hasFiniteBounds() && (hi - btVector3(2, 2, 0)).length() < 1e-6, "bounded half-space AABB max (%g %g %g)", hi.x(), hi.y(),
+              hi.z());
+        CHECK(t.buildTriangulation() > 0, "bounded half-space triangulation");
+    }
+    sdfccd_destroy_sdf(ground);
 }
 
 // ---- registration: order, twice, too late; closest points; calculateTimeOfImpact ----
