@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages sdfccd needs, only those that are missing (needs root).
+set -euo pipefail
+PKGS="build-essential cmake pkg-config check libassimp-dev libbullet-dev gnuplot-nox libmeshoptimizer-dev libfcl-dev"
+need=""
+for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || need="$need $p"; done
+if [ -n "$need" ]; then
+  echo "installing:$need"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq $need >/dev/null
+fi
