@@ -341,7 +341,14 @@ START_TEST(test_mesh_query_earliest)
     ck_assert_double_near(r.toi, 0.1 / 20.0, 1e-6);
     ck_assert_int_eq(c[0].triangle, 1);
     for (int i = 0; i < r.contact_count; ++i) ck_assert_int_eq(c[i].triangle, 1);
+    /* With the broad phase the earliest candidate goes first and its hit culls the other
+     * triangle; the plain loop tests both. Same answer either way. */
+    ck_assert_int_eq(r.triangles_tested, 1);
+    p.broad_phase = 0;
+    ck_assert_int_eq(sdfccd_query_mesh(plane, NULL, mesh, &m, 0.0, DT, &p, c, 8, &r), SDFCCD_OK);
     ck_assert_int_eq(r.triangles_tested, 2);
+    ck_assert_double_near(r.toi, 0.1 / 20.0, 1e-6);
+    ck_assert_int_eq(c[0].triangle, 1);
     sdfccd_destroy_mesh(mesh);
     sdfccd_destroy_sdf(plane);
 }
