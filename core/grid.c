@@ -279,15 +279,19 @@ static int interpolate_cell(const scc_grid* g, const scc_grid_field* fd, uint32_
     const double c0[3] = { 2.0 / den[0], 2.0 / den[1], 2.0 / den[2] };
     const double c1[3] = { (b.hi.x + b.lo.x) / den[0], (b.hi.y + b.lo.y) / den[1], (b.hi.z + b.lo.z) / den[2] };
     const scc_vec3 xi = scc_v3(c0[0] * p.x - c1[0], c0[1] * p.y - c1[1], c0[2] * p.z - c1[2]);
+    /* Gather the 32 values first: independent loads let the memory accesses overlap. */
+    const uint32_t* ids = fd->cells + (size_t)c * 32;
+    double v[32];
+    int missing = 0;
+    for (int a = 0; a < 32; ++a) v[a] = fd->nodes[ids[a]];
+    for (int a = 0; a < 32; ++a) missing |= v[a] == SCC_GRID_NO_VALUE;
+    if (missing) return 0;
     double N[32], dN[32][3];
     scc_cell_shape(xi, N, out_grad ? dN : NULL);
-    const uint32_t* ids = fd->cells + (size_t)c * 32;
     double phi = 0.0, gx = 0.0, gy = 0.0, gz = 0.0;
     for (int a = 0; a < 32; ++a) {
-        const double v = fd->nodes[ids[a]];
-        if (v == SCC_GRID_NO_VALUE) return 0;
-        phi += v * N[a];
-        if (out_grad) { gx += v * dN[a][0]; gy += v * dN[a][1]; gz += v * dN[a][2]; }
+        phi += v[a] * N[a];
+        if (out_grad) { gx += v[a] * dN[a][0]; gy += v[a] * dN[a][1]; gz += v[a] * dN[a][2]; }
     }
     *out_value = phi;
     if (out_grad) *out_grad = scc_v3(gx * c0[0], gy * c0[1], gz * c0[2]);

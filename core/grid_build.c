@@ -23,7 +23,8 @@ static void node_task(void* vctx, uint32_t task)
     const uint64_t begin = (uint64_t)task * c->chunk;
     uint64_t end = begin + c->chunk;
     if (end > c->count) end = c->count;
-    for (uint64_t l = begin; l < end; ++l) c->nodes[l] = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l));
+    uint32_t state = UINT32_MAX;
+    for (uint64_t l = begin; l < end; ++l) c->nodes[l] = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l), &state);
 }
 
 scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_build_def* def, scc_grid** out_grid)

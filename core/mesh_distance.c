@@ -163,13 +163,20 @@ size_t scc_mesh_sdf_memory(const scc_mesh_sdf* m)
 
 void scc_mesh_sdf_query(const scc_mesh_sdf* m, scc_vec3 p, scc_mesh_distance_result* out)
 {
+    uint32_t hint = UINT32_MAX;
+    scc_mesh_sdf_query_hint(m, p, &hint, out);
+}
+
+void scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, scc_mesh_distance_result* out)
+{
     scc_tri_nearest nr;
-    if (!scc_tri_bvh_nearest(&m->bvh, p, &nr)) {
+    if (!scc_tri_bvh_nearest_hint(&m->bvh, p, *hint, &nr)) {
         memset(out, 0, sizeof *out);
         out->distance = INFINITY;
         out->normal = scc_v3(0, 0, 1);
         return;
     }
+    *hint = nr.slot;
     const uint32_t t = nr.triangle;
     scc_vec3 n;
     switch (nr.feature) {

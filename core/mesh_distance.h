@@ -45,6 +45,9 @@ typedef struct scc_mesh_distance_result {
 
 /* Signed distance with the nearest point and feature. */
 void scc_mesh_sdf_query(const scc_mesh_sdf* m, scc_vec3 p, scc_mesh_distance_result* out);
+/* The same with a caller-kept hint (start with UINT32_MAX; updated to the answer's BVH slot):
+ * queries at nearby points in sequence run much faster. The result does not depend on it. */
+void scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, scc_mesh_distance_result* out);
 
 /* Only the topology report (no BVH). 0 on success, -1 on OOM. */
 int scc_mesh_topology_check(const scc_allocator* a, const scc_mesh* mesh, scc_mesh_topology* out);

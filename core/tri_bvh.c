@@ -144,8 +144,9 @@ int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* 
     bvh->nodes = scc_alloc(a, (size_t)bvh->node_capacity * sizeof *bvh->nodes);
     bvh->tris = scc_alloc(a, (size_t)n * 3 * sizeof(scc_vec3));
     bvh->tri_index = scc_alloc(a, (size_t)n * sizeof(uint32_t));
+    bvh->tri_boxes = scc_alloc(a, (size_t)n * sizeof(scc_aabb));
     build_item* items = scc_alloc(a, (size_t)n * sizeof *items);
-    if (!bvh->nodes || !bvh->tris || !bvh->tri_index || !items) {
+    if (!bvh->nodes || !bvh->tris || !bvh->tri_index || !bvh->tri_boxes || !items) {
         scc_free(a, items, (size_t)n * sizeof *items);
         scc_tri_bvh_destroy(bvh);
         return -1;
@@ -163,6 +164,7 @@ int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* 
     for (uint32_t i = 0; i < n; ++i) {
         bvh->tri_index[i] = items[i].tri;
         scc_mesh_triangle(mesh, items[i].tri, bvh->tris + 3 * (size_t)i);
+        bvh->tri_boxes[i] = tri_box(mesh, items[i].tri);
     }
     scc_free(a, items, (size_t)n * sizeof *items);
     return 0;
@@ -175,26 +177,34 @@ void scc_tri_bvh_destroy(scc_tri_bvh* bvh)
     scc_free(a, bvh->nodes, (size_t)bvh->node_capacity * sizeof *bvh->nodes);
     scc_free(a, bvh->tris, (size_t)bvh->tri_count * 3 * sizeof(scc_vec3));
     scc_free(a, bvh->tri_index, (size_t)bvh->tri_count * sizeof(uint32_t));
-    bvh->nodes = NULL; bvh->tris = NULL; bvh->tri_index = NULL;
+    scc_free(a, bvh->tri_boxes, (size_t)bvh->tri_count * sizeof(scc_aabb));
+    bvh->nodes = NULL; bvh->tris = NULL; bvh->tri_index = NULL; bvh->tri_boxes = NULL;
     bvh->tri_count = 0; bvh->node_count = 0; bvh->node_capacity = 0;
 }
 
 size_t scc_tri_bvh_memory(const scc_tri_bvh* bvh)
 {
-    return (size_t)bvh->node_capacity * sizeof *bvh->nodes + (size_t)bvh->tri_count * (3 * sizeof(scc_vec3) + sizeof(uint32_t));
+    return (size_t)bvh->node_capacity * sizeof *bvh->nodes + (size_t)bvh->tri_count * (3 * sizeof(scc_vec3) + sizeof(uint32_t) + sizeof(scc_aabb));
 }
 
 /* ---- query ---- */
 
+/* Squared distance from p to a box (0 inside). Plain comparisons: fmax is a libm call here. */
 static inline double box_dist2(const scc_aabb* b, scc_vec3 p)
 {
-    const double dx = fmax(fmax(b->lo.x - p.x, p.x - b->hi.x), 0.0);
-    const double dy = fmax(fmax(b->lo.y - p.y, p.y - b->hi.y), 0.0);
-    const double dz = fmax(fmax(b->lo.z - p.z, p.z - b->hi.z), 0.0);
-    return dx * dx + dy * dy + dz * dz;
+    double d = 0.0, t;
+    t = b->lo.x - p.x; if (t > 0.0) d += t * t; else { t = p.x - b->hi.x; if (t > 0.0) d += t * t; }
+    t = b->lo.y - p.y; if (t > 0.0) d += t * t; else { t = p.y - b->hi.y; if (t > 0.0) d += t * t; }
+    t = b->lo.z - p.z; if (t > 0.0) d += t * t; else { t = p.z - b->hi.z; if (t > 0.0) d += t * t; }
+    return d;
 }
 
 int scc_tri_bvh_nearest(const scc_tri_bvh* bvh, scc_vec3 p, scc_tri_nearest* out)
+{
+    return scc_tri_bvh_nearest_hint(bvh, p, UINT32_MAX, out);
+}
+
+int scc_tri_bvh_nearest_hint(const scc_tri_bvh* bvh, scc_vec3 p, uint32_t hint, scc_tri_nearest* out)
 {
     if (bvh->tri_count == 0) return 0;
     /* Depth-first, nearer child first, pruning boxes no nearer than the best so far. The
@@ -203,7 +213,13 @@ int scc_tri_bvh_nearest(const scc_tri_bvh* bvh, scc_vec3 p, scc_tri_nearest* out
     double stack_d[96];
     int sp = 0;
     double best = INFINITY;
-    scc_tri_nearest r = { INFINITY, p, 0, SCC_TRI_FACE };
+    scc_tri_nearest r = { INFINITY, p, 0, 0, SCC_TRI_FACE };
+    if (hint < bvh->tri_count) {
+        const scc_vec3* v = bvh->tris + 3 * (size_t)hint;
+        r.dist2 = best = scc_closest_point_triangle(p, v[0], v[1], v[2], &r.point, &r.feature);
+        r.triangle = bvh->tri_index[hint];
+        r.slot = hint;
+    }
     stack[sp] = 0; stack_d[sp] = box_dist2(&bvh->nodes[0].box, p); ++sp;
     while (sp > 0) {
         --sp;
@@ -211,13 +227,14 @@ int scc_tri_bvh_nearest(const scc_tri_bvh* bvh, scc_vec3 p, scc_tri_nearest* out
         const scc_tri_bvh_node* nd = &bvh->nodes[stack[sp]];
         if (nd->count) {
             for (uint32_t i = nd->first; i < nd->first + nd->count; ++i) {
+                if (box_dist2(&bvh->tri_boxes[i], p) >= best) continue;
                 const scc_vec3* v = bvh->tris + 3 * (size_t)i;
                 scc_vec3 q;
                 scc_tri_feature f;
                 const double d2 = scc_closest_point_triangle(p, v[0], v[1], v[2], &q, &f);
                 if (d2 < best) {
                     best = d2;
-                    r.dist2 = d2; r.point = q; r.triangle = bvh->tri_index[i]; r.feature = f;
+                    r.dist2 = d2; r.point = q; r.triangle = bvh->tri_index[i]; r.slot = i; r.feature = f;
                 }
             }
             continue;

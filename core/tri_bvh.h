@@ -31,6 +31,7 @@ typedef struct scc_tri_bvh {
     scc_tri_bvh_node* nodes;
     uint32_t node_count, node_capacity;
     scc_vec3* tris;      /* 3 vertices per slot, in leaf order */
+    scc_aabb* tri_boxes; /* box of each slot's triangle (a cheap lower bound before the exact test) */
     uint32_t* tri_index; /* mesh triangle of each slot */
     uint32_t tri_count;
     scc_allocator allocator;
@@ -46,10 +47,14 @@ typedef struct scc_tri_nearest {
     double dist2;             /* squared distance */
     scc_vec3 point;           /* closest point on the mesh */
     uint32_t triangle;        /* mesh triangle index */
+    uint32_t slot;            /* the triangle's slot in the hierarchy (a hint for the next query) */
     scc_tri_feature feature;  /* feature of that triangle */
 } scc_tri_nearest;
 
 /* Exact nearest triangle to p. Returns 1 and fills *out, or 0 when the mesh is empty. */
 int scc_tri_bvh_nearest(const scc_tri_bvh* bvh, scc_vec3 p, scc_tri_nearest* out);
+/* The same, starting from the distance to the triangle in slot `hint` (e.g. the answer for a
+ * nearby point; UINT32_MAX for none), which prunes most of the tree at once. Exact either way. */
+int scc_tri_bvh_nearest_hint(const scc_tri_bvh* bvh, scc_vec3 p, uint32_t hint, scc_tri_nearest* out);
 
 #endif

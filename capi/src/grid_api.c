@@ -196,11 +196,11 @@ typedef struct mesh_sample_ctx {
     double sign;
 } mesh_sample_ctx;
 
-static double mesh_sample(void* user, scc_vec3 p)
+static double mesh_sample(void* user, scc_vec3 p, uint32_t* state)
 {
     const mesh_sample_ctx* c = user;
     scc_mesh_distance_result r;
-    scc_mesh_sdf_query(c->ms, p, &r);
+    scc_mesh_sdf_query_hint(c->ms, p, state, &r);
     return c->sign * r.distance;
 }
 
@@ -248,8 +248,9 @@ sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_Grid
 
 typedef struct sdf_sample_ctx { const scc_sdf* sdf; double sign; } sdf_sample_ctx;
 
-static double sdf_sample(void* user, scc_vec3 p)
+static double sdf_sample(void* user, scc_vec3 p, uint32_t* state)
 {
+    (void)state;
     const sdf_sample_ctx* c = user;
     return c->sign * scc_sdf_eval(c->sdf, p, NULL);
 }

@@ -297,9 +297,10 @@ sdfccd_Status sdfccd_mesh_signed_distance(sdfccd_MeshId mesh, const sdfccd_Vec3*
         scc_mesh_sdf_destroy(&ms);
         return st;
     }
+    uint32_t hint = UINT32_MAX;
     for (int32_t i = 0; i < count; ++i) {
         scc_mesh_distance_result r;
-        scc_mesh_sdf_query(&ms, capi_v(points[i]), &r);
+        scc_mesh_sdf_query_hint(&ms, capi_v(points[i]), &hint, &r);
         out_distances[i] = r.distance;
         if (out_closest) out_closest[i] = capi_pv(r.closest);
     }
