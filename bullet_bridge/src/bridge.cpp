@@ -872,7 +872,8 @@ void Bridge::unregister()
     btCollisionDispatcher* d = m_impl->dispatcher;
     if (!d) return;
     btCollisionConfiguration* cc = d->getCollisionConfiguration();
-    const int types[2] = { m_impl->cfg.sdf_shape_type, SDF_SHAPE_PROXYTYPE };
+    std::vector<int> types(1, m_impl->cfg.sdf_shape_type); // the slots registerWith() wrote
+    if (m_impl->cfg.handle_bt_sdf_shape && m_impl->cfg.sdf_shape_type != SDF_SHAPE_PROXYTYPE) types.push_back(SDF_SHAPE_PROXYTYPE);
     for (int t : types) {
         d->registerCollisionCreateFunc(GIMPACT_SHAPE_PROXYTYPE, t, cc->getCollisionAlgorithmCreateFunc(GIMPACT_SHAPE_PROXYTYPE, t));
         d->registerCollisionCreateFunc(t, GIMPACT_SHAPE_PROXYTYPE, cc->getCollisionAlgorithmCreateFunc(t, GIMPACT_SHAPE_PROXYTYPE));
