@@ -14,7 +14,8 @@ if(SDFCCD_BUILD_BULLET_BRIDGE)
     target_compile_definitions(${_exe} PRIVATE SDFCCD_DATA_DIR="${SDFCCD_DATA_DIR}")
     sdfccd_target_defaults(${_exe})
     # One ctest per scene, so a failure names the scene.
-    foreach(_case cube_mesh_first cube_sdf_first cube_tunnels_without_bridge torus_spinning kinematic_sdf cdf_concave_box
+    foreach(_case cube_mesh_first cube_sdf_first cube_tunnels_without_bridge torus_spinning kinematic_sdf
+                  dynamic_sdf_on_mesh_floor cdf_concave_box
                   convex_box_on_triangulation shape_aabb registration closest_points_and_toi hard_clamp)
       add_test(NAME ${_exe}.${_case} COMMAND ${_exe} ${_case})
       set_tests_properties(${_exe}.${_case} PROPERTIES LABELS bullet)

@@ -333,6 +333,47 @@ static void test_kinematic_sdf()
     sdfccd_destroy_sdf(slab);
 }
 
+// ---- a dynamic SDF body: an SDF ball at 100 m/s onto a static GImpact floor of two triangles ----
+
+static void test_dynamic_sdf_on_mesh_floor()
+{
+    sdfccd_SdfId ball = { 0, 0 };
+    CHECK(sdfccd_create_sphere(0.5, &ball) == SDFCCD_OK, "sphere");
+    double z_after = NAN, z_final = NAN, v_final = NAN;
+    int impact = -1;
+    {
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        // The floor: a zero-thickness 10 m square (two counter-clockwise triangles facing +z).
+        std::unique_ptr<TriMesh> floor(new TriMesh);
+        const btScalar v[12] = { -5, -5, 0, 5, -5, 0, 5, 5, 0, -5, 5, 0 };
+        const int f[6] = { 0, 1, 2, 0, 2, 3 };
+        floor->v.assign(v, v + 12);
+        floor->f.assign(f, f + 6);
+        floor->finish();
+        SdfShape shape(ball);
+        w.add(floor->shape.get(), 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(&shape, 1, btVector3(0, 0, 4), btVector3(0.5, 0.5, 0.5));
+        body->setLinearVelocity(btVector3(0, 0, -100)); // 1.67 m per step
+        body->setActivationState(DISABLE_DEACTIVATION);
+        for (int i = 0; i < 90; ++i) {
+            w.step();
+            if (impact < 0 && bridge.stats().hits > 0) {
+                impact = i;
+                z_after = body->getCenterOfMassPosition().z();
+            }
+        }
+        z_final = body->getCenterOfMassPosition().z();
+        v_final = body->getLinearVelocity().length();
+    }
+    CHECK(impact == 2, "impact in step %d, expected 2", impact);
+    CHECK(std::fabs(z_after - 0.5) <= 1e-3, "z after the impact step %.5f, expected 0.5", z_after);
+    CHECK(std::fabs(z_final - 0.5) <= 1e-3 && v_final < 0.05, "final z %.5f speed %.4f, expected resting at 0.5", z_final, v_final);
+    std::printf("dynamic SDF ball on a GImpact floor: impact step %d, z after it %.5f, final z %.5f\n", impact, z_after, z_final);
+    sdfccd_destroy_sdf(ball);
+}
+
 // ---- a GImpact mesh dropped into the concave box .cdf through Bullet's btSdfCollisionShape ----
 
 static bool loadFile(const std::string& path, std::vector<char>& out)
@@ -675,6 +716,7 @@ static const Test kTests[] = {
     { "cube_tunnels_without_bridge", test_cube_tunnels_without_bridge },
     { "torus_spinning", test_torus_spinning },
     { "kinematic_sdf", test_kinematic_sdf },
+    { "dynamic_sdf_on_mesh_floor", test_dynamic_sdf_on_mesh_floor },
     { "cdf_concave_box", test_cdf_concave_box },
     { "convex_box_on_triangulation", test_convex_box_on_triangulation },
     { "shape_aabb", test_shape_aabb },
