@@ -326,6 +326,25 @@ START_TEST(test_ccd_on_grid)
         }
         if (methods[k] == SDFCCD_METHOD_FWGSS) ck_assert_double_near(rg.toi, toi, 1e-5);
     }
+    /* the mesh query: a small cube falling onto the sphere grid and the analytic sphere */
+    sdfccd_MeshId cube = load_mesh("bullet3/cube.obj");
+    sdfccd_RigidMotion cm = sdfccd_default_rigid_motion();
+    cm.pose.position = (sdfccd_Vec3){ 0.05, -0.03, 0.5 + 0.5 * 0.2 + 0.1 };
+    cm.linear_velocity = (sdfccd_Vec3){ 0.0, 0.0, -9.0 };
+    sdfccd_MeshLoadDef ld = sdfccd_default_mesh_load_def();
+    ld.scale = 0.2;
+    sdfccd_MeshId small;
+    ck_assert_int_eq(sdfccd_load_mesh(SDFCCD_DATA_DIR "/bullet3/cube.obj", &ld, &small), SDFCCD_OK);
+    sdfccd_QueryParams qp = sdfccd_default_query_params();
+    sdfccd_QueryResult ra, rg;
+    sdfccd_Contact ca[16], cg[16];
+    ck_assert_int_eq(sdfccd_query_mesh(sphere, NULL, small, &cm, 0.0, 1.0 / 30.0, &qp, ca, 16, &ra), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_query_mesh(grid, NULL, small, &cm, 0.0, 1.0 / 30.0, &qp, cg, 16, &rg), SDFCCD_OK);
+    ck_assert(ra.hit && rg.hit);
+    ck_assert_msg(fabs(ra.toi - rg.toi) < 1e-5, "mesh query toi %.9g vs %.9g", ra.toi, rg.toi);
+    ck_assert_double_near(cg[0].normal.z, ca[0].normal.z, 1e-3);
+    ck_assert_int_eq(sdfccd_destroy_mesh(small), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
     ck_assert_int_eq(sdfccd_destroy_sdf(sphere), SDFCCD_OK);
     ck_assert_int_eq(sdfccd_destroy_sdf(grid), SDFCCD_OK);
 }
