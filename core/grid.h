@@ -74,7 +74,7 @@ typedef struct scc_grid {
  * stops with SCC_GRID_BUILD_CANCELLED). */
 typedef void scc_task_fn(void* ctx, uint32_t task);
 typedef int scc_parallel_for_fn(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx);
-enum { SCC_GRID_STAGE_NODES = 0, SCC_GRID_STAGE_CELLS = 1 };
+enum { SCC_GRID_STAGE_NODES = 0, SCC_GRID_STAGE_CELLS = 1, SCC_GRID_STAGE_CORNERS = 2, SCC_GRID_STAGE_EDGES = 3 };
 
 /* Allocates an empty grid header with `field_count` zeroed field records and sets the geometry:
  * h = (hi - lo) / res and inv_h = 1 / h, as Discregrid computes them. Returns NULL on OOM.
@@ -146,6 +146,9 @@ typedef struct scc_grid_build_def {
                                   (cell diagonal); <= 0 or INFINITY: dense */
     scc_grid_sample_fn* sample;
     void* sample_user;
+    double sample_lipschitz;   /* > 0: a Lipschitz bound of the sampled function (1 for exact
+                                  distances); lets a narrow-band build skip the edge nodes of cells
+                                  that are certainly culled. 0: sample every node. */
     scc_parallel_for_fn* parallel_for; /* NULL: serial */
     void* parallel_user;
 } scc_grid_build_def;

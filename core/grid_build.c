@@ -13,6 +13,7 @@ typedef struct node_ctx {
     const scc_grid_build_def* def;
     const scc_grid* g;
     double* nodes;
+    const uint32_t* list; /* node ids to sample, or NULL for 0 .. count-1 */
     uint64_t count;
     uint64_t chunk;
 } node_ctx;
@@ -24,7 +25,18 @@ static void node_task(void* vctx, uint32_t task)
     uint64_t end = begin + c->chunk;
     if (end > c->count) end = c->count;
     uint32_t state = UINT32_MAX;
-    for (uint64_t l = begin; l < end; ++l) c->nodes[l] = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l), &state);
+    for (uint64_t i = begin; i < end; ++i) {
+        const uint64_t l = c->list ? c->list[i] : i;
+        c->nodes[l] = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l), &state);
+    }
+}
+
+static int sample_nodes(const scc_grid_build_def* def, node_ctx* nc, int stage)
+{
+    const uint32_t tasks = (uint32_t)((nc->count + nc->chunk - 1) / nc->chunk);
+    if (def->parallel_for) return def->parallel_for(def->parallel_user, stage, tasks, node_task, nc);
+    for (uint32_t t = 0; t < tasks; ++t) node_task(nc, t);
+    return 0;
 }
 
 scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_build_def* def, scc_grid** out_grid)
@@ -41,19 +53,65 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
     double* nodes = scc_alloc(a, (size_t)n_nodes * sizeof(double));
     if (!nodes) { scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
 
-    node_ctx nc = { def, g, nodes, n_nodes, 1024 };
-    const uint32_t tasks = (uint32_t)((n_nodes + nc.chunk - 1) / nc.chunk);
+    const int banded = def->band > 0.0 && isfinite(def->band);
+    const double keep_below = banded ? def->band + scc_len(g->h) : 0.0;
+    const double hmax = fmax(g->h.x, fmax(g->h.y, g->h.z));
     int cancelled;
-    if (def->parallel_for) cancelled = def->parallel_for(def->parallel_user, SCC_GRID_STAGE_NODES, tasks, node_task, &nc);
-    else {
-        cancelled = 0;
-        for (uint32_t t = 0; t < tasks; ++t) node_task(&nc, t);
+    if (banded && def->sample_lipschitz > 0.0 && isfinite(def->sample_lipschitz)) {
+        /* Narrow band with a known Lipschitz constant L: sample the cell corners first. An edge
+         * node lies within 2h/3 of a corner of every cell that uses it, so when all 8 corners of
+         * a cell have |v| >= keep_below + L * hmax, none of its 32 nodes can keep it and its edge
+         * nodes need no sample (unless a kept cell shares them). Unsampled nodes are never
+         * referenced by a kept cell. */
+        const uint64_t nv = (uint64_t)(def->res[0] + 1) * (def->res[1] + 1) * (def->res[2] + 1);
+        for (uint64_t l = nv; l < n_nodes; ++l) nodes[l] = NAN;
+        node_ctx nc = { def, g, nodes, NULL, nv, 1024 };
+        cancelled = sample_nodes(def, &nc, SCC_GRID_STAGE_CORNERS);
+        uint32_t* list = NULL;
+        uint64_t listed = 0;
+        if (!cancelled) {
+            uint8_t* need = scc_alloc(a, (size_t)(n_nodes - nv));
+            if (!need) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+            memset(need, 0, (size_t)(n_nodes - nv));
+            const double skip_at = keep_below + def->sample_lipschitz * hmax;
+            uint32_t ids[32];
+            for (uint32_t k = 0; k < def->res[2]; ++k)
+                for (uint32_t j = 0; j < def->res[1]; ++j)
+                    for (uint32_t i = 0; i < def->res[0]; ++i) {
+                        scc_grid_dense_cell_nodes(def->res, i, j, k, ids);
+                        double cmin = INFINITY;
+                        for (int s = 0; s < 8; ++s) cmin = fmin(cmin, fabs(nodes[ids[s]]));
+                        if (!(cmin < skip_at)) continue; /* NaN corner values fall through to sampling */
+                        for (int s = 8; s < 32; ++s) need[ids[s] - nv] = 1;
+                    }
+            for (uint64_t l = 0; l < n_nodes - nv; ++l) listed += need[l];
+            list = listed ? scc_alloc(a, (size_t)listed * sizeof(uint32_t)) : NULL;
+            if (listed && !list) {
+                scc_free(a, need, (size_t)(n_nodes - nv));
+                scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+                scc_grid_destroy(g);
+                return SCC_GRID_BUILD_OUT_OF_MEMORY;
+            }
+            uint64_t at = 0;
+            for (uint64_t l = 0; l < n_nodes - nv; ++l)
+                if (need[l]) list[at++] = (uint32_t)(nv + l);
+            scc_free(a, need, (size_t)(n_nodes - nv));
+            node_ctx ec = { def, g, nodes, list, listed, 1024 };
+            cancelled = sample_nodes(def, &ec, SCC_GRID_STAGE_EDGES);
+            scc_free(a, list, (size_t)listed * sizeof(uint32_t));
+        }
+        if (!cancelled)
+            for (uint64_t l = 0; l < nv; ++l)
+                if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
+    } else {
+        node_ctx nc = { def, g, nodes, NULL, n_nodes, 1024 };
+        cancelled = sample_nodes(def, &nc, SCC_GRID_STAGE_NODES);
     }
     if (cancelled) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED; }
-    for (uint64_t l = 0; l < n_nodes; ++l)
-        if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
+    if (!banded)
+        for (uint64_t l = 0; l < n_nodes; ++l)
+            if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
 
-    const int banded = def->band > 0.0 && isfinite(def->band);
     fd->map = scc_alloc(a, (size_t)n_cells * sizeof(uint32_t));
     if (!fd->map) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
 
@@ -74,7 +132,6 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
         /* Narrow band: keep a cell when any of its nodes is nearer than band + |h| to the
          * surface. Culled cells then satisfy |phi| >= band everywhere (every point of a cell
          * lies within |h| of one of its corners and the samples are exact distances). */
-        const double keep_below = def->band + scc_len(g->h);
         uint32_t* renumber = scc_alloc(a, (size_t)n_nodes * sizeof(uint32_t));
         if (!renumber) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
         memset(renumber, 0xFF, (size_t)n_nodes * sizeof(uint32_t));
@@ -87,6 +144,14 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
                     int keep = 0;
                     for (int s = 0; s < 32 && !keep; ++s) keep = fabs(nodes[ids[s]]) < keep_below;
                     if (!keep) { fd->map[l] = SCC_GRID_NO_CELL; continue; }
+                    int bad = 0;
+                    for (int s = 0; s < 32; ++s) bad |= !isfinite(nodes[ids[s]]);
+                    if (bad) { /* a sample returned NaN/inf (a skipped node cannot be here) */
+                        scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
+                        scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+                        scc_grid_destroy(g);
+                        return SCC_GRID_BUILD_BAD_VALUE;
+                    }
                     fd->map[l] = (uint32_t)kept++;
                     for (int s = 0; s < 32; ++s) renumber[ids[s]] = 0; /* mark used */
                 }

@@ -140,7 +140,12 @@ START_TEST(test_narrow_band)
     ck_assert_int_eq(sdfccd_grid_get_info(dense, &di), SDFCCD_OK);
     const double w = di.cell_size.x;
     def.band = w;
+    progress_log log = { 0, -1.0, 1 };
+    def.progress = on_progress;
+    def.progress_user = &log;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &band), SDFCCD_OK);
+    ck_assert_int_eq(log.monotone, 1);
+    ck_assert_double_eq(log.last, 1.0);
     ck_assert_int_eq(sdfccd_grid_get_info(band, &bi), SDFCCD_OK);
     fprintf(stderr, "bunny 40^3: dense %lld cells %lld nodes %lld bytes; band %.3g m: %lld cells %lld nodes %lld bytes\n",
             (long long)di.stored_cells, (long long)di.node_count, (long long)di.memory_bytes, w, (long long)bi.stored_cells,

@@ -83,14 +83,17 @@ void capi_pool_init(capi_pool* p, int threads, sdfccd_ProgressFcn* progress, voi
     p->threads = threads;
     p->progress = progress;
     p->progress_user = user;
-    p->stage_base[0] = 0.0; p->stage_weight[0] = 0.9;
-    p->stage_base[1] = 0.9; p->stage_weight[1] = 0.1;
+    /* progress ranges per stage: nodes (dense) 0-0.9, corners then edges (band) 0-0.3-0.9, cells 0.9-1 */
+    p->stage_base[SCC_GRID_STAGE_NODES] = 0.0; p->stage_weight[SCC_GRID_STAGE_NODES] = 0.9;
+    p->stage_base[SCC_GRID_STAGE_CELLS] = 0.9; p->stage_weight[SCC_GRID_STAGE_CELLS] = 0.1;
+    p->stage_base[SCC_GRID_STAGE_CORNERS] = 0.0; p->stage_weight[SCC_GRID_STAGE_CORNERS] = 0.3;
+    p->stage_base[SCC_GRID_STAGE_EDGES] = 0.3; p->stage_weight[SCC_GRID_STAGE_EDGES] = 0.6;
     p->last_reported = -1.0;
 }
 
 static void pool_report(capi_pool* p, double f)
 {
-    if (!p->progress) return;
+    if (!p->progress || f < p->last_reported) return;
     if (f < 1.0 && f - p->last_reported < 0.005) return;
     p->last_reported = f;
     p->progress(f, p->progress_user);
@@ -99,7 +102,7 @@ static void pool_report(capi_pool* p, double f)
 int capi_pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx)
 {
     capi_pool* p = user;
-    const int st = stage == SCC_GRID_STAGE_CELLS ? 1 : 0;
+    const int st = stage >= 0 && stage < 4 ? stage : 0;
     pool_run r;
     r.task = task;
     r.ctx = ctx;
@@ -123,7 +126,7 @@ int capi_pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* t
         if (count) pool_report(p, p->stage_base[st] + p->stage_weight[st] * (double)done / (double)count);
     }
     for (int i = 0; i < started; ++i) pthread_join(tids[i], NULL);
-    pool_report(p, st == 1 ? 1.0 : p->stage_base[st] + p->stage_weight[st]);
+    pool_report(p, st == SCC_GRID_STAGE_CELLS ? 1.0 : p->stage_base[st] + p->stage_weight[st]);
     return 0;
 }
 
@@ -237,6 +240,7 @@ sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_Grid
     mesh_sample_ctx ctx = { &ms, def->invert ? -1.0 : 1.0 };
     bd.sample = mesh_sample;
     bd.sample_user = &ctx;
+    bd.sample_lipschitz = 1.0; /* exact distance */
     scc_grid* g = NULL;
     st = build_status(scc_grid_build(capi_allocator(), &bd, &g), fn);
     scc_mesh_sdf_destroy(&ms);
@@ -278,6 +282,7 @@ sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef
     sdf_sample_ctx ctx = { s->sdf, def->invert ? -1.0 : 1.0 };
     bd.sample = sdf_sample;
     bd.sample_user = &ctx;
+    bd.sample_lipschitz = isfinite(s->sdf->lipschitz) && s->sdf->lipschitz > 0.0 ? s->sdf->lipschitz : 0.0;
     scc_grid* g = NULL;
     st = build_status(scc_grid_build(capi_allocator(), &bd, &g), fn);
     capi_sdf_release(s);

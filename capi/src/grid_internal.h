@@ -22,7 +22,7 @@ typedef struct capi_pool {
     int threads;
     sdfccd_ProgressFcn* progress;
     void* progress_user;
-    double stage_base[2], stage_weight[2]; /* progress mapping per stage */
+    double stage_base[4], stage_weight[4]; /* progress mapping per stage (SCC_GRID_STAGE_*) */
     double last_reported;
 } capi_pool;
 void capi_pool_init(capi_pool* p, int threads, sdfccd_ProgressFcn* progress, void* user);
