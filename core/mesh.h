@@ -6,12 +6,17 @@
 #include <stdint.h>
 #include "scc_math.h"
 
+struct scc_bsh;
+
 typedef struct scc_mesh {
     const scc_vec3* vertices;   /* local frame */
     const uint32_t* indices;    /* 3 per triangle, counter-clockwise */
     uint32_t vertex_count;
     uint32_t triangle_count;
     scc_aabb bounds;            /* local-frame box of the vertices */
+    /* Optional prebuilt bounding-sphere hierarchy (bsh.h) over these triangles; NULL: the mesh
+     * query builds a temporary one when params->broad_phase is set. */
+    const struct scc_bsh* bsh;
 } scc_mesh;
 
 static inline void scc_mesh_triangle(const scc_mesh* m, uint32_t t, scc_vec3 out[3])

@@ -2,7 +2,14 @@
  * sdfccd core: a moving mesh against an SDF. Each triangle is queried on [t0, best + window]
  * where `best` is the earliest TOI found so far, so the interval shrinks as earlier hits are
  * found (Section 5.3). The result is the earliest TOI with the contacts of every triangle whose
- * TOI lies within the window of it (plus their subdivision contacts). */
+ * TOI lies within the window of it (plus their subdivision contacts).
+ *
+ * With params->broad_phase the triangles come from the bounding-sphere hierarchy (bsh.h,
+ * Section 4.6): earliest candidate first, and every hit lowers the end of the interval the
+ * hierarchy still searches. Without it, every triangle is tested in index order. The broad
+ * phase's SDF evaluations are included in the summary's `evals`; `triangles_tested` counts the
+ * narrow-phase tests only. */
+#include "bsh.h"
 #include "ccd.h"
 
 typedef struct contact_buf {
@@ -55,50 +62,124 @@ static void fill_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_
     }
 }
 
+typedef struct mesh_ctx {
+    const scc_sdf* sdf;
+    const scc_mesh_motion* mm;
+    const scc_params* p;
+    const scc_allocator* alloc;
+    contact_buf buf;
+    double best, lower;
+    scc_state best_state;
+    int any_not_converged;
+    scc_query_summary* sum;
+} mesh_ctx;
+
+/* Narrow phase of triangle t on [t0, min(t1, best + window)]. Returns 0 on allocation failure. */
+static int test_triangle(mesh_ctx* c, uint32_t t)
+{
+    const scc_params* p = c->p;
+    scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
+    double tb = fmin(c->mm->t1, c->best + p->toi_window);
+    scc_tri_motion m;
+    fill_triangle_motion(c->mm, t, &m);
+    scc_query_summary s;
+    if (!scc_query_triangle(c->sdf, &m, c->mm->t0, tb, p, c->alloc, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s))
+        return 0;
+    c->sum->iterations += s.iterations;
+    c->sum->evals += s.evals;
+    c->sum->triangles_tested += 1;
+    c->lower = fmin(c->lower, s.toi_lower);
+    if (!s.hit) {
+        c->any_not_converged |= s.state == SCC_NOT_CONVERGED;
+        return 1;
+    }
+    int n = s.contacts_found < 1 + SCC_MAX_SUBDIVISION_CONTACTS ? s.contacts_found : 1 + SCC_MAX_SUBDIVISION_CONTACTS;
+    for (int i = 0; i < n; ++i)
+        if (!buf_push(&c->buf, &local[i])) return 0;
+    if (s.toi < c->best) {
+        c->best = s.toi;
+        c->best_state = s.state;
+        buf_prune(&c->buf, c->best + p->toi_window);
+    }
+    return 1;
+}
+
+static int visit_candidate(void* user, uint32_t triangle, double t_candidate, double* io_t_end)
+{
+    mesh_ctx* c = user;
+    (void)t_candidate;
+    if (!test_triangle(c, triangle)) return 0;
+    *io_t_end = fmin(*io_t_end, fmin(c->mm->t1, c->best + c->p->toi_window));
+    return 1;
+}
+
+/* Broad phase: the mesh's own hierarchy or a temporary one, refitted for linear motion. */
+static int run_broad_phase(mesh_ctx* c)
+{
+    const scc_mesh_motion* mm = c->mm;
+    const scc_allocator* alloc = c->alloc;
+    const scc_bsh* bsh = mm->mesh->bsh;
+    scc_bsh* own = NULL;
+    if (!bsh) {
+        own = scc_bsh_build(mm->mesh, alloc);
+        if (!own) return 0;
+        bsh = own;
+    }
+    scc_bsh_moving_node* moving = NULL;
+    size_t moving_bytes = 0;
+    int ok = 1;
+    if (!mm->body) {
+        moving_bytes = (size_t)bsh->node_count * sizeof *moving;
+        moving = scc_alloc(alloc, moving_bytes);
+        if (!moving) ok = 0;
+        else scc_bsh_refit_linear(bsh, mm->mesh, mm->start, mm->end, moving);
+    }
+    if (ok) {
+        scc_bsh_stats st;
+        ok = scc_bsh_traverse(bsh, moving, c->sdf, mm, c->p, alloc, mm->t1, visit_candidate, c, &st);
+        c->sum->evals += st.evals;
+    }
+    scc_free(alloc, moving, moving_bytes);
+    scc_bsh_destroy(own, alloc);
+    return ok;
+}
+
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum)
 {
-    contact_buf buf = { NULL, 0, 0, alloc };
-    scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
-    double best = INFINITY, lower = INFINITY;
-    scc_state best_state = SCC_NO_HIT;
-    int any_not_converged = 0, ok = 1;
+    mesh_ctx c;
+    c.sdf = sdf;
+    c.mm = mm;
+    c.p = p;
+    c.alloc = alloc;
+    c.buf.a = NULL;
+    c.buf.n = c.buf.cap = 0;
+    c.buf.alloc = alloc;
+    c.best = c.lower = INFINITY;
+    c.best_state = SCC_NO_HIT;
+    c.any_not_converged = 0;
+    c.sum = sum;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
-    for (uint32_t t = 0; t < mm->mesh->triangle_count && ok; ++t) {
-        double tb = fmin(mm->t1, best + p->toi_window);
-        scc_tri_motion m;
-        fill_triangle_motion(mm, t, &m);
-        scc_query_summary s;
-        if (!scc_query_triangle(sdf, &m, mm->t0, tb, p, alloc, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s)) {
-            ok = 0;
-            break;
-        }
-        sum->iterations += s.iterations;
-        sum->evals += s.evals;
-        sum->triangles_tested += 1;
-        lower = fmin(lower, s.toi_lower);
-        if (!s.hit) {
-            any_not_converged |= s.state == SCC_NOT_CONVERGED;
-            continue;
-        }
-        int n = s.contacts_found < 1 + SCC_MAX_SUBDIVISION_CONTACTS ? s.contacts_found : 1 + SCC_MAX_SUBDIVISION_CONTACTS;
-        for (int i = 0; i < n && ok; ++i) ok = buf_push(&buf, &local[i]);
-        if (s.toi < best) {
-            best = s.toi;
-            best_state = s.state;
-            buf_prune(&buf, best + p->toi_window);
-        }
+    int ok = 1;
+    if (p->broad_phase && mm->mesh->triangle_count > 0) {
+        ok = run_broad_phase(&c);
+    } else {
+        for (uint32_t t = 0; t < mm->mesh->triangle_count && ok; ++t) ok = test_triangle(&c, t);
     }
+    contact_buf buf = c.buf;
+    double best = c.best, lower = c.lower;
+    scc_state best_state = c.best_state;
+    int any_not_converged = c.any_not_converged;
     if (!ok) {
         scc_free(alloc, buf.a, buf.cap * sizeof *buf.a);
         return 0;
     }
     /* Earliest first; insertion sort is fine for the handful of contacts at one TOI. */
     for (size_t i = 1; i < buf.n; ++i) {
-        scc_contact c = buf.a[i];
+        scc_contact key = buf.a[i];
         size_t j = i;
-        while (j > 0 && buf.a[j - 1].toi > c.toi) { buf.a[j] = buf.a[j - 1]; --j; }
-        buf.a[j] = c;
+        while (j > 0 && buf.a[j - 1].toi > key.toi) { buf.a[j] = buf.a[j - 1]; --j; }
+        buf.a[j] = key;
     }
     sum->hit = isfinite(best);
     sum->toi = sum->hit ? best : mm->t1;

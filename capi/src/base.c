@@ -2,6 +2,7 @@
  * sdfccd C ABI: allocator hooks and byte count, error messages, version queries and the
  * generation-checked handle registry shared by SDFs and meshes. */
 #include "capi_internal.h"
+#include "../../core/bsh.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -346,8 +347,16 @@ sdfccd_Status capi_mesh_create(const double* vertices, uint32_t vertex_count, co
     m->mesh.bounds = box;
     m->dropped_triangles = triangle_count - kept;
     m->refs = 1;
+    m->bsh = scc_bsh_build(&m->mesh, capi_allocator()); /* broad phase of the mesh query */
+    if (!m->bsh) {
+        capi_free(block, m->block_size);
+        capi_free(m, sizeof *m);
+        return capi_oom("a mesh's bounding-sphere hierarchy");
+    }
+    m->mesh.bsh = m->bsh;
     sdfccd_MeshId id = { 0, 0 };
     if (!registry_add(m, KIND_MESH, &id.index1, &id.generation)) {
+        scc_bsh_destroy(m->bsh, capi_allocator());
         capi_free(block, m->block_size);
         capi_free(m, sizeof *m);
         return capi_oom("a mesh handle");
@@ -367,6 +376,7 @@ sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId id)
 {
     capi_mesh* m = registry_remove(id.index1, id.generation, KIND_MESH);
     if (!m) return capi_error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_mesh: handle {%u, %u} is not a live mesh", id.index1, id.generation);
+    scc_bsh_destroy(m->bsh, capi_allocator());
     capi_free(m->block, m->block_size);
     capi_free(m, sizeof *m);
     return SDFCCD_OK;
@@ -401,7 +411,7 @@ sdfccd_Status sdfccd_mesh_get_info(sdfccd_MeshId id, sdfccd_MeshInfo* out_info)
     out_info->triangle_count = m->mesh.triangle_count;
     out_info->dropped_triangles = m->dropped_triangles;
     out_info->bounds = capi_pbox(m->mesh.bounds);
-    out_info->memory_bytes = (int64_t)(m->block_size + sizeof *m);
+    out_info->memory_bytes = (int64_t)(m->block_size + sizeof *m + (m->bsh ? m->bsh->bytes : 0));
     return SDFCCD_OK;
 }
 

@@ -65,6 +65,8 @@ typedef struct capi_mesh {
     size_t block_size;
     uint32_t dropped_triangles;
     uint32_t refs;
+    struct scc_bsh* bsh;             /* broad-phase sphere hierarchy (core/bsh.h), built at creation and
+                                        owned; mesh.bsh points to it (memory counted by the allocator) */
 } capi_mesh;
 
 /* Creates a mesh object from arrays (validated). `what` names the source in messages. */

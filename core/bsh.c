@@ -1,0 +1,485 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: bounding-sphere hierarchy and padded sphere tracing (Section 4.6 of
+ * Pelletier-Guenette et al., SCA 2025). The contract and the padding argument are in bsh.h. */
+#include "bsh.h"
+
+#include <string.h>
+
+/* ---------------------------------------------------------------- spheres */
+
+/* Smallest sphere through or around three points: the circumsphere for an acute triangle,
+ * the longest edge's diametral sphere otherwise. The radius is re-measured from the vertices so
+ * round-off can only make it larger. */
+static void triangle_sphere(scc_vec3 a, scc_vec3 b, scc_vec3 c, scc_vec3* out_c, double* out_r)
+{
+    scc_vec3 ab = scc_sub(b, a), ac = scc_sub(c, a), bc = scc_sub(c, b);
+    double dA = scc_dot(ab, ac), dB = -scc_dot(ab, bc), dC = scc_dot(ac, bc);
+    scc_vec3 centre;
+    if (dA <= 0.0) centre = scc_scale(scc_add(b, c), 0.5);
+    else if (dB <= 0.0) centre = scc_scale(scc_add(a, c), 0.5);
+    else if (dC <= 0.0) centre = scc_scale(scc_add(a, b), 0.5);
+    else {
+        scc_vec3 n = scc_cross(ab, ac);
+        double n2 = scc_len2(n);
+        if (n2 > 0.0) {
+            scc_vec3 num = scc_cross(scc_sub(scc_scale(ac, scc_len2(ab)), scc_scale(ab, scc_len2(ac))), n);
+            centre = scc_add(a, scc_scale(num, 0.5 / n2));
+        } else {
+            centre = scc_scale(scc_add(scc_add(a, b), c), 1.0 / 3.0);
+        }
+    }
+    double r = fmax(scc_dist(centre, a), fmax(scc_dist(centre, b), scc_dist(centre, c)));
+    *out_c = centre;
+    *out_r = r * (1.0 + 1e-12);
+}
+
+/* Smallest sphere containing two spheres. */
+static void merge_spheres(scc_vec3 c1, double r1, scc_vec3 c2, double r2, scc_vec3* out_c, double* out_r)
+{
+    double d = scc_dist(c1, c2);
+    if (d + r2 <= r1) { *out_c = c1; *out_r = r1; return; }
+    if (d + r1 <= r2) { *out_c = c2; *out_r = r2; return; }
+    double r = 0.5 * (d + r1 + r2);
+    *out_c = scc_madd(c1, scc_sub(c2, c1), (r - r1) / d);
+    *out_r = r * (1.0 + 1e-12);
+}
+
+/* ---------------------------------------------------------------- build */
+
+typedef struct build_ctx {
+    const scc_mesh* mesh;
+    scc_bsh_node* nodes;
+    uint32_t* order;      /* triangle indices, permuted during the build */
+    scc_vec3* centroid;   /* per triangle */
+    uint32_t next;        /* next free node index */
+} build_ctx;
+
+static double axis_of(scc_vec3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
+
+/* Partially sorts order[lo, hi) so that order[k] holds the k-th smallest key (quickselect with
+ * a three-way partition, so equal keys always make progress). */
+static void select_kth(uint32_t* order, const scc_vec3* centroid, int axis, uint32_t lo, uint32_t hi, uint32_t k)
+{
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        double a = axis_of(centroid[order[lo]], axis), b = axis_of(centroid[order[mid]], axis), c = axis_of(centroid[order[hi - 1]], axis);
+        double pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        uint32_t lt = lo, i = lo, gt = hi; /* [lo,lt) < pivot, [lt,i) == pivot, [gt,hi) > pivot */
+        while (i < gt) {
+            double v = axis_of(centroid[order[i]], axis);
+            if (v < pivot) { uint32_t tmp = order[i]; order[i] = order[lt]; order[lt] = tmp; ++lt; ++i; }
+            else if (v > pivot) { --gt; uint32_t tmp = order[i]; order[i] = order[gt]; order[gt] = tmp; }
+            else ++i;
+        }
+        if (k < lt) hi = lt;
+        else if (k >= gt) lo = gt;
+        else return;
+    }
+}
+
+static void build_node(build_ctx* b, uint32_t index, uint32_t lo, uint32_t hi)
+{
+    scc_bsh_node* node = &b->nodes[index];
+    const scc_mesh* m = b->mesh;
+    if (hi - lo == 1) {
+        scc_vec3 v[3];
+        scc_mesh_triangle(m, b->order[lo], v);
+        triangle_sphere(v[0], v[1], v[2], &node->center, &node->radius);
+        node->first = b->order[lo];
+        node->is_leaf = 1;
+        return;
+    }
+    scc_aabb cb = { { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY } };
+    scc_aabb vb = cb;
+    for (uint32_t i = lo; i < hi; ++i) {
+        scc_vec3 c = b->centroid[b->order[i]];
+        cb.lo = scc_vmin(cb.lo, c);
+        cb.hi = scc_vmax(cb.hi, c);
+        scc_vec3 v[3];
+        scc_mesh_triangle(m, b->order[i], v);
+        for (int k = 0; k < 3; ++k) {
+            vb.lo = scc_vmin(vb.lo, v[k]);
+            vb.hi = scc_vmax(vb.hi, v[k]);
+        }
+    }
+    scc_vec3 ext = scc_sub(cb.hi, cb.lo);
+    int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    uint32_t mid = lo + (hi - lo) / 2;
+    select_kth(b->order, b->centroid, axis, lo, hi, mid);
+    uint32_t left = b->next;
+    b->next += 2;
+    node->first = left;
+    node->is_leaf = 0;
+    build_node(b, left, lo, mid);
+    build_node(b, left + 1, mid, hi);
+    node = &b->nodes[index];
+
+    /* Two valid spheres; keep the smaller: the children merged, or the vertex box's centre with
+     * the farthest vertex. */
+    scc_vec3 cm;
+    double rm;
+    merge_spheres(b->nodes[left].center, b->nodes[left].radius, b->nodes[left + 1].center, b->nodes[left + 1].radius, &cm, &rm);
+    scc_vec3 cv = scc_scale(scc_add(vb.lo, vb.hi), 0.5);
+    double rv = 0.0;
+    for (uint32_t i = lo; i < hi; ++i) {
+        scc_vec3 v[3];
+        scc_mesh_triangle(m, b->order[i], v);
+        for (int k = 0; k < 3; ++k) rv = fmax(rv, scc_len2(scc_sub(v[k], cv)));
+    }
+    rv = sqrt(rv) * (1.0 + 1e-12);
+    if (rv < rm) { node->center = cv; node->radius = rv; }
+    else { node->center = cm; node->radius = rm; }
+}
+
+scc_bsh* scc_bsh_build(const scc_mesh* mesh, const scc_allocator* alloc)
+{
+    uint32_t n = mesh->triangle_count;
+    if (n == 0) return NULL;
+    uint32_t count = 2 * n - 1;
+    size_t node_bytes = (size_t)count * sizeof(scc_bsh_node);
+    scc_bsh* bsh = scc_alloc(alloc, sizeof *bsh);
+    scc_bsh_node* nodes = scc_alloc(alloc, node_bytes);
+    uint32_t* order = scc_alloc(alloc, (size_t)n * sizeof *order);
+    scc_vec3* centroid = scc_alloc(alloc, (size_t)n * sizeof *centroid);
+    if (!bsh || !nodes || !order || !centroid) {
+        scc_free(alloc, bsh, sizeof *bsh);
+        scc_free(alloc, nodes, node_bytes);
+        scc_free(alloc, order, (size_t)n * sizeof *order);
+        scc_free(alloc, centroid, (size_t)n * sizeof *centroid);
+        return NULL;
+    }
+    for (uint32_t t = 0; t < n; ++t) {
+        scc_vec3 v[3];
+        scc_mesh_triangle(mesh, t, v);
+        order[t] = t;
+        centroid[t] = scc_scale(scc_add(scc_add(v[0], v[1]), v[2]), 1.0 / 3.0);
+    }
+    build_ctx b = { mesh, nodes, order, centroid, 1 };
+    build_node(&b, 0, 0, n);
+    scc_free(alloc, order, (size_t)n * sizeof *order);
+    scc_free(alloc, centroid, (size_t)n * sizeof *centroid);
+    bsh->nodes = nodes;
+    bsh->node_count = count;
+    bsh->triangle_count = n;
+    bsh->bytes = sizeof *bsh + node_bytes;
+    return bsh;
+}
+
+void scc_bsh_destroy(scc_bsh* bsh, const scc_allocator* alloc)
+{
+    if (!bsh) return;
+    scc_free(alloc, bsh->nodes, (size_t)bsh->node_count * sizeof(scc_bsh_node));
+    scc_free(alloc, bsh, sizeof *bsh);
+}
+
+/* ---------------------------------------------------------------- refit */
+
+static void refit_node(const scc_bsh* bsh, const scc_mesh* mesh, const scc_vec3* start, const scc_vec3* end,
+                       scc_bsh_moving_node* out, uint32_t i)
+{
+    const scc_bsh_node* n = &bsh->nodes[i];
+    if (n->is_leaf) {
+        const uint32_t* f = mesh->indices + 3 * n->first;
+        double r0, r1;
+        triangle_sphere(start[f[0]], start[f[1]], start[f[2]], &out[i].c0, &r0);
+        triangle_sphere(end[f[0]], end[f[1]], end[f[2]], &out[i].c1, &r1);
+        out[i].radius = fmax(r0, r1);
+        return;
+    }
+    refit_node(bsh, mesh, start, end, out, n->first);
+    refit_node(bsh, mesh, start, end, out, n->first + 1);
+    const scc_bsh_moving_node* a = &out[n->first];
+    const scc_bsh_moving_node* b = &out[n->first + 1];
+    double r0, r1;
+    merge_spheres(a->c0, a->radius, b->c0, b->radius, &out[i].c0, &r0);
+    merge_spheres(a->c1, a->radius, b->c1, b->radius, &out[i].c1, &r1);
+    /* Each point's offset from the lerped centre is the lerp of its end offsets, so the larger
+     * end radius covers every time in between. */
+    out[i].radius = fmax(r0, r1);
+}
+
+void scc_bsh_refit_linear(const scc_bsh* bsh, const scc_mesh* mesh, const scc_vec3* start, const scc_vec3* end,
+                          scc_bsh_moving_node* out)
+{
+    if (bsh->node_count) refit_node(bsh, mesh, start, end, out, 0);
+}
+
+/* ---------------------------------------------------------------- traversal */
+
+#define MARCH_MAX_STEPS 48
+#define SEG_UNTRACED 0x80000000u
+
+typedef struct segment {
+    double ta, tm, tb;
+    scc_quat q[3];    /* rigid body pose at ta, tm, tb */
+    scc_vec3 p[3];
+} segment;
+
+typedef struct item {
+    double key;       /* candidate time (untraced roots: the segment start) */
+    uint32_t node;
+    uint32_t seg;     /* | SEG_UNTRACED for a root not yet marched */
+} item;
+
+typedef struct item_heap {
+    item* a;
+    size_t n, cap;
+    const scc_allocator* alloc;
+} item_heap;
+
+static int heap_push(item_heap* h, item it)
+{
+    if (h->n == h->cap) {
+        size_t cap = h->cap ? 2 * h->cap : 64;
+        item* na = scc_alloc(h->alloc, cap * sizeof *na);
+        if (!na) return 0;
+        if (h->n) memcpy(na, h->a, h->n * sizeof *na);
+        scc_free(h->alloc, h->a, h->cap * sizeof *h->a);
+        h->a = na;
+        h->cap = cap;
+    }
+    size_t i = h->n++;
+    while (i > 0) {
+        size_t parent = (i - 1) / 2;
+        if (h->a[parent].key <= it.key) break;
+        h->a[i] = h->a[parent];
+        i = parent;
+    }
+    h->a[i] = it;
+    return 1;
+}
+
+static item heap_pop(item_heap* h)
+{
+    item top = h->a[0];
+    item last = h->a[--h->n];
+    size_t i = 0;
+    for (;;) {
+        size_t l = 2 * i + 1, r = l + 1, m = i;
+        double km = last.key;
+        if (l < h->n && h->a[l].key < km) { m = l; km = h->a[l].key; }
+        if (r < h->n && h->a[r].key < km) m = r;
+        if (m == i) break;
+        h->a[i] = h->a[m];
+        i = m;
+    }
+    if (h->n) h->a[i] = last;
+    return top;
+}
+
+typedef struct trav {
+    const scc_bsh* bsh;
+    const scc_bsh_moving_node* moving;
+    const scc_sdf* sdf;
+    const scc_mesh_motion* mm;
+    const scc_params* p;
+    double lipschitz;
+    double w_body2;           /* |w_body|^2 */
+    segment* seg;
+    scc_bsh_stats* stats;
+} trav;
+
+static double node_radius(const trav* tr, uint32_t i)
+{
+    return tr->moving ? tr->moving[i].radius : tr->bsh->nodes[i].radius;
+}
+
+/* Node centre in the SDF frame at time t, using a precomputed body pose (rigid motion). */
+static scc_vec3 centre_at(const trav* tr, uint32_t i, double t, const scc_quat* q, const scc_vec3* p)
+{
+    scc_vec3 w;
+    if (tr->moving) {
+        double span = tr->mm->t1 - tr->mm->t0;
+        double s = span > 0.0 ? (t - tr->mm->t0) / span : 0.0;
+        w = scc_lerp(tr->moving[i].c0, tr->moving[i].c1, s);
+    } else {
+        w = scc_add(scc_quat_rotate(*q, tr->bsh->nodes[i].center), *p);
+    }
+    return scc_sdf_frame_point(tr->mm->sdf, t, w);
+}
+
+/* Upper bound on the acceleration (SDF frame) of a node's centre. */
+static double centre_accel_bound(const trav* tr, uint32_t i)
+{
+    const scc_mesh_motion* mm = tr->mm;
+    if (!mm->sdf) {
+        if (tr->moving) return 0.0;
+        return tr->w_body2 * scc_dist(tr->bsh->nodes[i].center, mm->body->c_local);
+    }
+    scc_tri_motion m;
+    memset(&m, 0, sizeof m);
+    m.sdf = mm->sdf;
+    m.t0 = mm->t0;
+    m.t1 = mm->t1;
+    if (tr->moving) {
+        m.kind = SCC_TRI_LINEAR;
+        for (int k = 0; k < 3; ++k) { m.start[k] = tr->moving[i].c0; m.end[k] = tr->moving[i].c1; }
+    } else {
+        m.kind = SCC_TRI_RIGID;
+        m.body = mm->body;
+        for (int k = 0; k < 3; ++k) m.local[k] = tr->bsh->nodes[i].center;
+    }
+    return scc_tri_accel_bound(&m);
+}
+
+static double field(trav* tr, scc_vec3 x)
+{
+    tr->stats->evals += 1;
+    return scc_sdf_eval(tr->sdf, x, NULL);
+}
+
+/* Marches node i's padded sphere along the chord of segment s from time `from` to `to`.
+ * Returns 1 with the candidate time, or 0 when the sphere stays clear up to `to`. */
+static int march(trav* tr, uint32_t i, uint32_t s, double from, double to, double* out_tc)
+{
+    const segment* sg = &tr->seg[s];
+    tr->stats->nodes_visited += 1;
+    scc_vec3 A = centre_at(tr, i, sg->ta, &sg->q[0], &sg->p[0]);
+    scc_vec3 M = centre_at(tr, i, sg->tm, &sg->q[1], &sg->p[1]);
+    scc_vec3 B = centre_at(tr, i, sg->tb, &sg->q[2], &sg->p[2]);
+    double span = sg->tb - sg->ta;
+    double pad = scc_dist(M, scc_scale(scc_add(A, B), 0.5));
+    pad = fmax(pad, centre_accel_bound(tr, i) * span * span * 0.125);
+    double R = node_radius(tr, i) + pad;
+    R += 1e-12 * (1.0 + R);
+    double tol = 1e-3 * R + 1e-9;
+    scc_vec3 D = scc_sub(B, A);
+    double len = scc_len(D);
+    double t = from;
+    for (int it = 0; it < MARCH_MAX_STEPS; ++it) {
+        double f = span > 0.0 ? (t - sg->ta) / span : 0.0;
+        double phi = field(tr, scc_madd(A, D, f));
+        double clear = (phi - tr->p->margin) / tr->lipschitz - R;
+        if (!(clear > tol)) { *out_tc = t; return 1; }
+        if (!(len > 0.0) || !(span > 0.0)) return 0;
+        t += clear * span / len;
+        if (t > to) return 0;
+    }
+    *out_tc = t;
+    return 1;
+}
+
+static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void* user, const scc_allocator* alloc)
+{
+    /* DCD: the pose at t_end only. Depth-first with an explicit stack (depth <= 64 for a
+     * median-split tree of up to 2^30 triangles, but grow it anyway). */
+    const scc_bsh* b = tr->bsh;
+    scc_quat q = scc_quat_identity();
+    scc_vec3 p = scc_v3(0, 0, 0);
+    if (!tr->moving) scc_rigid_pose_at(tr->mm->body, t_end, &q, &p);
+    size_t cap = 128, n = 0;
+    uint32_t* stack = scc_alloc(alloc, cap * sizeof *stack);
+    if (!stack) return 0;
+    stack[n++] = 0;
+    int ok = 1;
+    double te = t_end;
+    while (n && ok) {
+        uint32_t i = stack[--n];
+        tr->stats->nodes_visited += 1;
+        scc_vec3 c = centre_at(tr, i, t_end, &q, &p);
+        double clear = (field(tr, c) - tr->p->margin) / tr->lipschitz - node_radius(tr, i) * (1.0 + 1e-12);
+        if (clear > 0.0) continue;
+        if (b->nodes[i].is_leaf) {
+            tr->stats->candidates += 1;
+            ok = visit(user, b->nodes[i].first, t_end, &te);
+            continue;
+        }
+        if (n + 2 > cap) {
+            uint32_t* ns = scc_alloc(alloc, 2 * cap * sizeof *ns);
+            if (!ns) { ok = 0; break; }
+            memcpy(ns, stack, n * sizeof *ns);
+            scc_free(alloc, stack, cap * sizeof *stack);
+            stack = ns;
+            cap *= 2;
+        }
+        stack[n++] = b->nodes[i].first + 1;
+        stack[n++] = b->nodes[i].first;
+    }
+    scc_free(alloc, stack, cap * sizeof *stack);
+    return ok;
+}
+
+int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_sdf* sdf,
+                     const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc, double t_end,
+                     scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats)
+{
+    stats->evals = stats->nodes_visited = stats->candidates = 0;
+    if (!bsh || bsh->node_count == 0) return 1;
+    trav tr;
+    tr.bsh = bsh;
+    tr.moving = moving;
+    tr.sdf = sdf;
+    tr.mm = mm;
+    tr.p = p;
+    tr.lipschitz = sdf->lipschitz > 0.0 ? sdf->lipschitz : 1.0;
+    tr.w_body2 = mm->body && !moving ? scc_len2(mm->body->w) : 0.0;
+    tr.stats = stats;
+    tr.seg = NULL;
+    if (p->method == SCC_METHOD_DCD) return traverse_static(&tr, t_end, visit, user, alloc);
+
+    /* Segments: no more than min(pi, max_rotation) of relative rotation each. */
+    double w = (mm->body && !moving ? scc_len(mm->body->w) : 0.0) + (mm->sdf ? scc_len(mm->sdf->w) : 0.0);
+    double limit = p->max_rotation > 0.0 ? fmin(p->max_rotation, SCC_PI) : SCC_PI;
+    double angle = w * fabs(t_end - mm->t0);
+    uint32_t nseg = 1;
+    if (angle > limit) {
+        double k = ceil(angle / limit);
+        nseg = k > 1e5 ? 100000u : (uint32_t)k;
+    }
+    segment* seg = scc_alloc(alloc, nseg * sizeof *seg);
+    uint8_t* tested = scc_alloc(alloc, ((size_t)bsh->triangle_count + 7) / 8);
+    item_heap heap = { NULL, 0, 0, alloc };
+    int ok = seg && tested;
+    if (ok) {
+        memset(tested, 0, ((size_t)bsh->triangle_count + 7) / 8);
+        tr.seg = seg;
+        for (uint32_t s = 0; s < nseg; ++s) {
+            segment* sg = &seg[s];
+            sg->ta = mm->t0 + (t_end - mm->t0) * s / nseg;
+            sg->tb = s + 1 == nseg ? t_end : mm->t0 + (t_end - mm->t0) * (s + 1) / nseg;
+            sg->tm = 0.5 * (sg->ta + sg->tb);
+            const double ts[3] = { sg->ta, sg->tm, sg->tb };
+            for (int k = 0; k < 3; ++k) {
+                if (!moving) scc_rigid_pose_at(mm->body, ts[k], &sg->q[k], &sg->p[k]);
+                else { sg->q[k] = scc_quat_identity(); sg->p[k] = scc_v3(0, 0, 0); }
+            }
+            item root = { sg->ta, 0, s | SEG_UNTRACED };
+            if (!(ok = heap_push(&heap, root))) break;
+        }
+    }
+    double te = t_end;
+    while (ok && heap.n) {
+        item it = heap_pop(&heap);
+        if (it.key > te) break;
+        uint32_t s = it.seg & ~SEG_UNTRACED;
+        double to = fmin(seg[s].tb, te);
+        if (it.seg & SEG_UNTRACED) {
+            double tc;
+            if (march(&tr, it.node, s, it.key, to, &tc)) {
+                item c = { tc, it.node, s };
+                ok = heap_push(&heap, c);
+            }
+            continue;
+        }
+        const scc_bsh_node* n = &bsh->nodes[it.node];
+        if (n->is_leaf) {
+            uint32_t t = n->first;
+            if (tested[t >> 3] & (1u << (t & 7))) continue;
+            tested[t >> 3] |= (uint8_t)(1u << (t & 7));
+            stats->candidates += 1;
+            ok = visit(user, t, it.key, &te);
+            continue;
+        }
+        for (uint32_t k = 0; k < 2 && ok; ++k) {
+            double tc;
+            if (march(&tr, n->first + k, s, it.key, to, &tc)) {
+                item c = { tc, n->first + k, s };
+                ok = heap_push(&heap, c);
+            }
+        }
+    }
+    scc_free(alloc, heap.a, heap.cap * sizeof *heap.a);
+    scc_free(alloc, tested, ((size_t)bsh->triangle_count + 7) / 8);
+    scc_free(alloc, seg, nseg * sizeof *seg);
+    return ok;
+}

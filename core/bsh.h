@@ -1,0 +1,90 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: the bounding-sphere hierarchy (BSH) broad phase of the mesh query
+ * (Pelletier-Guenette et al., SCA 2025, Section 4.6).
+ *
+ * A binary tree of spheres over a mesh's triangles, built once per mesh in the mesh's local
+ * frame (one triangle per leaf). A rigid motion moves every sphere rigidly, so the tree is used
+ * as built; per-vertex linear motion (cloth, deformables) refits it per query: every node gets a
+ * start and an end centre and one radius that covers its triangles at every time in between.
+ *
+ * Culling is padded sphere tracing. The interval is split into segments that rotate (relative to
+ * the SDF) at most min(pi, params->max_rotation); on each segment a node's centre path c(t) is
+ * replaced by its chord L(t) (the lerp between the segment's end centres) and the sphere's radius
+ * is padded by
+ *     pad = max(|c(tm) - L(tm)|,  A (tb - ta)^2 / 8),
+ * the first term being the paper's heuristic (true versus linear mid-interval centre) and the
+ * second the interpolation-error bound for a path with acceleration at most A (an upper bound
+ * from the motion). The second term makes the padding a proof that c(t) stays within pad of the
+ * chord. The padded sphere is then marched along the chord: with a Lipschitz bound K of the
+ * field, a sphere of radius R centred at x is clear while (phi(x) - margin) / K > R, and it can
+ * advance by the excess. A node whose march stalls (excess below a small tolerance, or the step
+ * cap reached) is a candidate at that time, which is a lower bound of any contact of its
+ * triangles (as long as K is a true Lipschitz bound). Candidates are processed earliest first
+ * (a priority queue keyed by that time); a child is marched from its parent's candidate time;
+ * a leaf candidate goes to the caller, who may shrink the end of the searched interval (every
+ * narrow-phase hit does), which stops the march of everything later.
+ *
+ * DCD (end pose only) uses the same tree statically: a node is culled when its sphere at the end
+ * pose is clear.
+ */
+#ifndef SCC_BSH_H
+#define SCC_BSH_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "alloc.h"
+#include "ccd.h"
+#include "mesh.h"
+#include "sdf.h"
+
+typedef struct scc_bsh_node {
+    scc_vec3 center;   /* local frame */
+    double radius;     /* covers every vertex of the node's triangles */
+    uint32_t first;    /* inner: index of the left child (the right one is first + 1); leaf: triangle index */
+    uint32_t is_leaf;
+} scc_bsh_node;
+
+typedef struct scc_bsh {
+    scc_bsh_node* nodes;  /* node 0 is the root */
+    uint32_t node_count;  /* 2 * triangle_count - 1 */
+    uint32_t triangle_count;
+    size_t bytes;         /* everything this hierarchy allocated, the struct included */
+} scc_bsh;
+
+/* Builds the hierarchy over `mesh` (top-down median split of triangle centroids on the longest
+ * axis). Returns NULL when out of memory or when the mesh has no triangle. */
+scc_bsh* scc_bsh_build(const scc_mesh* mesh, const scc_allocator* alloc);
+void scc_bsh_destroy(scc_bsh* bsh, const scc_allocator* alloc);
+
+/* A node refitted for per-vertex linear motion: at time fraction s every point of the node's
+ * triangles lies within `radius` of lerp(c0, c1, s). */
+typedef struct scc_bsh_moving_node {
+    scc_vec3 c0, c1;
+    double radius;
+} scc_bsh_moving_node;
+
+/* Refits `bsh` (built on `mesh`'s topology) for vertices moving linearly from `start` to `end`
+ * (world positions). `out` holds bsh->node_count nodes. */
+void scc_bsh_refit_linear(const scc_bsh* bsh, const scc_mesh* mesh, const scc_vec3* start, const scc_vec3* end,
+                          scc_bsh_moving_node* out);
+
+/* Counters of one traversal. */
+typedef struct scc_bsh_stats {
+    int64_t evals;          /* SDF evaluations spent marching */
+    int64_t nodes_visited;  /* node-segment marches */
+    int64_t candidates;     /* leaves handed to the visitor */
+} scc_bsh_stats;
+
+/* Called for each candidate triangle, earliest candidate time first, at most once per triangle.
+ * `t_candidate` is the time at which its padded sphere may first touch. The visitor may lower
+ * *io_t_end (the end of the searched interval). Return 0 to abort the traversal (out of memory). */
+typedef int scc_bsh_visit_fn(void* user, uint32_t triangle, double t_candidate, double* io_t_end);
+
+/* Traverses `bsh` for the motion `mm` over [mm->t0, t_end]: continuous (padded sphere tracing)
+ * unless `p->method` is DCD, which tests the pose at t_end only. `moving` is the refit for linear
+ * motion (NULL for rigid motion). Returns 0 on allocation failure or when the visitor aborts. */
+int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_sdf* sdf,
+                     const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc, double t_end,
+                     scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats);
+
+#endif
