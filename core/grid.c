@@ -434,15 +434,19 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
 /* ------------------------------------------------------------------------------------------
  * Finalisation: per-cell gradient bounds and hole sources.
  *
- * Gradient bound: each component of grad phi in a cell is c0_d * dphi/dxi_d, a polynomial of
- * degree <= 3 in each local coordinate. Sampled at the 4^3 tensor points {-1,-1/3,1/3,1}^3 and
- * converted per axis to the cubic Bernstein basis on [-1,1], its coefficients enclose its
- * range (convex hull property), so max |coefficient| bounds |dphi/dxi_d| on the whole cell.
- * The map from the 32 node values to the 64 coefficients is a fixed 64x32 matrix per axis.
+ * Gradient bound: phi on a cell is a polynomial of degree <= 3 in each local coordinate, so it
+ * has a tensor cubic Bernstein form on [-1,1]^3 (64 coefficients, a fixed 64x32 map from the
+ * node values). Each partial derivative then has a Bernstein form with coefficients from
+ * differences, and Bernstein coefficients enclose the range of their polynomial (convex hull
+ * property), so max |coefficient| bounds |dphi/dxi_d| on the whole cell; grad phi scales that
+ * by 2/h_d.
  * ---------------------------------------------------------------------------------------- */
 
-typedef struct bern_tables { double m[3][64][32]; double val[64][32]; } bern_tables;
+typedef struct bern_tables { double val[64][32]; } bern_tables;
 
+/* val[s][a]: the Bernstein coefficient s = i + 4j + 16k (degree 3 per axis on [-1,1]^3) of
+ * shape function a. Built by sampling at the tensor points {-1,-1/3,1/3,1}^3 and converting the
+ * samples per axis. */
 static void bern_tables_init(bern_tables* t)
 {
     static const double pts[4] = { -1.0, -1.0 / 3.0, 1.0 / 3.0, 1.0 };
@@ -454,36 +458,29 @@ static void bern_tables_init(bern_tables* t)
         { 1.0 / 3.0, -1.5, 3.0, -5.0 / 6.0 },
         { 0.0, 0.0, 0.0, 1.0 },
     };
-    double N[32], dN[32][3];
+    double N[32];
     for (int k = 0; k < 4; ++k)
         for (int j = 0; j < 4; ++j)
             for (int i = 0; i < 4; ++i) {
-                scc_cell_shape(scc_v3(pts[i], pts[j], pts[k]), N, dN);
-                for (int a = 0; a < 32; ++a) {
-                    for (int d = 0; d < 3; ++d) t->m[d][i + 4 * j + 16 * k][a] = dN[a][d];
-                    t->val[i + 4 * j + 16 * k][a] = N[a];
-                }
+                scc_cell_shape(scc_v3(pts[i], pts[j], pts[k]), N, NULL);
+                for (int a = 0; a < 32; ++a) t->val[i + 4 * j + 16 * k][a] = N[a];
             }
-    for (int d = 0; d < 4; ++d)
-        for (int a = 0; a < 32; ++a) {
-            double f[64], g[64];
-            for (int s = 0; s < 64; ++s) f[s] = d < 3 ? t->m[d][s][a] : t->val[s][a];
-            for (int axis = 0; axis < 3; ++axis) {
-                const int stride = axis == 0 ? 1 : (axis == 1 ? 4 : 16);
-                for (int s = 0; s < 64; ++s) {
-                    const int idx = (s / stride) % 4;
-                    const int base = s - idx * stride;
-                    double acc = 0.0;
-                    for (int m = 0; m < 4; ++m) acc += conv[idx][m] * f[base + m * stride];
-                    g[s] = acc;
-                }
-                memcpy(f, g, sizeof f);
-            }
+    for (int a = 0; a < 32; ++a) {
+        double f[64], g[64];
+        for (int s = 0; s < 64; ++s) f[s] = t->val[s][a];
+        for (int axis = 0; axis < 3; ++axis) {
+            const int stride = axis == 0 ? 1 : (axis == 1 ? 4 : 16);
             for (int s = 0; s < 64; ++s) {
-                if (d < 3) t->m[d][s][a] = f[s];
-                else t->val[s][a] = f[s];
+                const int idx = (s / stride) % 4;
+                const int base = s - idx * stride;
+                double acc = 0.0;
+                for (int m = 0; m < 4; ++m) acc += conv[idx][m] * f[base + m * stride];
+                g[s] = acc;
             }
+            memcpy(f, g, sizeof f);
         }
+        for (int s = 0; s < 64; ++s) t->val[s][a] = f[s];
+    }
 }
 
 typedef struct finalize_ctx {
@@ -517,14 +514,29 @@ static void cell_bound_task(void* vctx, uint32_t task)
             if (v[a] == SCC_GRID_NO_VALUE) hole = 1;
         }
         if (hole) { g->cell_lipschitz[c] = -1.0f; continue; }
+        /* Bernstein coefficients of phi on the cell (degree 3 per axis), then those of each
+         * partial derivative by differences: d/dxi of a cubic Bernstein form on [-1,1] has the
+         * degree-2 coefficients 1.5 (b[i+1] - b[i]) along that axis. */
+        double b[64];
+        for (int s = 0; s < 64; ++s) {
+            const double* row = ctx->bt->val[s];
+            double acc = 0.0;
+            for (int k = 0; k < 32; ++k) acc += row[k] * v[k];
+            b[s] = acc;
+        }
         double sum2 = 0.0;
         for (int d = 0; d < 3; ++d) {
+            const int stride = d == 0 ? 1 : (d == 1 ? 4 : 16);
             double bmax = 0.0;
             for (int s = 0; s < 64; ++s) {
-                const double* row = ctx->bt->m[d][s];
-                double acc = 0.0;
-                for (int a = 0; a < 32; ++a) acc += row[a] * v[a];
-                if (fabs(acc) > bmax) bmax = fabs(acc);
+                if ((s / stride) % 4 != 0) continue;
+                /* degree-2 coefficients along d, elevated back to degree 3 (convex combinations,
+                 * so the enclosure only gets tighter) */
+                const double e0 = 1.5 * (b[s + stride] - b[s]), e1 = 1.5 * (b[s + 2 * stride] - b[s + stride]),
+                             e2 = 1.5 * (b[s + 3 * stride] - b[s + 2 * stride]);
+                const double q[4] = { e0, (e0 + 2.0 * e1) / 3.0, (2.0 * e1 + e2) / 3.0, e2 };
+                for (int m = 0; m < 4; ++m)
+                    if (fabs(q[m]) > bmax) bmax = fabs(q[m]);
             }
             sum2 += (c0[d] * bmax) * (c0[d] * bmax);
         }
