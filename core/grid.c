@@ -86,6 +86,62 @@ void scc_cell_shape(scc_vec3 xi, double N[32], double dN[32][3])
     }
 }
 
+void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double out_grad[3])
+{
+    /* The same interpolant as sum_a v[a] N_a, factored: the corner part is
+     * (9 r^2 - 19)/64 times the trilinear form S of the corner values, and each edge family is
+     * (9/64)(1 - x_d^2) times a cubic factor in x_d times a bilinear form in the other two. */
+    const double x[3] = { xi.x, xi.y, xi.z };
+    double L[3][2];
+    for (int d = 0; d < 3; ++d) { L[d][0] = 1.0 - x[d]; L[d][1] = 1.0 + x[d]; }
+    double S = 0.0, Sx = 0.0, Sy = 0.0, Sz = 0.0;
+    for (int a = 0; a < 8; ++a) {
+        const int i0 = a & 1, i1 = (a >> 1) & 1, i2 = (a >> 2) & 1;
+        const double yz = L[1][i1] * L[2][i2];
+        S += v[a] * L[0][i0] * yz;
+        if (out_grad) {
+            Sx += (i0 ? v[a] : -v[a]) * yz;
+            Sy += (i1 ? v[a] : -v[a]) * L[0][i0] * L[2][i2];
+            Sz += (i2 ? v[a] : -v[a]) * L[0][i0] * L[1][i1];
+        }
+    }
+    const double q = 9.0 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) - 19.0;
+    double phi = (1.0 / 64.0) * q * S;
+    double g[3] = { 0.0, 0.0, 0.0 };
+    if (out_grad) {
+        g[0] = (1.0 / 64.0) * (q * Sx + 18.0 * x[0] * S);
+        g[1] = (1.0 / 64.0) * (q * Sy + 18.0 * x[1] * S);
+        g[2] = (1.0 / 64.0) * (q * Sz + 18.0 * x[2] * S);
+    }
+    for (int d = 0; d < 3; ++d) {
+        const int p = d == 0 ? 1 : (d == 1 ? 2 : 0); /* outer axis of the slot nesting */
+        const int r = d == 0 ? 2 : (d == 1 ? 0 : 1); /* inner axis */
+        const double* e = v + 8 + 8 * d;             /* e[4 dp + 2 dr + s] */
+        const double w = 1.0 - x[d] * x[d];
+        const double m0 = 1.0 - 3.0 * x[d], m1 = 1.0 + 3.0 * x[d];
+        double B[2] = { 0.0, 0.0 }, Bp[2] = { 0.0, 0.0 }, Br[2] = { 0.0, 0.0 };
+        for (int dp = 0; dp < 2; ++dp)
+            for (int dr = 0; dr < 2; ++dr)
+                for (int t = 0; t < 2; ++t) {
+                    const double val = e[4 * dp + 2 * dr + t];
+                    B[t] += val * L[p][dp] * L[r][dr];
+                    if (out_grad) {
+                        Bp[t] += (dp ? val : -val) * L[r][dr];
+                        Br[t] += (dr ? val : -val) * L[p][dp];
+                    }
+                }
+        const double m = m0 * B[0] + m1 * B[1];
+        phi += (9.0 / 64.0) * w * m;
+        if (out_grad) {
+            g[d] += (9.0 / 64.0) * (-2.0 * x[d] * m + w * 3.0 * (B[1] - B[0]));
+            g[p] += (9.0 / 64.0) * w * (m0 * Bp[0] + m1 * Bp[1]);
+            g[r] += (9.0 / 64.0) * w * (m0 * Br[0] + m1 * Br[1]);
+        }
+    }
+    *out_value = phi;
+    if (out_grad) { out_grad[0] = g[0]; out_grad[1] = g[1]; out_grad[2] = g[2]; }
+}
+
 /* ------------------------------------------------------------------------------------------
  * Grid data
  * ---------------------------------------------------------------------------------------- */
@@ -286,15 +342,9 @@ static int interpolate_cell(const scc_grid* g, const scc_grid_field* fd, uint32_
     for (int a = 0; a < 32; ++a) v[a] = fd->nodes[ids[a]];
     for (int a = 0; a < 32; ++a) missing |= v[a] == SCC_GRID_NO_VALUE;
     if (missing) return 0;
-    double N[32], dN[32][3];
-    scc_cell_shape(xi, N, out_grad ? dN : NULL);
-    double phi = 0.0, gx = 0.0, gy = 0.0, gz = 0.0;
-    for (int a = 0; a < 32; ++a) {
-        phi += v[a] * N[a];
-        if (out_grad) { gx += v[a] * dN[a][0]; gy += v[a] * dN[a][1]; gz += v[a] * dN[a][2]; }
-    }
-    *out_value = phi;
-    if (out_grad) *out_grad = scc_v3(gx * c0[0], gy * c0[1], gz * c0[2]);
+    double gr[3];
+    scc_cell_eval(v, xi, out_value, out_grad ? gr : NULL);
+    if (out_grad) *out_grad = scc_v3(gr[0] * c0[0], gr[1] * c0[1], gr[2] * c0[2]);
     return 1;
 }
 

@@ -36,6 +36,9 @@
 scc_vec3 scc_cell_node_local(int slot);
 /* Shape functions N[32] at local point xi; when dN is not NULL also dN/dxi (dN[a][d]). */
 void scc_cell_shape(scc_vec3 xi, double N[32], double dN[32][3]);
+/* sum_a v[a] N_a(xi) and, when out_grad is not NULL, its derivatives with respect to xi, in a
+ * factored form (about 4x fewer operations than going through scc_cell_shape). */
+void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double out_grad[3]);
 
 /* ---- grid data ---- */
 

@@ -125,6 +125,26 @@ START_TEST(test_element_cubic_reproduction)
 }
 END_TEST
 
+/* The factored evaluator equals the sum over the shape functions. */
+START_TEST(test_element_fused_eval)
+{
+    test_rng rng = { 13 };
+    for (int it = 0; it < 2000; ++it) {
+        double v[32], N[32], dN[32][3];
+        for (int a = 0; a < 32; ++a) v[a] = test_rng_uniform(&rng, -2, 2);
+        scc_vec3 xi = scc_v3(test_rng_uniform(&rng, -1, 1), test_rng_uniform(&rng, -1, 1), test_rng_uniform(&rng, -1, 1));
+        scc_cell_shape(xi, N, dN);
+        double f = 0, g[3] = { 0, 0, 0 }, ff, gg[3];
+        for (int a = 0; a < 32; ++a) { f += v[a] * N[a]; for (int d = 0; d < 3; ++d) g[d] += v[a] * dN[a][d]; }
+        scc_cell_eval(v, xi, &ff, gg);
+        ck_assert_double_near(ff, f, 1e-13);
+        for (int d = 0; d < 3; ++d) ck_assert_double_near(gg[d], g[d], 1e-12);
+        scc_cell_eval(v, xi, &ff, NULL);
+        ck_assert_double_near(ff, f, 1e-13);
+    }
+}
+END_TEST
+
 /* The table of the notes: slot 9 = (+1/3,-1,-1), 10 = (-1/3,-1,+1), 12 = (-1/3,+1,-1),
  * 18 = (+1,-1/3,-1), 20 = (-1,-1/3,+1), 26 = (-1,+1,-1/3), 28 = (+1,-1,-1/3). */
 START_TEST(test_element_slot_order)
@@ -542,6 +562,7 @@ int main(void)
     tcase_add_test(tc, test_element_kronecker_and_unity);
     tcase_add_test(tc, test_element_cubic_reproduction);
     tcase_add_test(tc, test_element_slot_order);
+    tcase_add_test(tc, test_element_fused_eval);
     suite_add_tcase(s, tc);
     tc = tcase_create("files");
     test_add_memory_fixture(tc);
