@@ -203,7 +203,7 @@ size_t scc_grid_memory(const scc_grid* g)
     size_t b = sizeof *g + (size_t)g->field_count * sizeof *g->fields;
     for (uint32_t f = 0; f < g->field_count; ++f) {
         const scc_grid_field* fd = &g->fields[f];
-        b += (size_t)fd->node_count * sizeof(double) + (size_t)fd->cell_count * 32 * sizeof(uint32_t)
+        b += (size_t)fd->node_count * sizeof(double) + (fd->cells ? (size_t)fd->cell_count * 32 * sizeof(uint32_t) : 0)
            + (fd->map ? (size_t)g->n_cells * sizeof(uint32_t) : 0);
     }
     if (g->cell_lipschitz) b += (size_t)g->fields[0].cell_count * sizeof(float);
@@ -292,6 +292,16 @@ void scc_grid_dense_cell_nodes(const uint32_t res[3], uint32_t i, uint32_t j, ui
  * Evaluation
  * ---------------------------------------------------------------------------------------- */
 
+const uint32_t* scc_grid_cell_ids(const scc_grid* g, uint32_t field, uint32_t c, uint32_t scratch[32])
+{
+    const scc_grid_field* fd = &g->fields[field];
+    if (fd->cells) return fd->cells + (size_t)c * 32;
+    /* dense field 0 without a table: stored cell c is full-grid cell c */
+    const uint32_t i = (uint32_t)(c % g->res[0]), j = (uint32_t)((c / g->res[0]) % g->res[1]), k = (uint32_t)(c / ((uint64_t)g->res[0] * g->res[1]));
+    scc_grid_dense_cell_nodes(g->res, i, j, k, scratch);
+    return scratch;
+}
+
 static inline void cell_ijk(const scc_grid* g, uint64_t l, uint32_t ijk[3])
 {
     ijk[0] = (uint32_t)(l % g->res[0]);
@@ -335,8 +345,15 @@ static int interpolate_cell(const scc_grid* g, const scc_grid_field* fd, uint32_
     const double c0[3] = { 2.0 / den[0], 2.0 / den[1], 2.0 / den[2] };
     const double c1[3] = { (b.hi.x + b.lo.x) / den[0], (b.hi.y + b.lo.y) / den[1], (b.hi.z + b.lo.z) / den[2] };
     const scc_vec3 xi = scc_v3(c0[0] * p.x - c1[0], c0[1] * p.y - c1[1], c0[2] * p.z - c1[2]);
-    /* Gather the 32 values first: independent loads let the memory accesses overlap. */
-    const uint32_t* ids = fd->cells + (size_t)c * 32;
+    /* Gather the 32 values first: independent loads let the memory accesses overlap. A dense
+     * field 0 in Discregrid's numbering computes the node ids instead of reading the table. */
+    uint32_t dense_ids[32];
+    const uint32_t* ids;
+    if (fd->cells) ids = fd->cells + (size_t)c * 32;
+    else {
+        scc_grid_dense_cell_nodes(g->res, ijk[0], ijk[1], ijk[2], dense_ids);
+        ids = dense_ids;
+    }
     double v[32];
     int missing = 0;
     for (int a = 0; a < 32; ++a) v[a] = fd->nodes[ids[a]];
@@ -556,7 +573,8 @@ static void cell_bound_task(void* vctx, uint32_t task)
     if (end > fd->cell_count) end = fd->cell_count;
     const double c0[3] = { 2.0 / g->h.x, 2.0 / g->h.y, 2.0 / g->h.z };
     for (uint64_t c = begin; c < end; ++c) {
-        const uint32_t* ids = fd->cells + c * 32;
+        uint32_t scratch[32];
+        const uint32_t* ids = scc_grid_cell_ids(g, 0, (uint32_t)c, scratch);
         double v[32];
         int hole = 0;
         for (int a = 0; a < 32; ++a) {
@@ -629,6 +647,23 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     }
     if (g->valued_cells == 0) { scc_free(a, bt, sizeof *bt); return SCC_GRID_EMPTY; }
 
+    /* Dense Discregrid layout of field 0 (identity map, tables equal to the formulas)? Then
+     * the node ids are computed and the 128-byte-per-cell table is not kept. */
+    if (fd->cells) {
+        int dense = fd->cell_count == g->n_cells && fd->node_count == scc_grid_dense_node_count(g->res);
+        for (uint64_t l = 0; l < g->n_cells && dense; ++l) {
+            uint32_t ijk[3], ids[32];
+            cell_ijk(g, l, ijk);
+            scc_grid_dense_cell_nodes(g->res, ijk[0], ijk[1], ijk[2], ids);
+            dense = fd->map[l] == l && memcmp(ids, fd->cells + l * 32, sizeof ids) == 0;
+        }
+        if (dense) {
+            scc_free(a, fd->cells, (size_t)fd->cell_count * 32 * sizeof(uint32_t));
+            fd->cells = NULL;
+        }
+    }
+    g->dense_layout = fd->cells == NULL;
+
     /* Hole sources: multi-source breadth-first search over the 26-neighbourhood from every
      * cell with values, so each hole cell learns a valued cell at the least Chebyshev
      * distance; then the side (sign) from that cell's value at the point nearest the hole's
@@ -700,7 +735,9 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
             continue;
         }
         double v[32];
-        for (int s = 0; s < 32; ++s) v[s] = fd->nodes[fd->cells[(size_t)c * 32 + s]];
+        uint32_t scratch[32];
+        const uint32_t* ids = scc_grid_cell_ids(g, 0, c, scratch);
+        for (int s = 0; s < 32; ++s) v[s] = fd->nodes[ids[s]];
         for (int s = 0; s < 64 && boundary_nonneg; ++s) {
             const int idx[3] = { s % 4, (s / 4) % 4, s / 16 };
             int on_face = 0;

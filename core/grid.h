@@ -45,7 +45,8 @@ void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double ou
 typedef struct scc_grid_field {
     double* nodes;        /* node_count values */
     uint64_t node_count;
-    uint32_t* cells;      /* 32 * cell_count node ids, slot order */
+    uint32_t* cells;      /* 32 * cell_count node ids, slot order; NULL for a dense field 0 in
+                             Discregrid's numbering (ids computed: scc_grid_cell_ids) */
     uint64_t cell_count;
     uint32_t* map;        /* n_cells entries: stored cell index or SCC_GRID_NO_CELL */
 } scc_grid_field;
@@ -68,6 +69,7 @@ typedef struct scc_grid {
     uint64_t valued_cells;     /* cells of field 0 with values */
     double band;               /* known lower bound on |phi| in cells without value (0 if unknown) */
     double lipschitz_max;      /* max of cell_lipschitz */
+    int dense_layout;          /* field 0 is dense in Discregrid's numbering (fields[0].cells is NULL) */
     scc_allocator allocator;   /* what freed the arrays (copied at creation) */
 } scc_grid;
 
@@ -102,6 +104,10 @@ typedef enum scc_grid_status {
  * culled cells) and fills the scc_sdf interface. Safe to call once after the fields are set.
  * `band`: a known lower bound on |phi| inside culled cells (0 when unknown). */
 scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn* parallel_for, void* parallel_user);
+
+/* The 32 node ids of stored cell c of `field` (from the table, or computed into `scratch` for
+ * a dense field 0). */
+const uint32_t* scc_grid_cell_ids(const scc_grid* g, uint32_t field, uint32_t c, uint32_t scratch[32]);
 
 /* Bytes owned by the grid (header, fields, derived arrays). */
 size_t scc_grid_memory(const scc_grid* g);

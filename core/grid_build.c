@@ -116,18 +116,12 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
     if (!fd->map) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
 
     if (!banded) {
+        /* Dense: Discregrid's numbering, identity map; the cell table is implied (NULL). */
         fd->nodes = nodes;
         fd->node_count = n_nodes;
-        fd->cells = scc_alloc(a, (size_t)n_cells * 32 * sizeof(uint32_t));
-        if (!fd->cells) { scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+        fd->cells = NULL;
         fd->cell_count = n_cells;
-        uint64_t l = 0;
-        for (uint32_t k = 0; k < def->res[2]; ++k)
-            for (uint32_t j = 0; j < def->res[1]; ++j)
-                for (uint32_t i = 0; i < def->res[0]; ++i, ++l) {
-                    scc_grid_dense_cell_nodes(def->res, i, j, k, fd->cells + l * 32);
-                    fd->map[l] = (uint32_t)l;
-                }
+        for (uint64_t l = 0; l < n_cells; ++l) fd->map[l] = (uint32_t)l;
     } else {
         /* Narrow band: keep a cell when any of its nodes is nearer than band + |h| to the
          * surface. Culled cells then satisfy |phi| >= band everywhere (every point of a cell

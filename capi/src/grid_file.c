@@ -208,7 +208,13 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
     ok = ok && wr(f, &n_fields, 8);
     for (uint32_t i = 0; ok && i < g->field_count; ++i) {
         const uint64_t c = g->fields[i].cell_count;
-        ok = wr(f, &c, 8) && wr(f, g->fields[i].cells, (size_t)c * 128);
+        ok = wr(f, &c, 8);
+        if (g->fields[i].cells) ok = ok && wr(f, g->fields[i].cells, (size_t)c * 128);
+        else /* dense field 0: the table is implied; write it out */
+            for (uint64_t k = 0; ok && k < c; ++k) {
+                uint32_t scratch[32];
+                ok = wr(f, scc_grid_cell_ids(g, i, (uint32_t)k, scratch), 128);
+            }
     }
     ok = ok && wr(f, &n_fields, 8);
     for (uint32_t i = 0; ok && i < g->field_count; ++i) ok = wr(f, &n_cells, 8) && wr(f, g->fields[i].map, (size_t)n_cells * 4);
