@@ -117,7 +117,7 @@ static void build_node(build_state* s, uint32_t node, uint32_t lo, uint32_t hi)
         cbox.lo = scc_vmin(cbox.lo, s->items[i].centroid); cbox.hi = scc_vmax(cbox.hi, s->items[i].centroid);
     }
     bvh->nodes[node].box = box;
-    if (hi - lo <= 4) {
+    if (hi - lo <= 8) {
         bvh->nodes[node].first = lo;
         bvh->nodes[node].count = hi - lo;
         return;
