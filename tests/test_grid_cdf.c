@@ -511,6 +511,32 @@ START_TEST(test_corrupt_files)
         else put_f64(b, cases[i].at, cases[i].d);
         expect_format_error(b, n, cases[i].what);
     }
+    /* a not-sampled node (DBL_MAX) in field 0: the file loads; the cells around it have no raw
+     * value, and evaluation there falls back to a finite conservative value of the right side */
+    memcpy(b, orig, n);
+    {
+        uint32_t ids[32];
+        const uint32_t res[3] = { 5, 5, 5 };
+        scc_grid_dense_cell_nodes(res, 4, 2, 2, ids); /* a cell holding the box's +x face */
+        put_f64(b, nodes_at + 8 * (size_t)ids[1], 1.7976931348623157e308);
+        sdfccd_SdfId id;
+        ck_assert_int_eq(sdfccd_load_grid_memory(b, n, &id), SDFCCD_OK);
+        sdfccd_GridInfo gi;
+        ck_assert_int_eq(sdfccd_grid_get_info(id, &gi), SDFCCD_OK);
+        ck_assert_int_lt(gi.valued_cells, 125);
+        scc_grid* g = grid_of(id);
+        const sdfccd_Vec3 p = { g->lo.x + 4.6 * g->h.x, g->lo.y + 2.5 * g->h.y, g->lo.z + 2.5 * g->h.z };
+        double v, raw;
+        sdfccd_Vec3 gr;
+        int32_t has;
+        ck_assert_int_eq(sdfccd_grid_interpolate(id, 0, p, &raw, NULL, &has), SDFCCD_OK);
+        ck_assert_int_eq(has, 0);
+        ck_assert_int_eq(sdfccd_sdf_eval(id, p, &v, &gr), SDFCCD_OK);
+        const double exact = box_sdf(capi_v(p), 1.0); /* the point is inside the box, in the +x face cell */
+        ck_assert_msg(isfinite(v) && (v < 0) == (exact < 0) && fabs(v) <= fabs(exact) + 1e-12, "fallback %g, box distance %g", v, exact);
+        ck_assert_double_near(gr.x * gr.x + gr.y * gr.y + gr.z * gr.z, 1.0, 1e-9);
+        ck_assert_int_eq(sdfccd_destroy_sdf(id), SDFCCD_OK);
+    }
     /* every cell culled: a valid file but no SDF */
     memcpy(b, orig, n);
     for (int i = 0; i < 125; ++i) put_u32(b, map_at + 4 * (size_t)i, 0xFFFFFFFFu);
