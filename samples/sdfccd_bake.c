@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT
  * sdfccd_bake: builds a Discregrid-compatible grid SDF (.cdf) from a mesh file.
  *
- *   sdfccd_bake MESH -r N [-d "minx miny minz maxx maxy maxz"] [--band W] [-t threads]
+ *   sdfccd_bake MESH -r N [-d "minx miny minz maxx maxy maxz" | --pad P] [--band W] [-t threads]
  *               [-i] [--allow-open] [--samples K] -o OUT.cdf
  *
  * -r takes one count (N^3 cells) or three ("NX NY NZ" or NX,NY,NZ). Without -d the domain is
@@ -22,11 +22,12 @@
 static void usage(FILE* f)
 {
     fprintf(f,
-            "usage: sdfccd_bake MESH -r N [-d \"minx miny minz maxx maxy maxz\"] [--band W] [-t threads]\n"
+            "usage: sdfccd_bake MESH -r N [-d \"minx miny minz maxx maxy maxz\" | --pad P] [--band W] [-t threads]\n"
             "                   [-i] [--allow-open] [--samples K] -o OUT.cdf\n"
             "  MESH          any mesh file assimp reads (OBJ is read in double precision)\n"
             "  -r N          cells per axis: N, or \"NX NY NZ\" / NX,NY,NZ\n"
             "  -d BOX        domain (metres, mesh frame); default: the mesh box enlarged by 0.1%% of its diagonal\n"
+            "  --pad P       with the default domain: add P metres on every side\n"
             "  --band W      keep only cells within W (+ one cell diagonal) of the surface; default dense\n"
             "  -t T          threads (default: all cores)\n"
             "  -i            store -phi (positive inside), for containers\n"
@@ -103,6 +104,10 @@ int main(int argc, char** argv)
             if (parse_numbers(argv[++i], v, 6) != 6) { fprintf(stderr, "sdfccd_bake: error: -d expects 6 numbers, got '%s'\n", argv[i]); return 2; }
             def.fit_domain = 0;
             def.domain = (sdfccd_Aabb){ { v[0], v[1], v[2] }, { v[3], v[4], v[5] } };
+        } else if (!strcmp(a, "--pad") && has_next) {
+            double v;
+            if (parse_numbers(argv[++i], &v, 1) != 1 || !(v >= 0)) { fprintf(stderr, "sdfccd_bake: error: --pad expects a width >= 0, got '%s'\n", argv[i]); return 2; }
+            def.padding = v;
         } else if (!strcmp(a, "--band") && has_next) {
             double v;
             if (parse_numbers(argv[++i], &v, 1) != 1 || !(v > 0)) { fprintf(stderr, "sdfccd_bake: error: --band expects a positive width, got '%s'\n", argv[i]); return 2; }

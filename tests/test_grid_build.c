@@ -471,6 +471,17 @@ START_TEST(test_bad_defs)
     def.resolution[1] = 0;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
     def = sdfccd_default_grid_def();
+    def.padding = -1.0;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
+    def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 4;
+    def.padding = 0.25;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_OK);
+    sdfccd_GridInfo pinfo;
+    ck_assert_int_eq(sdfccd_grid_get_info(g, &pinfo), SDFCCD_OK);
+    ck_assert(pinfo.domain.hi.x > 0.75 && pinfo.domain.hi.x < 0.76 && pinfo.domain.lo.z < -0.75);
+    ck_assert_int_eq(sdfccd_destroy_sdf(g), SDFCCD_OK);
+    def = sdfccd_default_grid_def();
     def.band = NAN;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
     def = sdfccd_default_grid_def();

@@ -162,6 +162,8 @@ static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
         if (!(def->domain.lo.x < def->domain.hi.x && def->domain.lo.y < def->domain.hi.y && def->domain.lo.z < def->domain.hi.z))
             return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: domain.lo must be below domain.hi on every axis", fn);
     }
+    if (!(def->padding >= 0.0) || !isfinite(def->padding))
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: padding = %g must be finite and >= 0", fn, def->padding);
     if (!(def->band >= 0.0) || isnan(def->band))
         return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: band = %g must be >= 0 (0 = dense)", fn, def->band);
     if (def->threads < 0) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: threads = %d must be >= 0", fn, def->threads);
@@ -179,6 +181,15 @@ static sdfccd_Status build_status(scc_grid_build_status st, const char* fn)
     case SCC_GRID_BUILD_CANCELLED: return capi_error(SDFCCD_BAD_STATE, "%s: cancelled", fn);
     }
     return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: unknown build failure", fn);
+}
+
+static scc_aabb padded(scc_aabb b, double pad)
+{
+    if (pad > 0.0) {
+        b.lo = scc_sub(b.lo, scc_v3(pad, pad, pad));
+        b.hi = scc_add(b.hi, scc_v3(pad, pad, pad));
+    }
+    return b;
 }
 
 static void fill_build_def(scc_grid_build_def* bd, const sdfccd_GridDef* def, scc_aabb domain, capi_pool* pool)
@@ -232,7 +243,7 @@ sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_Grid
         scc_mesh_sdf_destroy(&ms);
         return st;
     }
-    const scc_aabb domain = def->fit_domain ? scc_grid_fit_domain(m->mesh.bounds) : capi_box(def->domain);
+    const scc_aabb domain = def->fit_domain ? padded(scc_grid_fit_domain(m->mesh.bounds), def->padding) : capi_box(def->domain);
     capi_pool pool;
     capi_pool_init(&pool, def->threads, def->progress, def->progress_user);
     scc_grid_build_def bd;
@@ -270,7 +281,7 @@ sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef
     if (def->fit_domain) {
         if (!scc_vfinite(s->sdf->bounds.lo) || !scc_vfinite(s->sdf->bounds.hi))
             return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the SDF's bounds are infinite; set fit_domain = 0 and a domain", fn);
-        domain = scc_grid_fit_domain(s->sdf->bounds);
+        domain = padded(scc_grid_fit_domain(s->sdf->bounds), def->padding);
     } else {
         domain = capi_box(def->domain);
     }

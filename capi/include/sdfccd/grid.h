@@ -102,6 +102,10 @@ typedef struct sdfccd_GridDef {
      * 0: `domain` is used as given. */
     int32_t fit_domain;
     sdfccd_Aabb domain;     /**< Grid box (m, local frame) when fit_domain is 0; lo < hi on every axis. */
+    /** With fit_domain 1: extra margin (m, >= 0) added on every side of the fitted box, so that
+     * queries a little outside the surface still read grid values (outside the domain only the
+     * conservative continuation is available). Default 0 (exactly Discregrid's domain). */
+    double padding;
     /** Narrow band half-width (m). 0 (default): dense, exactly Discregrid's layout. > 0: cells whose
      * 32 node values all satisfy |phi| >= band + |cell diagonal| are culled; |phi| >= band holds in
      * every culled cell and evaluation there returns a conservative value. */
@@ -117,7 +121,7 @@ typedef struct sdfccd_GridDef {
     int32_t internal_value; /**< Set by sdfccd_default_grid_def(); do not change. */
 } sdfccd_GridDef;
 
-/** Defaults: 32^3 cells, fitted domain, dense, all cores, not inverted, closed meshes only, no progress. */
+/** Defaults: 32^3 cells, fitted domain without padding, dense, all cores, not inverted, closed meshes only, no progress. */
 SDFCCD_API sdfccd_GridDef sdfccd_default_grid_def(void);
 
 /** Samples the exact signed distance of a mesh at every node (BVH + pseudonormals, exact to
