@@ -312,7 +312,7 @@ START_TEST(test_ccd_on_grid)
     sdfccd_Vec3 tri[3] = { { -0.1, -0.1, 0.7 }, { 0.1, -0.1, 0.7 }, { 0.0, 0.12, 0.7 } };
     sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
     m.linear_velocity = (sdfccd_Vec3){ 0.0, 0.0, -12.0 };
-    const sdfccd_Method methods[] = { SDFCCD_METHOD_FWGSS, SDFCCD_METHOD_DCD, SDFCCD_METHOD_CERTIFIED };
+    const sdfccd_Method methods[] = { SDFCCD_METHOD_FWGSS, SDFCCD_METHOD_FW, SDFCCD_METHOD_DCD, SDFCCD_METHOD_CERTIFIED };
     const double toi = (0.7 - 0.5) / 12.0; /* the lowest point (0, -0.1, 0.7) is at |p| = 0.707: first contact near t = 0.0167 */
     for (size_t k = 0; k < sizeof methods / sizeof methods[0]; ++k) {
         sdfccd_QueryParams qp = sdfccd_default_query_params();
