@@ -12,7 +12,7 @@
  *    Discregrid and Bullet compute them, gradient not normalised);
  *  - in a culled cell (or one touching a "not sampled" node): a conservative value whose sign
  *    is the side of the surface and whose magnitude is a lower bound on the distance, with a
- *    unit gradient pointing away from the nearest cell that has values (scc_grid_fallback);
+ *    unit gradient pointing away from the nearest cell that has values (see eval_hole in grid.c);
  *  - outside the domain box: a lower bound built from the distance d to the box and the value
  *    phi(p) at the nearest box point p (see scc_grid_eval).
  * All routines are pure; evaluation is thread-safe. Memory comes from the caller's allocator.
