@@ -194,6 +194,7 @@ void scc_grid_destroy(scc_grid* g)
         scc_free(&al, g->cell_lipschitz, (size_t)g->fields[0].cell_count * sizeof(float));
     }
     scc_free(&al, g->hole_source, (size_t)g->n_cells * sizeof(uint32_t));
+    scc_free(&al, g->blocks, (size_t)g->block_count * sizeof(double));
     scc_free(&al, g->fields, (size_t)g->field_count * sizeof *g->fields);
     scc_free(&al, g, sizeof *g);
 }
@@ -203,11 +204,12 @@ size_t scc_grid_memory(const scc_grid* g)
     size_t b = sizeof *g + (size_t)g->field_count * sizeof *g->fields;
     for (uint32_t f = 0; f < g->field_count; ++f) {
         const scc_grid_field* fd = &g->fields[f];
-        b += (size_t)fd->node_count * sizeof(double) + (fd->cells ? (size_t)fd->cell_count * 32 * sizeof(uint32_t) : 0)
+        b += (fd->nodes ? (size_t)fd->node_count * sizeof(double) : 0) + (fd->cells ? (size_t)fd->cell_count * 32 * sizeof(uint32_t) : 0)
            + (fd->map ? (size_t)g->n_cells * sizeof(uint32_t) : 0);
     }
     if (g->cell_lipschitz) b += (size_t)g->fields[0].cell_count * sizeof(float);
     if (g->hole_source) b += (size_t)g->n_cells * sizeof(uint32_t);
+    b += (size_t)g->block_count * sizeof(double);
     return b;
 }
 
@@ -292,6 +294,58 @@ void scc_grid_dense_cell_nodes(const uint32_t res[3], uint32_t i, uint32_t j, ui
  * Evaluation
  * ---------------------------------------------------------------------------------------- */
 
+uint64_t scc_grid_dense_block_index(const uint32_t res[3], uint64_t l)
+{
+    /* Vertex-block layout: vertex (i,j,k) owns 7 consecutive values: its own, then the two
+     * nodes of the x, y and z edges that start at it. */
+    const uint64_t nx = res[0], ny = res[1], nz = res[2];
+    const uint64_t nv = (nx + 1) * (ny + 1) * (nz + 1);
+    const uint64_t ex = nx * (ny + 1) * (nz + 1), ey = (nx + 1) * ny * (nz + 1);
+    uint64_t i, j, k, slot;
+    if (l < nv) return 7 * l;
+    if (l < nv + 2 * ex) {
+        const uint64_t e = (l - nv) / 2;
+        slot = 1 + (l - nv) % 2;
+        k = e / (nx * (ny + 1)); j = (e % (nx * (ny + 1))) / nx; i = e % nx;
+    } else if (l < nv + 2 * (ex + ey)) {
+        const uint64_t e = (l - nv - 2 * ex) / 2;
+        slot = 3 + (l - nv - 2 * ex) % 2;
+        i = e / (ny * (nz + 1)); k = (e % (ny * (nz + 1))) / ny; j = e % ny;
+    } else {
+        const uint64_t e = (l - nv - 2 * (ex + ey)) / 2;
+        slot = 5 + (l - nv - 2 * (ex + ey)) % 2;
+        j = e / (nz * (nx + 1)); i = (e % (nz * (nx + 1))) / nz; k = e % nz;
+    }
+    return 7 * (i + (nx + 1) * (j + (ny + 1) * k)) + slot;
+}
+
+double scc_grid_node_value(const scc_grid* g, uint32_t field, uint64_t id)
+{
+    if (field == 0 && g->blocks) return g->blocks[scc_grid_dense_block_index(g->res, id)];
+    return g->fields[field].nodes[id];
+}
+
+/* The 32 values of stored cell c (full-grid position ijk) of a field, in slot order. */
+static inline void gather_cell(const scc_grid* g, const scc_grid_field* fd, uint32_t c, const uint32_t ijk[3], double v[32])
+{
+    if (fd == &g->fields[0] && g->blocks) {
+        const uint64_t n1x = (uint64_t)g->res[0] + 1, n1y = (uint64_t)g->res[1] + 1;
+        for (int dk = 0; dk < 2; ++dk)
+            for (int dj = 0; dj < 2; ++dj)
+                for (int di = 0; di < 2; ++di) {
+                    const double* b = g->blocks + 7 * ((ijk[0] + di) + n1x * ((ijk[1] + dj) + n1y * (uint64_t)(ijk[2] + dk)));
+                    v[di + 2 * dj + 4 * dk] = b[0];
+                    if (!di) { v[8 + 4 * dj + 2 * dk] = b[1]; v[9 + 4 * dj + 2 * dk] = b[2]; }
+                    if (!dj) { v[16 + 4 * dk + 2 * di] = b[3]; v[17 + 4 * dk + 2 * di] = b[4]; }
+                    if (!dk) { v[24 + 4 * di + 2 * dj] = b[5]; v[25 + 4 * di + 2 * dj] = b[6]; }
+                }
+        return;
+    }
+    uint32_t scratch[32];
+    const uint32_t* ids = fd->cells ? fd->cells + (size_t)c * 32 : scc_grid_cell_ids(g, (uint32_t)(fd - g->fields), c, scratch);
+    for (int a = 0; a < 32; ++a) v[a] = fd->nodes[ids[a]];
+}
+
 const uint32_t* scc_grid_cell_ids(const scc_grid* g, uint32_t field, uint32_t c, uint32_t scratch[32])
 {
     const scc_grid_field* fd = &g->fields[field];
@@ -346,17 +400,10 @@ static int interpolate_cell(const scc_grid* g, const scc_grid_field* fd, uint32_
     const double c1[3] = { (b.hi.x + b.lo.x) / den[0], (b.hi.y + b.lo.y) / den[1], (b.hi.z + b.lo.z) / den[2] };
     const scc_vec3 xi = scc_v3(c0[0] * p.x - c1[0], c0[1] * p.y - c1[1], c0[2] * p.z - c1[2]);
     /* Gather the 32 values first: independent loads let the memory accesses overlap. A dense
-     * field 0 in Discregrid's numbering computes the node ids instead of reading the table. */
-    uint32_t dense_ids[32];
-    const uint32_t* ids;
-    if (fd->cells) ids = fd->cells + (size_t)c * 32;
-    else {
-        scc_grid_dense_cell_nodes(g->res, ijk[0], ijk[1], ijk[2], dense_ids);
-        ids = dense_ids;
-    }
+     * field 0 reads them from 8 vertex blocks (see scc_grid_dense_block_index). */
     double v[32];
     int missing = 0;
-    for (int a = 0; a < 32; ++a) v[a] = fd->nodes[ids[a]];
+    gather_cell(g, fd, c, ijk, v);
     for (int a = 0; a < 32; ++a) missing |= v[a] == SCC_GRID_NO_VALUE;
     if (missing) return 0;
     double gr[3];
@@ -573,14 +620,12 @@ static void cell_bound_task(void* vctx, uint32_t task)
     if (end > fd->cell_count) end = fd->cell_count;
     const double c0[3] = { 2.0 / g->h.x, 2.0 / g->h.y, 2.0 / g->h.z };
     for (uint64_t c = begin; c < end; ++c) {
-        uint32_t scratch[32];
-        const uint32_t* ids = scc_grid_cell_ids(g, 0, (uint32_t)c, scratch);
         double v[32];
+        uint32_t ijk[3] = { 0, 0, 0 };
+        if (!fd->cells) cell_ijk(g, c, ijk); /* dense: stored cell c is full-grid cell c */
+        gather_cell(g, fd, (uint32_t)c, ijk, v);
         int hole = 0;
-        for (int a = 0; a < 32; ++a) {
-            v[a] = fd->nodes[ids[a]];
-            if (v[a] == SCC_GRID_NO_VALUE) hole = 1;
-        }
+        for (int a = 0; a < 32; ++a) hole |= v[a] == SCC_GRID_NO_VALUE;
         if (hole) { g->cell_lipschitz[c] = -1.0f; continue; }
         /* Bernstein coefficients of phi on the cell (degree 3 per axis), then those of each
          * partial derivative by differences: d/dxi of a cubic Bernstein form on [-1,1] has the
@@ -627,6 +672,33 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     if (g->n_cells > 0x7FFFFFFEu) return SCC_GRID_TOO_LARGE;
     g->band = band > 0.0 && isfinite(band) ? band : 0.0;
 
+    /* Dense Discregrid layout of field 0 (identity map, tables equal to the formulas)? Then the
+     * node ids are implied, the 128-byte-per-cell table is dropped, and the values move to the
+     * vertex-block layout (the builder writes them there directly). */
+    if (fd->cells && !g->blocks) {
+        int dense = fd->cell_count == g->n_cells && fd->node_count == scc_grid_dense_node_count(g->res);
+        for (uint64_t l = 0; l < g->n_cells && dense; ++l) {
+            uint32_t ijk[3], ids[32];
+            cell_ijk(g, l, ijk);
+            scc_grid_dense_cell_nodes(g->res, ijk[0], ijk[1], ijk[2], ids);
+            dense = fd->map[l] == l && memcmp(ids, fd->cells + l * 32, sizeof ids) == 0;
+        }
+        if (dense) {
+            const uint64_t nb = 7 * (uint64_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1);
+            double* blocks = scc_alloc(a, (size_t)nb * sizeof(double));
+            if (!blocks) return SCC_GRID_OUT_OF_MEMORY;
+            memset(blocks, 0, (size_t)nb * sizeof(double));
+            for (uint64_t l = 0; l < fd->node_count; ++l) blocks[scc_grid_dense_block_index(g->res, l)] = fd->nodes[l];
+            scc_free(a, fd->cells, (size_t)fd->cell_count * 32 * sizeof(uint32_t));
+            scc_free(a, fd->nodes, (size_t)fd->node_count * sizeof(double));
+            fd->cells = NULL;
+            fd->nodes = NULL;
+            g->blocks = blocks;
+            g->block_count = nb;
+        }
+    }
+    g->dense_layout = g->blocks != NULL;
+
     /* Per-cell gradient bounds. */
     g->cell_lipschitz = scc_alloc(a, (size_t)fd->cell_count * sizeof(float));
     bern_tables* bt = scc_alloc(a, sizeof *bt);
@@ -647,22 +719,6 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     }
     if (g->valued_cells == 0) { scc_free(a, bt, sizeof *bt); return SCC_GRID_EMPTY; }
 
-    /* Dense Discregrid layout of field 0 (identity map, tables equal to the formulas)? Then
-     * the node ids are computed and the 128-byte-per-cell table is not kept. */
-    if (fd->cells) {
-        int dense = fd->cell_count == g->n_cells && fd->node_count == scc_grid_dense_node_count(g->res);
-        for (uint64_t l = 0; l < g->n_cells && dense; ++l) {
-            uint32_t ijk[3], ids[32];
-            cell_ijk(g, l, ijk);
-            scc_grid_dense_cell_nodes(g->res, ijk[0], ijk[1], ijk[2], ids);
-            dense = fd->map[l] == l && memcmp(ids, fd->cells + l * 32, sizeof ids) == 0;
-        }
-        if (dense) {
-            scc_free(a, fd->cells, (size_t)fd->cell_count * 32 * sizeof(uint32_t));
-            fd->cells = NULL;
-        }
-    }
-    g->dense_layout = fd->cells == NULL;
 
     /* Hole sources: multi-source breadth-first search over the 26-neighbourhood from every
      * cell with values, so each hole cell learns a valued cell at the least Chebyshev
@@ -735,9 +791,7 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
             continue;
         }
         double v[32];
-        uint32_t scratch[32];
-        const uint32_t* ids = scc_grid_cell_ids(g, 0, c, scratch);
-        for (int s = 0; s < 32; ++s) v[s] = fd->nodes[ids[s]];
+        gather_cell(g, fd, c, ijk, v);
         for (int s = 0; s < 64 && boundary_nonneg; ++s) {
             const int idx[3] = { s % 4, (s / 4) % 4, s / 16 };
             int on_face = 0;

@@ -47,6 +47,7 @@ typedef struct scc_grid_field {
     uint64_t node_count;
     uint32_t* cells;      /* 32 * cell_count node ids, slot order; NULL for a dense field 0 in
                              Discregrid's numbering (ids computed: scc_grid_cell_ids) */
+    /* nodes: node_count values; NULL for a dense field 0 (values in scc_grid.blocks) */
     uint64_t cell_count;
     uint32_t* map;        /* n_cells entries: stored cell index or SCC_GRID_NO_CELL */
 } scc_grid_field;
@@ -69,7 +70,11 @@ typedef struct scc_grid {
     uint64_t valued_cells;     /* cells of field 0 with values */
     double band;               /* known lower bound on |phi| in cells without value (0 if unknown) */
     double lipschitz_max;      /* max of cell_lipschitz */
-    int dense_layout;          /* field 0 is dense in Discregrid's numbering (fields[0].cells is NULL) */
+    int dense_layout;          /* field 0 is dense in Discregrid's numbering: fields[0].cells and
+                                  fields[0].nodes are NULL (node_count stays the file's count) and
+                                  the values live in `blocks` */
+    double* blocks;            /* dense field 0: 7 values per grid vertex (scc_grid_dense_block_index) */
+    uint64_t block_count;
     scc_allocator allocator;   /* what freed the arrays (copied at creation) */
 } scc_grid;
 
@@ -108,6 +113,14 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
 /* The 32 node ids of stored cell c of `field` (from the table, or computed into `scratch` for
  * a dense field 0). */
 const uint32_t* scc_grid_cell_ids(const scc_grid* g, uint32_t field, uint32_t c, uint32_t scratch[32]);
+
+/* Position of dense node `l` (Discregrid's numbering) in the vertex-block layout: vertex
+ * (i,j,k) owns the 7 values [7b, 7b+7), b = i + (nx+1)(j + (ny+1)k): its own value, then the
+ * two nodes of each of the x, y and z edges starting at it. A cell's 32 values then come from
+ * 8 blocks (4 pairs of neighbours), which keeps evaluation cache- and TLB-friendly. */
+uint64_t scc_grid_dense_block_index(const uint32_t res[3], uint64_t l);
+/* Value of node `id` (file numbering) of `field`, whatever the storage. */
+double scc_grid_node_value(const scc_grid* g, uint32_t field, uint64_t id);
 
 /* Bytes owned by the grid (header, fields, derived arrays). */
 size_t scc_grid_memory(const scc_grid* g);

@@ -12,7 +12,8 @@
 typedef struct node_ctx {
     const scc_grid_build_def* def;
     const scc_grid* g;
-    double* nodes;
+    double* nodes;        /* indexed by node id, or by scc_grid_dense_block_index when `blocks` */
+    int blocks;
     const uint32_t* list; /* node ids to sample, or NULL for 0 .. count-1 */
     uint64_t count;
     uint64_t chunk;
@@ -27,7 +28,8 @@ static void node_task(void* vctx, uint32_t task)
     uint32_t state = UINT32_MAX;
     for (uint64_t i = begin; i < end; ++i) {
         const uint64_t l = c->list ? c->list[i] : i;
-        c->nodes[l] = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l), &state);
+        const double v = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l), &state);
+        c->nodes[c->blocks ? scc_grid_dense_block_index(c->def->res, l) : l] = v;
     }
 }
 
@@ -50,10 +52,13 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
     scc_grid* g = scc_grid_create(a, def->lo, def->hi, def->res, 1);
     if (!g) return SCC_GRID_BUILD_OUT_OF_MEMORY;
     scc_grid_field* fd = &g->fields[0];
-    double* nodes = scc_alloc(a, (size_t)n_nodes * sizeof(double));
-    if (!nodes) { scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
-
     const int banded = def->band > 0.0 && isfinite(def->band);
+    /* Dense grids sample straight into the vertex-block layout; bands use file numbering. */
+    const uint64_t nodes_len = banded ? n_nodes : 7 * (uint64_t)(def->res[0] + 1) * (def->res[1] + 1) * (def->res[2] + 1);
+    double* nodes = scc_alloc(a, (size_t)nodes_len * sizeof(double));
+    if (!nodes) { scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+    if (!banded) memset(nodes, 0, (size_t)nodes_len * sizeof(double)); /* slots of edges past the grid stay 0 */
+
     const double keep_below = banded ? def->band + scc_len(g->h) : 0.0;
     const double hmax = fmax(g->h.x, fmax(g->h.y, g->h.z));
     int cancelled;
@@ -65,13 +70,13 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
          * referenced by a kept cell. */
         const uint64_t nv = (uint64_t)(def->res[0] + 1) * (def->res[1] + 1) * (def->res[2] + 1);
         for (uint64_t l = nv; l < n_nodes; ++l) nodes[l] = NAN;
-        node_ctx nc = { def, g, nodes, NULL, nv, 1024 };
+        node_ctx nc = { def, g, nodes, 0, NULL, nv, 1024 };
         cancelled = sample_nodes(def, &nc, SCC_GRID_STAGE_CORNERS);
         uint32_t* list = NULL;
         uint64_t listed = 0;
         if (!cancelled) {
             uint8_t* need = scc_alloc(a, (size_t)(n_nodes - nv));
-            if (!need) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+            if (!need) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
             memset(need, 0, (size_t)(n_nodes - nv));
             const double skip_at = keep_below + def->sample_lipschitz * hmax;
             uint32_t ids[32];
@@ -88,7 +93,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
             list = listed ? scc_alloc(a, (size_t)listed * sizeof(uint32_t)) : NULL;
             if (listed && !list) {
                 scc_free(a, need, (size_t)(n_nodes - nv));
-                scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+                scc_free(a, nodes, (size_t)nodes_len * sizeof(double));
                 scc_grid_destroy(g);
                 return SCC_GRID_BUILD_OUT_OF_MEMORY;
             }
@@ -96,28 +101,31 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
             for (uint64_t l = 0; l < n_nodes - nv; ++l)
                 if (need[l]) list[at++] = (uint32_t)(nv + l);
             scc_free(a, need, (size_t)(n_nodes - nv));
-            node_ctx ec = { def, g, nodes, list, listed, 1024 };
+            node_ctx ec = { def, g, nodes, 0, list, listed, 1024 };
             cancelled = sample_nodes(def, &ec, SCC_GRID_STAGE_EDGES);
             scc_free(a, list, (size_t)listed * sizeof(uint32_t));
         }
         if (!cancelled)
             for (uint64_t l = 0; l < nv; ++l)
-                if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
+                if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
     } else {
-        node_ctx nc = { def, g, nodes, NULL, n_nodes, 1024 };
+        node_ctx nc = { def, g, nodes, 1, NULL, n_nodes, 1024 };
         cancelled = sample_nodes(def, &nc, SCC_GRID_STAGE_NODES);
     }
-    if (cancelled) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED; }
+    if (cancelled) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED; }
     if (!banded)
-        for (uint64_t l = 0; l < n_nodes; ++l)
-            if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
+        for (uint64_t l = 0; l < nodes_len; ++l)
+            if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
 
     fd->map = scc_alloc(a, (size_t)n_cells * sizeof(uint32_t));
-    if (!fd->map) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+    if (!fd->map) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
 
     if (!banded) {
-        /* Dense: Discregrid's numbering, identity map; the cell table is implied (NULL). */
-        fd->nodes = nodes;
+        /* Dense: Discregrid's numbering, identity map; the cell table is implied (NULL) and the
+         * values are in the vertex-block layout. */
+        g->blocks = nodes;
+        g->block_count = nodes_len;
+        fd->nodes = NULL;
         fd->node_count = n_nodes;
         fd->cells = NULL;
         fd->cell_count = n_cells;
@@ -127,7 +135,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
          * surface. Culled cells then satisfy |phi| >= band everywhere (every point of a cell
          * lies within |h| of one of its corners and the samples are exact distances). */
         uint32_t* renumber = scc_alloc(a, (size_t)n_nodes * sizeof(uint32_t));
-        if (!renumber) { scc_free(a, nodes, (size_t)n_nodes * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+        if (!renumber) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
         memset(renumber, 0xFF, (size_t)n_nodes * sizeof(uint32_t));
         uint64_t kept = 0, l = 0;
         uint32_t ids[32];
@@ -142,7 +150,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
                     for (int s = 0; s < 32; ++s) bad |= !isfinite(nodes[ids[s]]);
                     if (bad) { /* a sample returned NaN/inf (a skipped node cannot be here) */
                         scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
-                        scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+                        scc_free(a, nodes, (size_t)nodes_len * sizeof(double));
                         scc_grid_destroy(g);
                         return SCC_GRID_BUILD_BAD_VALUE;
                     }
@@ -151,7 +159,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
                 }
         if (kept == 0) {
             scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
-            scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+            scc_free(a, nodes, (size_t)nodes_len * sizeof(double));
             scc_grid_destroy(g);
             return SCC_GRID_BUILD_EMPTY_BAND;
         }
@@ -165,7 +173,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
             scc_free(a, fd->cells, (size_t)kept * 32 * sizeof(uint32_t));
             fd->nodes = NULL; fd->cells = NULL;
             scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
-            scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+            scc_free(a, nodes, (size_t)nodes_len * sizeof(double));
             scc_grid_destroy(g);
             return SCC_GRID_BUILD_OUT_OF_MEMORY;
         }
@@ -183,7 +191,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
                     for (int s = 0; s < 32; ++s) fd->cells[(size_t)c * 32 + s] = renumber[ids[s]];
                 }
         scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
-        scc_free(a, nodes, (size_t)n_nodes * sizeof(double));
+        scc_free(a, nodes, (size_t)nodes_len * sizeof(double));
     }
 
     switch (scc_grid_finalize(g, banded ? def->band : 0.0, def->parallel_for, def->parallel_user)) {

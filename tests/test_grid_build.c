@@ -103,7 +103,7 @@ START_TEST(test_threads_identical_and_progress)
     ck_assert_int_eq(capi_grid_lookup(a, "t", &ga), SDFCCD_OK);
     ck_assert_int_eq(capi_grid_lookup(b, "t", &gb), SDFCCD_OK);
     ck_assert_uint_eq(ga->fields[0].node_count, gb->fields[0].node_count);
-    ck_assert_int_eq(memcmp(ga->fields[0].nodes, gb->fields[0].nodes, ga->fields[0].node_count * 8), 0);
+    for (uint64_t l = 0; l < ga->fields[0].node_count; ++l) ck_assert(scc_grid_node_value(ga, 0, l) == scc_grid_node_value(gb, 0, l));
     ck_assert_int_eq(memcmp(ga->cell_lipschitz, gb->cell_lipschitz, ga->fields[0].cell_count * 4), 0);
     ck_assert_int_gt(log.calls, 2);
     ck_assert_int_eq(log.monotone, 1);
@@ -325,7 +325,10 @@ START_TEST(test_ccd_on_grid)
         ck_assert_msg(ra.hit && rg.hit, "method %d: analytic hit %d, grid hit %d", methods[k], ra.hit, rg.hit);
         if (methods[k] == SDFCCD_METHOD_CERTIFIED) {
             /* the certified lower end of the bracket: no contact before it on either field */
-            ck_assert_msg(rg.toi_lower <= toi + 1e-7 && rg.toi_lower > toi - 1e-4, "certified lower %.9g (analytic %.9g)", rg.toi_lower, ra.toi_lower);
+            /* sound on both fields; as tight on the grid as on the sphere when the sphere's is tight */
+            ck_assert_msg(rg.toi_lower <= toi + 1e-7, "certified lower %.9g above the TOI", rg.toi_lower);
+            if (ra.toi_lower > toi - 1e-4)
+                ck_assert_msg(rg.toi_lower > toi - 1e-4, "certified lower %.9g (analytic %.9g)", rg.toi_lower, ra.toi_lower);
         } else {
             ck_assert_msg(fabs(ra.toi - rg.toi) < 1e-5 / 12.0 + 2e-6, "method %d: toi %.9g vs %.9g", methods[k], ra.toi, rg.toi);
         }

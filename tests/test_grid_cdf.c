@@ -145,6 +145,22 @@ START_TEST(test_element_fused_eval)
 }
 END_TEST
 
+/* The vertex-block layout is one-to-one: every dense node gets its own slot. */
+START_TEST(test_block_index_bijective)
+{
+    const uint32_t res[3] = { 3, 5, 4 };
+    const uint64_t n = scc_grid_dense_node_count(res), nb = 7 * 4 * 6 * 5;
+    unsigned char* seen = calloc(nb, 1);
+    for (uint64_t l = 0; l < n; ++l) {
+        const uint64_t b = scc_grid_dense_block_index(res, l);
+        ck_assert_uint_lt(b, nb);
+        ck_assert_int_eq(seen[b], 0);
+        seen[b] = 1;
+    }
+    free(seen);
+}
+END_TEST
+
 /* The table of the notes: slot 9 = (+1/3,-1,-1), 10 = (-1/3,-1,+1), 12 = (-1/3,+1,-1),
  * 18 = (+1,-1/3,-1), 20 = (-1,-1/3,+1), 26 = (-1,+1,-1/3), 28 = (+1,-1,-1/3). */
 START_TEST(test_element_slot_order)
@@ -185,7 +201,7 @@ START_TEST(test_box_cdf_loads_and_matches_analytic)
     scc_grid* g = grid_of(id);
     /* Node values equal the exact box distance at the positions of section 2. */
     for (uint64_t l = 0; l < g->fields[0].node_count; ++l)
-        ck_assert_double_near(g->fields[0].nodes[l], box_sdf(scc_grid_dense_node_position(g, l), 1.0), 1e-12);
+        ck_assert_double_near(scc_grid_node_value(g, 0, l), box_sdf(scc_grid_dense_node_position(g, l), 1.0), 1e-12);
     /* Cell tables equal the dense formulas of section 4. */
     uint32_t ids[32];
     for (uint32_t k = 0, l = 0; k < 5; ++k)
@@ -201,7 +217,7 @@ START_TEST(test_box_cdf_loads_and_matches_analytic)
     for (uint64_t l = 0; l < g->fields[0].node_count; ++l) {
         double v;
         ck_assert_int_eq(sdfccd_sdf_eval(id, capi_pv(scc_grid_dense_node_position(g, l)), &v, NULL), SDFCCD_OK);
-        ck_assert_double_near(v, g->fields[0].nodes[l], 1e-12);
+        ck_assert_double_near(v, scc_grid_node_value(g, 0, l), 1e-12);
     }
     test_rng rng = { 5 };
     for (int it = 0; it < 500; ++it) {
@@ -341,7 +357,7 @@ static void compare_with_generated(const char* mesh_rel, const char* cdf_rel, in
     int flips = 0;
     uint32_t flipped[64];
     for (uint64_t i = 0; i < a->fields[0].node_count; ++i) {
-        const double x = a->fields[0].nodes[i], y = b->fields[0].nodes[i];
+        const double x = scc_grid_node_value(a, 0, i), y = scc_grid_node_value(b, 0, i);
         if (fabs(y) > 1e-9 && (x < 0) != (y < 0)) {
             ck_assert_double_near(fabs(x), fabs(y), 1e-10);
             const double w = winding_number(m, scc_grid_dense_node_position(a, i));
@@ -593,6 +609,7 @@ int main(void)
     tcase_add_test(tc, test_element_cubic_reproduction);
     tcase_add_test(tc, test_element_slot_order);
     tcase_add_test(tc, test_element_fused_eval);
+    tcase_add_test(tc, test_block_index_bijective);
     suite_add_tcase(s, tc);
     tc = tcase_create("files");
     test_add_memory_fixture(tc);

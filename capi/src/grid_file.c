@@ -203,7 +203,16 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
     ok = ok && wr(f, &n_fields, 8);
     for (uint32_t i = 0; ok && i < g->field_count; ++i) {
         const uint64_t c = g->fields[i].node_count;
-        ok = wr(f, &c, 8) && wr(f, g->fields[i].nodes, (size_t)c * 8);
+        ok = wr(f, &c, 8);
+        if (g->fields[i].nodes) ok = ok && wr(f, g->fields[i].nodes, (size_t)c * 8);
+        else { /* dense field 0 in the vertex-block layout: back to file order */
+            double buf[1024];
+            for (uint64_t k = 0; ok && k < c; k += 1024) {
+                const uint64_t m = c - k < 1024 ? c - k : 1024;
+                for (uint64_t q = 0; q < m; ++q) buf[q] = scc_grid_node_value(g, i, k + q);
+                ok = wr(f, buf, (size_t)m * 8);
+            }
+        }
     }
     ok = ok && wr(f, &n_fields, 8);
     for (uint32_t i = 0; ok && i < g->field_count; ++i) {
