@@ -23,6 +23,7 @@ typedef struct scc_params {
     int fwgss_restarts;     /* extra FWGSS descents from the other vertices (0..2) */
     int subdivision;
     double sub_min_area;    /* m^2 */
+    int sub_max_depth;      /* levels of splitting */
     double contact_slop;    /* m */
     double toi_window;      /* s */
     double max_rotation;    /* rad per segment */

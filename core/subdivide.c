@@ -6,8 +6,10 @@
  * A = (b, c, g), B = (a, g, c), C = (a, b, g) (Eq. 21). The child holding the known contact keeps
  * it; DCD searches each other child for its deepest point, and a child whose deepest point is in
  * contact (phi <= margin + contact_slop) yields a new contact and is split in turn. Children
- * with no contact are dropped. Splitting stops below the minimum area, and the search stops as
- * soon as two extra points that are not collinear with the first contact are known. */
+ * with no contact are dropped (a Lipschitz test rejects most of them without DCD). Splitting
+ * stops below the minimum area or at the depth cap (edge contacts never yield non-collinear
+ * points, so without a cap they recurse to the area floor), and the search stops as soon as
+ * two extra points that are not collinear with the first contact are known. */
 #include "ccd.h"
 
 #define MAX_REGIONS 96
@@ -15,6 +17,7 @@
 typedef struct sub_region {
     double c[3][3]; /* corners as barycentric weights of the full triangle */
     double pt[3];   /* the known contact inside, as weights of the full triangle */
+    int depth;      /* 0 for the whole triangle */
 } sub_region;
 
 static scc_vec3 from_bary(const scc_vec3 tri[3], const double b[3])
@@ -56,22 +59,27 @@ int scc_subdivide(const scc_sdf* sdf, const scc_vec3 tri[3], const double primar
     const double dup2 = 1e-8 * scale2;
     const scc_vec3 p0 = from_bary(tri, primary);
 
+    /* Extra contacts need their deepest point only to within a fraction of the slop. */
+    scc_params dcd_params = *p;
+    dcd_params.dist_tol = fmax(p->dist_tol, 0.01 * p->contact_slop);
     sub_region queue[MAX_REGIONS];
     int head = 0, tail = 0, count = 0;
-    sub_region root = { { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } }, { primary[0], primary[1], primary[2] } };
+    sub_region root = { { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } }, { primary[0], primary[1], primary[2] }, 0 };
     queue[tail++] = root;
 
     while (head < tail && count < capacity) {
         sub_region r = queue[head++];
-        if (full_area * region_fraction(&r) / 3.0 < p->sub_min_area) continue;
+        if (full_area * region_fraction(&r) / 3.0 < p->sub_min_area || r.depth >= p->sub_max_depth) continue;
         double g[3];
         for (int j = 0; j < 3; ++j) g[j] = (r.c[0][j] + r.c[1][j] + r.c[2][j]) / 3.0;
         sub_region kids[3];
         /* Eq. 21: A = (b, c, g), B = (a, g, c), C = (a, b, g). */
         const double* corners[3][3] = { { r.c[1], r.c[2], g }, { r.c[0], g, r.c[2] }, { r.c[0], r.c[1], g } };
-        for (int k = 0; k < 3; ++k)
+        for (int k = 0; k < 3; ++k) {
+            kids[k].depth = r.depth + 1;
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j) kids[k].c[i][j] = corners[k][i][j];
+        }
         double lw[3];
         local_weights(&r, r.pt, lw);
         int home = (lw[0] <= lw[1] && lw[0] <= lw[2]) ? 0 : (lw[1] <= lw[0] && lw[1] <= lw[2]) ? 1 : 2;
@@ -83,7 +91,13 @@ int scc_subdivide(const scc_sdf* sdf, const scc_vec3 tri[3], const double primar
             }
             scc_vec3 sub[3];
             for (int i = 0; i < 3; ++i) sub[i] = from_bary(tri, kids[k].c[i]);
-            scc_dcd_result d = scc_dcd(sdf, sub, p);
+            /* Exact cull: phi(c) - L r > threshold means no point of the child is in contact. */
+            scc_vec3 mid = scc_scale(scc_add(scc_add(sub[0], sub[1]), sub[2]), 1.0 / 3.0);
+            double rad = fmax(scc_dist(mid, sub[0]), fmax(scc_dist(mid, sub[1]), scc_dist(mid, sub[2])));
+            scc_aabb box = { scc_sub(mid, scc_v3(rad, rad, rad)), scc_add(mid, scc_v3(rad, rad, rad)) };
+            ++*io_evals;
+            if (scc_sdf_eval(sdf, mid, NULL) - scc_sdf_lipschitz(sdf, &box) * rad > threshold) continue;
+            scc_dcd_result d = scc_dcd(sdf, sub, &dcd_params);
             *io_evals += d.evals;
             if (!(d.phi <= threshold)) continue; /* no contact in this child: drop it */
             for (int j = 0; j < 3; ++j)

@@ -21,7 +21,8 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.max_line_search_iterations = 64;
     p.fwgss_restarts = 2;
     p.subdivision = 1;
-    p.subdivision_min_area = 1e-6;
+    p.subdivision_min_area = 1e-4;
+    p.subdivision_max_depth = 3;
     p.contact_slop = 1e-4;
     p.toi_window = 1e-5;
     p.max_rotation_per_segment = 3.14159265358979323846;
@@ -74,6 +75,9 @@ static sdfccd_Status convert_params(const sdfccd_QueryParams* in, const char* fn
     out->fwgss_restarts = in->fwgss_restarts;
     out->subdivision = in->subdivision != 0;
     out->sub_min_area = in->subdivision_min_area;
+    if (in->subdivision_max_depth < 1 || in->subdivision_max_depth > 32)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->subdivision_max_depth must be in [1, 32] (got %d)", fn, in->subdivision_max_depth);
+    out->sub_max_depth = in->subdivision_max_depth;
     out->contact_slop = in->contact_slop;
     out->toi_window = in->toi_window;
     out->max_rotation = in->max_rotation_per_segment;

@@ -51,7 +51,8 @@ typedef struct sdfccd_QueryParams {
                                         (0 = the paper's single descent, up to 2). They share the shrinking interval and
                                         correct local minima and later entries. Default 2. */
     int32_t subdivision;           /**< Adaptive triangle subdivision at the TOI (Section 4.5). Default 1 (on). */
-    double subdivision_min_area;   /**< Smallest sub-triangle area searched (m^2). Default 1e-6. */
+    double subdivision_min_area;   /**< Smallest sub-triangle area searched (m^2). Default 1e-4 (1 cm^2). */
+    int32_t subdivision_max_depth; /**< Levels of recursive splitting (1 = only the paper's first three regions). Default 3. */
     double contact_slop;           /**< Extra contacts at the TOI are kept when phi <= margin + contact_slop (m). Default 1e-4. */
     double toi_window;             /**< Mesh query: triangles whose TOI is within this of the earliest also give contacts (s). Default 1e-5. */
     double max_rotation_per_segment; /**< Intervals are split so no segment rotates more than this (rad). Default pi. */
