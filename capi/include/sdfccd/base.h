@@ -6,6 +6,11 @@
  * it writes nothing to its out-parameters unless stated, leaves no partial object behind,
  * and records a human-readable message retrievable with sdfccd_last_error() in the calling
  * thread. The library never prints and never aborts on bad input.
+ *
+ * Threads: queries and evaluations may run concurrently from any number of threads, also on the
+ * same SDF and mesh handles. Creating and destroying handles is thread-safe too, but a handle
+ * must not be destroyed while another thread is still using it in a call. sdfccd_set_allocator()
+ * must not race with any other call.
  */
 #ifndef SDFCCD_BASE_H
 #define SDFCCD_BASE_H
