@@ -161,6 +161,10 @@ scc_bsh* scc_bsh_build(const scc_mesh* mesh, const scc_allocator* alloc)
     bsh->nodes = nodes;
     bsh->node_count = count;
     bsh->triangle_count = n;
+    double rsum = 0.0;
+    for (uint32_t i = 0; i < count; ++i)
+        if (nodes[i].is_leaf) rsum += nodes[i].radius;
+    bsh->leaf_radius = rsum / n;
     bsh->bytes = sizeof *bsh + node_bytes;
     return bsh;
 }
@@ -425,6 +429,25 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
     if (angle > limit) {
         double k = ceil(angle / limit);
         nseg = k > 1e5 ? 100000u : (uint32_t)k;
+    }
+    {
+        /* Padding ~ A T^2 / 8 for a segment of length T: split until a point on the root's rim
+         * is padded by at most twice the mean leaf radius. */
+        double r_root = moving ? moving[0].radius : bsh->nodes[0].radius;
+        double A = centre_accel_bound(&tr, 0) + w * w * r_root;
+        double target = 2.0 * (moving ? 0.0 : bsh->leaf_radius);
+        if (moving) {
+            double rs = 0.0;
+            for (uint32_t i = 0; i < bsh->node_count; ++i)
+                if (bsh->nodes[i].is_leaf) rs += moving[i].radius;
+            target = 2.0 * rs / bsh->triangle_count;
+        }
+        double T = fabs(t_end - mm->t0);
+        if (A > 0.0 && target > 0.0) {
+            double k = ceil(T * sqrt(A / (8.0 * target)));
+            if (k > 64.0) k = 64.0;
+            if (k > nseg) nseg = (uint32_t)k;
+        }
     }
     segment* seg = scc_alloc(alloc, nseg * sizeof *seg);
     uint8_t* tested = scc_alloc(alloc, ((size_t)bsh->triangle_count + 7) / 8);

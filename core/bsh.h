@@ -8,7 +8,9 @@
  * start and an end centre and one radius that covers its triangles at every time in between.
  *
  * Culling is padded sphere tracing. The interval is split into segments that rotate (relative to
- * the SDF) at most min(pi, params->max_rotation); on each segment a node's centre path c(t) is
+ * the SDF) at most min(pi, params->max_rotation), and finely enough that the padding of a point at
+ * the root sphere's rim stays below twice the mean leaf radius (at most 64 segments), since the
+ * padding shrinks with the square of the segment length; on each segment a node's centre path c(t) is
  * replaced by its chord L(t) (the lerp between the segment's end centres) and the sphere's radius
  * is padded by
  *     pad = max(|c(tm) - L(tm)|,  A (tb - ta)^2 / 8),
@@ -48,6 +50,7 @@ typedef struct scc_bsh {
     scc_bsh_node* nodes;  /* node 0 is the root */
     uint32_t node_count;  /* 2 * triangle_count - 1 */
     uint32_t triangle_count;
+    double leaf_radius;   /* mean radius of the leaf spheres (sets how finely a spinning motion is split) */
     size_t bytes;         /* everything this hierarchy allocated, the struct included */
 } scc_bsh;
 
@@ -86,5 +89,14 @@ typedef int scc_bsh_visit_fn(void* user, uint32_t triangle, double t_candidate, 
 int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_sdf* sdf,
                      const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc, double t_end,
                      scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats);
+
+/* The mesh query (ccd.h's scc_query_mesh) with instrumentation for benchmarks: `probe` (may be
+ * NULL) is called with begin = 1 right before and begin = 0 right after each narrow-phase triangle
+ * test, so a caller can time triangles; *out_broad_evals (may be NULL) receives the broad phase's
+ * share of sum->evals. */
+typedef void scc_mesh_probe_fn(void* user, uint32_t triangle, int begin);
+int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
+                          scc_contact* out, int capacity, scc_query_summary* sum, scc_mesh_probe_fn* probe, void* probe_user,
+                          int64_t* out_broad_evals);
 
 #endif

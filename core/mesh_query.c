@@ -72,10 +72,14 @@ typedef struct mesh_ctx {
     scc_state best_state;
     int any_not_converged;
     scc_query_summary* sum;
+    scc_mesh_probe_fn* probe;
+    void* probe_user;
+    int64_t broad_evals;
 } mesh_ctx;
 
-/* Narrow phase of triangle t on [t0, min(t1, best + window)]. Returns 0 on allocation failure. */
-static int test_triangle(mesh_ctx* c, uint32_t t)
+/* Narrow phase of triangle t on [ta, min(t1, best + window)], where ta is t0 or the broad phase's
+ * candidate time (a proven lower bound of the triangle's contacts). Returns 0 on allocation failure. */
+static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
 {
     const scc_params* p = c->p;
     scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
@@ -83,11 +87,16 @@ static int test_triangle(mesh_ctx* c, uint32_t t)
     scc_tri_motion m;
     fill_triangle_motion(c->mm, t, &m);
     scc_query_summary s;
-    if (!scc_query_triangle(c->sdf, &m, c->mm->t0, tb, p, c->alloc, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s))
-        return 0;
+    if (c->probe) c->probe(c->probe_user, t, 1);
+    if (!(ta < tb)) ta = c->mm->t0;
+    int ok = scc_query_triangle(c->sdf, &m, ta, tb, p, c->alloc, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s);
+    if (c->probe) c->probe(c->probe_user, t, 0);
+    if (!ok) return 0;
     c->sum->iterations += s.iterations;
     c->sum->evals += s.evals;
     c->sum->triangles_tested += 1;
+    /* Touching at a candidate time after t0 is a hit there, not a penetration at the query's start. */
+    if (s.state == SCC_PENETRATING && ta > c->mm->t0) s.state = SCC_HIT;
     c->lower = fmin(c->lower, s.toi_lower);
     if (!s.hit) {
         c->any_not_converged |= s.state == SCC_NOT_CONVERGED;
@@ -107,8 +116,9 @@ static int test_triangle(mesh_ctx* c, uint32_t t)
 static int visit_candidate(void* user, uint32_t triangle, double t_candidate, double* io_t_end)
 {
     mesh_ctx* c = user;
-    (void)t_candidate;
-    if (!test_triangle(c, triangle)) return 0;
+    /* DCD tests the end pose; the others start at the candidate time. */
+    double ta = c->p->method == SCC_METHOD_DCD ? c->mm->t0 : fmax(c->mm->t0, t_candidate);
+    if (!test_triangle(c, triangle, ta)) return 0;
     *io_t_end = fmin(*io_t_end, fmin(c->mm->t1, c->best + c->p->toi_window));
     return 1;
 }
@@ -138,6 +148,7 @@ static int run_broad_phase(mesh_ctx* c)
         scc_bsh_stats st;
         ok = scc_bsh_traverse(bsh, moving, c->sdf, mm, c->p, alloc, mm->t1, visit_candidate, c, &st);
         c->sum->evals += st.evals;
+        c->broad_evals += st.evals;
     }
     scc_free(alloc, moving, moving_bytes);
     scc_bsh_destroy(own, alloc);
@@ -146,6 +157,13 @@ static int run_broad_phase(mesh_ctx* c)
 
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum)
+{
+    return scc_query_mesh_probed(sdf, mm, p, alloc, out, capacity, sum, NULL, NULL, NULL);
+}
+
+int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
+                          scc_contact* out, int capacity, scc_query_summary* sum, scc_mesh_probe_fn* probe, void* probe_user,
+                          int64_t* out_broad_evals)
 {
     mesh_ctx c;
     c.sdf = sdf;
@@ -159,13 +177,17 @@ int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
     c.best_state = SCC_NO_HIT;
     c.any_not_converged = 0;
     c.sum = sum;
+    c.probe = probe;
+    c.probe_user = probe_user;
+    c.broad_evals = 0;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
     int ok = 1;
     if (p->broad_phase && mm->mesh->triangle_count > 0) {
         ok = run_broad_phase(&c);
     } else {
-        for (uint32_t t = 0; t < mm->mesh->triangle_count && ok; ++t) ok = test_triangle(&c, t);
+        for (uint32_t t = 0; t < mm->mesh->triangle_count && ok; ++t) ok = test_triangle(&c, t, mm->t0);
     }
+    if (out_broad_evals) *out_broad_evals = c.broad_evals;
     contact_buf buf = c.buf;
     double best = c.best, lower = c.lower;
     scc_state best_state = c.best_state;
