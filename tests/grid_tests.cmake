@@ -29,3 +29,14 @@ if(CMAKE_CXX_COMPILER)
     endif()
   endforeach()
 endif()
+
+# The bake tool: a good run, and clear failures (exit status 1 for a bad mesh, 2 for bad usage).
+if(TARGET sdfccd_bake)
+  add_test(NAME sdfccd_bake_box COMMAND sdfccd_bake ${SDFCCD_DATA_DIR}/discregrid/box.obj -r 5 -t 2 --samples 2000
+           -o ${CMAKE_CURRENT_BINARY_DIR}/bake_box_r5.cdf)
+  set_tests_properties(sdfccd_bake_box PROPERTIES PASS_REGULAR_EXPRESSION "cells: 125 stored of 125; nodes: 1296;.*file: 27040 bytes")
+  add_test(NAME sdfccd_bake_missing_mesh COMMAND sdfccd_bake ${SDFCCD_DATA_DIR}/no_such_mesh.obj -r 8 -o ${CMAKE_CURRENT_BINARY_DIR}/x.cdf)
+  set_tests_properties(sdfccd_bake_missing_mesh PROPERTIES WILL_FAIL TRUE)
+  add_test(NAME sdfccd_bake_bad_usage COMMAND sdfccd_bake ${SDFCCD_DATA_DIR}/discregrid/box.obj -r zero -o ${CMAKE_CURRENT_BINARY_DIR}/x.cdf)
+  set_tests_properties(sdfccd_bake_bad_usage PROPERTIES WILL_FAIL TRUE)
+endif()
