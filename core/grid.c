@@ -489,6 +489,13 @@ double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
     const scc_vec3 dq = scc_sub(p, q);
     const double d2 = scc_len2(dq);
     if (d2 == 0.0) return eval_inside(g, p, out_grad);
+    if (!(d2 < INFINITY)) {
+        /* astronomically far: the largest axis distance is a finite lower bound */
+        const scc_vec3 ad = scc_vabs(dq);
+        const int ax = ad.x >= ad.y && ad.x >= ad.z ? 0 : (ad.y >= ad.z ? 1 : 2);
+        if (out_grad) *out_grad = scc_v3(ax == 0 ? (dq.x > 0 ? 1.0 : -1.0) : 0.0, ax == 1 ? (dq.y > 0 ? 1.0 : -1.0) : 0.0, ax == 2 ? (dq.z > 0 ? 1.0 : -1.0) : 0.0);
+        return ax == 0 ? ad.x : (ax == 1 ? ad.y : ad.z);
+    }
 
     /* Outside the domain: d = |p - q| to the nearest box point q, phi_q = phi(q).
      * phi_q >= 0: sqrt(d^2 + phi_q^2), a lower bound on the distance to a surface that lies

@@ -236,6 +236,14 @@ START_TEST(test_outside_domain)
         const double gl = sqrt(gr.x * gr.x + gr.y * gr.y + gr.z * gr.z);
         ck_assert(isfinite(gl) && gl > 0.1 && gl <= 1.5);
     }
+    /* very far points: finite values and gradients */
+    {
+        double v;
+        sdfccd_Vec3 gr;
+        ck_assert_int_eq(sdfccd_sdf_eval(g, (sdfccd_Vec3){ 1e200, -3e200, 2e200 }, &v, &gr), SDFCCD_OK);
+        ck_assert(isfinite(v) && v >= 2.9e200 && isfinite(gr.x) && isfinite(gr.y) && isfinite(gr.z));
+        ck_assert_double_eq(gr.y, -1.0);
+    }
     /* continuity across the max-x face */
     for (int i = 0; i < 200; ++i) {
         sdfccd_Vec3 q = { dom.hi.x, test_rng_uniform(&rng, dom.lo.y, dom.hi.y), test_rng_uniform(&rng, dom.lo.z, dom.hi.z) };
