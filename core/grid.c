@@ -501,14 +501,17 @@ double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
      * phi_q >= 0: sqrt(d^2 + phi_q^2), a lower bound on the distance to a surface that lies
      *             inside the box (any path to it crosses the box at some b with
      *             |p - b| >= sqrt(d^2 + |q - b|^2) and phi(b) >= phi_q - |q - b|).
-     * phi_q < 0:  the box cuts the shape; phi_q - d, the 1-Lipschitz lower bound, which keeps
-     *             points beyond an inside boundary inside. Discontinuous where the surface
-     *             crosses the boundary (phi_q = 0).
+     * phi_q < 0:  when every boundary node is >= 0 (outside_positive: the surface lies inside,
+     *             as for meshes in a fitted domain) this is an interpolation dip and phi_q is
+     *             taken as 0; otherwise the box cuts the shape and phi_q - d, the 1-Lipschitz
+     *             lower bound, keeps points beyond an inside boundary inside (discontinuous
+     *             where the surface crosses the boundary).
      * The gradient is that of these expressions; the part of grad phi(q) along clamped axes
      * drops out. */
     const double d = sqrt(d2);
     scc_vec3 gq;
-    const double vq = eval_inside(g, q, out_grad ? &gq : NULL);
+    double vq = eval_inside(g, q, out_grad ? &gq : NULL);
+    if (g->outside_positive && vq < 0.0) vq = 0.0; /* interpolation dip on the boundary: the surface is inside */
     if (!out_grad) return vq >= 0.0 ? sqrt(d2 + vq * vq) : vq - d;
     if (p.x != q.x) gq.x = 0.0;
     if (p.y != q.y) gq.y = 0.0;
@@ -781,8 +784,34 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
      * unbounded (phi_q - d continues the inside). Non-negativity of each boundary face is
      * proved with the face's Bernstein coefficients (the face restriction of the cell's
      * tensor Bernstein form), which enclose the interpolant on the face. */
+    /* outside_positive: every node on the domain boundary is >= 0 (and no inside hole touches
+     * it), i.e. the sampled surface lies inside the box. */
+    g->outside_positive = 1;
+    for (uint64_t l = 0; l < g->n_cells && g->outside_positive; ++l) {
+        uint32_t ijk[3];
+        cell_ijk(g, l, ijk);
+        int lo_face[3], hi_face[3], any = 0;
+        for (int d = 0; d < 3; ++d) {
+            lo_face[d] = ijk[d] == 0;
+            hi_face[d] = ijk[d] == g->res[d] - 1;
+            any |= lo_face[d] | hi_face[d];
+        }
+        if (!any) continue;
+        const uint32_t c = fd->map[l];
+        if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) {
+            if (g->hole_source[l] & 0x80000000u) g->outside_positive = 0;
+            continue;
+        }
+        double v[32];
+        gather_cell(g, fd, c, ijk, v);
+        for (int slot = 0; slot < 32; ++slot)
+            for (int d = 0; d < 3; ++d)
+                if ((lo_face[d] && k_sigma[slot][d] == -1.0) || (hi_face[d] && k_sigma[slot][d] == 1.0))
+                    if (v[slot] < 0.0) g->outside_positive = 0;
+    }
+    /* Otherwise try to prove phi >= 0 on the boundary from the faces' Bernstein coefficients. */
     int boundary_nonneg = 1;
-    for (uint64_t l = 0; l < g->n_cells && boundary_nonneg; ++l) {
+    for (uint64_t l = 0; l < g->n_cells && boundary_nonneg && !g->outside_positive; ++l) {
         uint32_t ijk[3];
         cell_ijk(g, l, ijk);
         int lo_face[3], hi_face[3], any = 0;
@@ -814,7 +843,7 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     g->base.lipschitz_in = scc_grid_lipschitz_in;
     g->base.domain.lo = g->lo;
     g->base.domain.hi = g->hi;
-    if (boundary_nonneg) {
+    if (boundary_nonneg || g->outside_positive) {
         g->base.bounds.lo = g->lo;
         g->base.bounds.hi = g->hi;
     } else {

@@ -70,6 +70,7 @@ typedef struct scc_grid {
     uint64_t valued_cells;     /* cells of field 0 with values */
     double band;               /* known lower bound on |phi| in cells without value (0 if unknown) */
     double lipschitz_max;      /* max of cell_lipschitz */
+    int outside_positive;      /* every boundary node >= 0: outside the box phi is positive */
     int dense_layout;          /* field 0 is dense in Discregrid's numbering: fields[0].cells and
                                   fields[0].nodes are NULL (node_count stays the file's count) and
                                   the values live in `blocks` */

@@ -236,6 +236,11 @@ START_TEST(test_outside_domain)
         const double gl = sqrt(gr.x * gr.x + gr.y * gr.y + gr.z * gr.z);
         ck_assert(isfinite(gl) && gl > 0.1 && gl <= 1.5);
     }
+    /* the surface is inside the fitted domain: bounds are the domain */
+    sdfccd_SdfInfo si;
+    ck_assert_int_eq(sdfccd_sdf_get_info(g, &si), SDFCCD_OK);
+    ck_assert_double_eq(si.bounds.lo.x, dom.lo.x);
+    ck_assert_double_eq(si.bounds.hi.z, dom.hi.z);
     /* very far points: finite values and gradients */
     {
         double v;

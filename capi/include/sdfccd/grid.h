@@ -15,14 +15,14 @@
  *  - in a cell culled by a narrow band (or touching a node a file marks as not sampled): a value
  *    with the correct side (sign) whose magnitude is a lower bound on the distance, and a unit
  *    gradient pointing away from the nearest cell with values. Not continuous across cells;
- *  - outside the domain box, at distance d from its nearest point q: sqrt(d^2 + phi(q)^2) where
- *    phi(q) >= 0 (a lower bound on the distance when the surface lies inside the box, as it does
- *    for grids built from closed meshes with the default domain), and phi(q) - d where phi(q) < 0
- *    (the box cuts the shape: a 1-Lipschitz lower bound that keeps points beyond an inside
- *    boundary inside). The two rules meet discontinuously where the surface crosses the domain
- *    boundary; keep shapes inside the domain where that matters (certified queries). The SDF's
- *    `bounds` are the domain when phi >= 0 on the whole boundary (proved per boundary face), else
- *    infinite.
+ *  - outside the domain box, at distance d from its nearest point q: sqrt(d^2 + phi(q)^2), a lower
+ *    bound on the distance when the surface lies inside the box. The grid takes the surface to be
+ *    inside when every node on the domain boundary is >= 0 (always so for closed meshes with the
+ *    default domain); then phi(q) < 0 can only be an interpolation dip and counts as 0, and the
+ *    SDF's `bounds` are the domain. Otherwise (the box cuts the shape, e.g. a ground plane) the
+ *    value is phi(q) - d where phi(q) < 0, a 1-Lipschitz lower bound that keeps points beyond an
+ *    inside boundary inside; the two rules meet discontinuously where the surface crosses the
+ *    boundary, and `bounds` are infinite unless phi >= 0 on the boundary is proved face by face.
  * The per-cell bound on |grad phi| used by the certified method is exact for the interpolant in
  * cells with values (a Bernstein enclosure), 1 in culled cells (sound for the true distance the
  * conservative value bounds from below) and sqrt(1 + L^2) outside the domain.
