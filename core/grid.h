@@ -159,8 +159,10 @@ void scc_grid_dense_cell_nodes(const uint32_t res[3], uint32_t i, uint32_t j, ui
 
 /* The function sampled at the nodes: value at p. Must be thread-safe. `state` is a scratch word
  * private to the calling task (UINT32_MAX at the task's start; consecutive calls of a task are
- * at nearby nodes), e.g. for a nearest-triangle hint. The value must not depend on it. */
-typedef double scc_grid_sample_fn(void* user, scc_vec3 p, uint32_t* state);
+ * at nearby nodes), e.g. for a nearest-triangle hint. The value must not depend on it.
+ * `cap` (> 0, possibly INFINITY): the builder only needs the value when |value| < cap; when
+ * |value| >= cap the function may return any value of magnitude >= cap (e.g. cap itself). */
+typedef double scc_grid_sample_fn(void* user, scc_vec3 p, uint32_t* state, double cap);
 
 typedef struct scc_grid_build_def {
     scc_vec3 lo, hi;           /* domain (lo < hi) */

@@ -15,6 +15,7 @@ typedef struct node_ctx {
     double* nodes;        /* indexed by node id, or by scc_grid_dense_block_index when `blocks` */
     int blocks;
     const uint32_t* list; /* node ids to sample, or NULL for 0 .. count-1 */
+    double cap;           /* passed to the sample function */
     uint64_t count;
     uint64_t chunk;
 } node_ctx;
@@ -28,7 +29,7 @@ static void node_task(void* vctx, uint32_t task)
     uint32_t state = UINT32_MAX;
     for (uint64_t i = begin; i < end; ++i) {
         const uint64_t l = c->list ? c->list[i] : i;
-        const double v = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l), &state);
+        const double v = c->def->sample(c->def->sample_user, scc_grid_dense_node_position(c->g, l), &state, c->cap);
         c->nodes[c->blocks ? scc_grid_dense_block_index(c->def->res, l) : l] = v;
     }
 }
@@ -70,7 +71,10 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
          * referenced by a kept cell. */
         const uint64_t nv = (uint64_t)(def->res[0] + 1) * (def->res[1] + 1) * (def->res[2] + 1);
         for (uint64_t l = nv; l < n_nodes; ++l) nodes[l] = NAN;
-        node_ctx nc = { def, g, nodes, 0, NULL, nv, 1024 };
+        /* Corner values are only needed exactly below keep_below + L (|h| + hmax): corners of
+         * kept cells lie within |h| of a node below keep_below, and the skip test below only
+         * compares with keep_below + L hmax. */
+        node_ctx nc = { def, g, nodes, 0, NULL, keep_below + def->sample_lipschitz * (scc_len(g->h) + hmax) * 1.000001, nv, 1024 };
         cancelled = sample_nodes(def, &nc, SCC_GRID_STAGE_CORNERS);
         uint32_t* list = NULL;
         uint64_t listed = 0;
@@ -101,7 +105,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
             for (uint64_t l = 0; l < n_nodes - nv; ++l)
                 if (need[l]) list[at++] = (uint32_t)(nv + l);
             scc_free(a, need, (size_t)(n_nodes - nv));
-            node_ctx ec = { def, g, nodes, 0, list, listed, 1024 };
+            node_ctx ec = { def, g, nodes, 0, list, INFINITY, listed, 1024 };
             cancelled = sample_nodes(def, &ec, SCC_GRID_STAGE_EDGES);
             scc_free(a, list, (size_t)listed * sizeof(uint32_t));
         }
@@ -109,7 +113,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
             for (uint64_t l = 0; l < nv; ++l)
                 if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
     } else {
-        node_ctx nc = { def, g, nodes, 1, NULL, n_nodes, 1024 };
+        node_ctx nc = { def, g, nodes, 1, NULL, INFINITY, n_nodes, 1024 };
         cancelled = sample_nodes(def, &nc, SCC_GRID_STAGE_NODES);
     }
     if (cancelled) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED; }

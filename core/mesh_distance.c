@@ -167,6 +167,29 @@ void scc_mesh_sdf_query(const scc_mesh_sdf* m, scc_vec3 p, scc_mesh_distance_res
     scc_mesh_sdf_query_hint(m, p, &hint, out);
 }
 
+static scc_vec3 feature_normal(const scc_mesh_sdf* m, uint32_t t, scc_tri_feature f)
+{
+    switch (f) {
+    case SCC_TRI_V0: return m->vertex_normal[m->mesh->indices[3 * t]];
+    case SCC_TRI_V1: return m->vertex_normal[m->mesh->indices[3 * t + 1]];
+    case SCC_TRI_V2: return m->vertex_normal[m->mesh->indices[3 * t + 2]];
+    case SCC_TRI_E01: return m->edge_normal[3 * t];
+    case SCC_TRI_E12: return m->edge_normal[3 * t + 1];
+    case SCC_TRI_E20: return m->edge_normal[3 * t + 2];
+    default: return m->face_normal[t];
+    }
+}
+
+double scc_mesh_sdf_distance_capped(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, double cap)
+{
+    scc_tri_nearest nr;
+    if (!scc_tri_bvh_nearest_within(&m->bvh, p, *hint, cap < INFINITY ? cap * cap : INFINITY, &nr)) return cap;
+    *hint = nr.slot;
+    const double d = sqrt(nr.dist2);
+    if (!(d < cap)) return cap;
+    return scc_dot(scc_sub(p, nr.point), feature_normal(m, nr.triangle, nr.feature)) >= 0.0 ? d : -d;
+}
+
 void scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, scc_mesh_distance_result* out)
 {
     scc_tri_nearest nr;
@@ -178,16 +201,7 @@ void scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, 
     }
     *hint = nr.slot;
     const uint32_t t = nr.triangle;
-    scc_vec3 n;
-    switch (nr.feature) {
-    case SCC_TRI_V0: n = m->vertex_normal[m->mesh->indices[3 * t]]; break;
-    case SCC_TRI_V1: n = m->vertex_normal[m->mesh->indices[3 * t + 1]]; break;
-    case SCC_TRI_V2: n = m->vertex_normal[m->mesh->indices[3 * t + 2]]; break;
-    case SCC_TRI_E01: n = m->edge_normal[3 * t]; break;
-    case SCC_TRI_E12: n = m->edge_normal[3 * t + 1]; break;
-    case SCC_TRI_E20: n = m->edge_normal[3 * t + 2]; break;
-    default: n = m->face_normal[t]; break;
-    }
+    const scc_vec3 n = feature_normal(m, t, nr.feature);
     const double d = sqrt(nr.dist2);
     out->distance = scc_dot(scc_sub(p, nr.point), n) >= 0.0 ? d : -d;
     out->closest = nr.point;

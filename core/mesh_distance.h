@@ -48,6 +48,9 @@ void scc_mesh_sdf_query(const scc_mesh_sdf* m, scc_vec3 p, scc_mesh_distance_res
 /* The same with a caller-kept hint (start with UINT32_MAX; updated to the answer's BVH slot):
  * queries at nearby points in sequence run much faster. The result does not depend on it. */
 void scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, scc_mesh_distance_result* out);
+/* Signed distance when |distance| < cap; otherwise returns cap (sign not computed) without
+ * searching further than cap. */
+double scc_mesh_sdf_distance_capped(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, double cap);
 
 /* Only the topology report (no BVH). 0 on success, -1 on OOM. */
 int scc_mesh_topology_check(const scc_allocator* a, const scc_mesh* mesh, scc_mesh_topology* out);

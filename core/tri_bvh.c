@@ -206,19 +206,32 @@ int scc_tri_bvh_nearest(const scc_tri_bvh* bvh, scc_vec3 p, scc_tri_nearest* out
 
 int scc_tri_bvh_nearest_hint(const scc_tri_bvh* bvh, scc_vec3 p, uint32_t hint, scc_tri_nearest* out)
 {
+    return scc_tri_bvh_nearest_within(bvh, p, hint, INFINITY, out);
+}
+
+int scc_tri_bvh_nearest_within(const scc_tri_bvh* bvh, scc_vec3 p, uint32_t hint, double max_dist2, scc_tri_nearest* out)
+{
     if (bvh->tri_count == 0) return 0;
     /* Depth-first, nearer child first, pruning boxes no nearer than the best so far. The
      * median split keeps the depth below 2 + log2(n), so 96 entries are plenty. */
     uint32_t stack[96];
     double stack_d[96];
     int sp = 0;
-    double best = INFINITY;
+    double best = max_dist2;
+    int found = 0;
     scc_tri_nearest r = { INFINITY, p, 0, 0, SCC_TRI_FACE };
     if (hint < bvh->tri_count) {
         const scc_vec3* v = bvh->tris + 3 * (size_t)hint;
-        r.dist2 = best = scc_closest_point_triangle(p, v[0], v[1], v[2], &r.point, &r.feature);
-        r.triangle = bvh->tri_index[hint];
-        r.slot = hint;
+        scc_vec3 q;
+        scc_tri_feature f;
+        const double d2 = scc_closest_point_triangle(p, v[0], v[1], v[2], &q, &f);
+        if (d2 < best) {
+            best = d2;
+            found = 1;
+            r.dist2 = d2; r.point = q; r.feature = f;
+            r.triangle = bvh->tri_index[hint];
+            r.slot = hint;
+        }
     }
     stack[sp] = 0; stack_d[sp] = box_dist2(&bvh->nodes[0].box, p); ++sp;
     while (sp > 0) {
@@ -234,6 +247,7 @@ int scc_tri_bvh_nearest_hint(const scc_tri_bvh* bvh, scc_vec3 p, uint32_t hint, 
                 const double d2 = scc_closest_point_triangle(p, v[0], v[1], v[2], &q, &f);
                 if (d2 < best) {
                     best = d2;
+                    found = 1;
                     r.dist2 = d2; r.point = q; r.triangle = bvh->tri_index[i]; r.slot = i; r.feature = f;
                 }
             }
@@ -252,5 +266,5 @@ int scc_tri_bvh_nearest_hint(const scc_tri_bvh* bvh, scc_vec3 p, uint32_t hint, 
         }
     }
     *out = r;
-    return 1;
+    return found;
 }

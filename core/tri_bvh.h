@@ -56,5 +56,8 @@ int scc_tri_bvh_nearest(const scc_tri_bvh* bvh, scc_vec3 p, scc_tri_nearest* out
 /* The same, starting from the distance to the triangle in slot `hint` (e.g. the answer for a
  * nearby point; UINT32_MAX for none), which prunes most of the tree at once. Exact either way. */
 int scc_tri_bvh_nearest_hint(const scc_tri_bvh* bvh, scc_vec3 p, uint32_t hint, scc_tri_nearest* out);
+/* The same, but only triangles nearer than sqrt(max_dist2) are looked for: returns 0 (and
+ * leaves *out unspecified) when there is none, which is fast for points far from the mesh. */
+int scc_tri_bvh_nearest_within(const scc_tri_bvh* bvh, scc_vec3 p, uint32_t hint, double max_dist2, scc_tri_nearest* out);
 
 #endif

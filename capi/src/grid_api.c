@@ -210,12 +210,10 @@ typedef struct mesh_sample_ctx {
     double sign;
 } mesh_sample_ctx;
 
-static double mesh_sample(void* user, scc_vec3 p, uint32_t* state)
+static double mesh_sample(void* user, scc_vec3 p, uint32_t* state, double cap)
 {
     const mesh_sample_ctx* c = user;
-    scc_mesh_distance_result r;
-    scc_mesh_sdf_query_hint(c->ms, p, state, &r);
-    return c->sign * r.distance;
+    return c->sign * scc_mesh_sdf_distance_capped(c->ms, p, state, cap);
 }
 
 sdfccd_Status capi_mesh_topology_message(const scc_mesh_topology* t, const char* fn)
@@ -263,9 +261,10 @@ sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_Grid
 
 typedef struct sdf_sample_ctx { const scc_sdf* sdf; double sign; } sdf_sample_ctx;
 
-static double sdf_sample(void* user, scc_vec3 p, uint32_t* state)
+static double sdf_sample(void* user, scc_vec3 p, uint32_t* state, double cap)
 {
     (void)state;
+    (void)cap;
     const sdf_sample_ctx* c = user;
     return c->sign * scc_sdf_eval(c->sdf, p, NULL);
 }
