@@ -103,8 +103,27 @@ START_TEST(test_bvh_vs_brute_force)
             scc_tri_nearest nr;
             ck_assert_int_eq(scc_tri_bvh_nearest(&bvh, p, &nr), 1);
             ck_assert_double_eq(nr.dist2, best);
+            /* the capped search finds the same triangle below the cap and nothing above it */
+            const double cap2 = 0.01 * scc_len2(e);
+            const int found = scc_tri_bvh_nearest_within(&bvh, p, (uint32_t)(it % m->triangle_count), cap2, &nr);
+            ck_assert_int_eq(found, best < cap2);
+            if (found) ck_assert_double_eq(nr.dist2, best);
         }
         scc_tri_bvh_destroy(&bvh);
+        /* capped signed distance: exact below the cap, the cap above it */
+        scc_mesh_sdf ms;
+        ck_assert_int_eq(scc_mesh_sdf_init(&ms, capi_allocator(), m), 0);
+        uint32_t hint = UINT32_MAX, hint2 = UINT32_MAX;
+        for (int it = 0; it < 500; ++it) {
+            scc_vec3 p = scc_v3(c.x + e.x * test_rng_uniform(&rng, -1, 1), c.y + e.y * test_rng_uniform(&rng, -1, 1), c.z + e.z * test_rng_uniform(&rng, -1, 1));
+            scc_mesh_distance_result r;
+            scc_mesh_sdf_query_hint(&ms, p, &hint, &r);
+            const double cap = 0.1 * scc_len(e);
+            const double v = scc_mesh_sdf_distance_capped(&ms, p, &hint2, cap);
+            if (fabs(r.distance) < cap) ck_assert_double_eq(v, r.distance);
+            else ck_assert_double_eq(v, cap);
+        }
+        scc_mesh_sdf_destroy(&ms);
         ck_assert_int_eq(sdfccd_destroy_mesh(id), SDFCCD_OK);
     }
 }
