@@ -15,6 +15,8 @@
  *     companion program sdfccd_peers.
  * Usage:
  *   sdfccd_bench report OUTDIR [--quick]   everything; writes OUTDIR/report.md, CSVs and the chart
+ *                                          (--quick: 64 cases per mesh; --smoke: 4, accuracy and chart only;
+ *                                          --only=MASK: 1 accuracy, 2 chart, 4 scaling, 8 peers)
  *   sdfccd_bench dataset DIR [--quick]     only the data set and its certified ground truth
  * The data set and ground truth are cached in OUTDIR/dataset and reused when present (same seed,
  * count and generator version). Progress goes to stderr. Seeded: the same command gives the same
@@ -385,7 +387,7 @@ static int read_ground_truth(const char* dir, dataset* ds)
 static void build_dataset(const char* dir, dataset* ds, int quick)
 {
     memset(ds, 0, sizeof *ds);
-    ds->n_per_mesh = quick ? 64 : 1024;
+    ds->n_per_mesh = quick >= 2 ? 4 : (quick ? 64 : 1024); /* quick 2: the ctest smoke run */
     ds->n = 2 * ds->n_per_mesh;
     ds->c = calloc((size_t)ds->n, sizeof *ds->c);
     make_triangle(&ds->mesh[0]);
@@ -863,7 +865,7 @@ static int run_report(const char* outdir, int quick, const char* argv0, unsigned
 
     if (sections & 1) {
     /* brute force subset */
-    int NB = quick ? 8 : 48;
+    int NB = quick >= 2 ? 1 : (quick ? 8 : 48);
     progress("brute force on %d cases per mesh", NB);
     FILE* bf = open_out(outdir, "brute_force.csv");
     fprintf(bf, "id,certified_lower,certified_toi,brute_force_toi,difference,queries\n");
@@ -970,7 +972,7 @@ static int run_report(const char* outdir, int quick, const char* argv0, unsigned
 
     if (sections & 2) {
     /* ---------------- speed versus accuracy */
-    int NS = quick ? 32 : 192;
+    int NS = quick >= 2 ? 2 : (quick ? 32 : 192);
     progress("speed versus accuracy on %d cases per mesh", NS);
     FILE* sv = open_out(outdir, "speed_accuracy.csv");
     fprintf(sv, "method,setting,mean_us,fn_rate,fp_rate,mean_abs_dtoi\n");
@@ -1147,7 +1149,7 @@ static int run_report(const char* outdir, int quick, const char* argv0, unsigned
     char* slash = strrchr(peers, '/');
     if (slash) snprintf(slash + 1, sizeof peers - (size_t)(slash + 1 - peers), "sdfccd_peers");
     else snprintf(peers, sizeof peers, "sdfccd_peers");
-    int NP = quick ? 32 : 256;
+    int NP = quick >= 2 ? 2 : (quick ? 32 : 256);
     snprintf(cmd, sizeof cmd, "'%s' '%s/cases.txt' %d > '%s/peers_cases.csv'", peers, dsdir, NP, outdir);
     int pr = access(peers, X_OK) == 0 ? system(cmd) : -1;
     if (pr != 0) {
@@ -1248,6 +1250,7 @@ int main(int argc, char** argv)
         unsigned sections = 15;
         for (int i = 3; i < argc; ++i) {
             if (strcmp(argv[i], "--quick") == 0) quick = 1;
+            else if (strcmp(argv[i], "--smoke") == 0) { quick = 2; sections = 3; } /* ctest: exit status only */
             else if (strncmp(argv[i], "--only=", 7) == 0) sections = (unsigned)atoi(argv[i] + 7);
         }
         return run_report(argv[2], quick, argv[0], sections);
@@ -1259,7 +1262,7 @@ int main(int argc, char** argv)
         free_dataset(&ds);
         return 0;
     }
-    fprintf(stderr, "usage: %s report OUTDIR [--quick] [--only=MASK] | dataset DIR [--quick]\n"
+    fprintf(stderr, "usage: %s report OUTDIR [--quick | --smoke] [--only=MASK] | dataset DIR [--quick]\n"
                     "  MASK: 1 accuracy, 2 speed-accuracy chart, 4 scaling, 8 peers (sum; default 15)\n", argv[0]);
     return 2;
 }
