@@ -195,6 +195,7 @@ void scc_grid_destroy(scc_grid* g)
     }
     scc_free(&al, g->hole_source, (size_t)g->n_cells * sizeof(uint32_t));
     scc_free(&al, g->blocks, (size_t)g->block_count * sizeof(double));
+    scc_free(&al, g->vertex_block, (size_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1) * sizeof(uint32_t));
     scc_free(&al, g->fields, (size_t)g->field_count * sizeof *g->fields);
     scc_free(&al, g, sizeof *g);
 }
@@ -210,6 +211,7 @@ size_t scc_grid_memory(const scc_grid* g)
     if (g->cell_lipschitz) b += (size_t)g->fields[0].cell_count * sizeof(float);
     if (g->hole_source) b += (size_t)g->n_cells * sizeof(uint32_t);
     b += (size_t)g->block_count * sizeof(double);
+    if (g->vertex_block) b += (size_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1) * sizeof(uint32_t);
     return b;
 }
 
@@ -321,6 +323,7 @@ uint64_t scc_grid_dense_block_index(const uint32_t res[3], uint64_t l)
 
 double scc_grid_node_value(const scc_grid* g, uint32_t field, uint64_t id)
 {
+    if (field == 0 && g->vertex_block) return NAN; /* band layout: node ids exist only in saved files */
     if (field == 0 && g->blocks) return g->blocks[scc_grid_dense_block_index(g->res, id)];
     return g->fields[field].nodes[id];
 }
@@ -333,7 +336,8 @@ static inline void gather_cell(const scc_grid* g, const scc_grid_field* fd, uint
         for (int dk = 0; dk < 2; ++dk)
             for (int dj = 0; dj < 2; ++dj)
                 for (int di = 0; di < 2; ++di) {
-                    const double* b = g->blocks + 7 * ((ijk[0] + di) + n1x * ((ijk[1] + dj) + n1y * (uint64_t)(ijk[2] + dk)));
+                    const uint64_t vtx = (ijk[0] + di) + n1x * ((ijk[1] + dj) + n1y * (uint64_t)(ijk[2] + dk));
+                    const double* b = g->blocks + 7 * (uint64_t)(g->vertex_block ? g->vertex_block[vtx] : vtx);
                     v[di + 2 * dj + 4 * dk] = b[0];
                     if (!di) { v[8 + 4 * dj + 2 * dk] = b[1]; v[9 + 4 * dj + 2 * dk] = b[2]; }
                     if (!dj) { v[16 + 4 * dk + 2 * di] = b[3]; v[17 + 4 * dk + 2 * di] = b[4]; }
@@ -627,13 +631,15 @@ static void cell_bound_task(void* vctx, uint32_t task)
     const scc_grid_field* fd = &g->fields[0];
     const uint64_t begin = (uint64_t)task * ctx->chunk;
     uint64_t end = begin + ctx->chunk;
-    if (end > fd->cell_count) end = fd->cell_count;
+    if (end > g->n_cells) end = g->n_cells;
     const double c0[3] = { 2.0 / g->h.x, 2.0 / g->h.y, 2.0 / g->h.z };
-    for (uint64_t c = begin; c < end; ++c) {
+    for (uint64_t l = begin; l < end; ++l) {
+        const uint32_t c = fd->map[l];
+        if (c == SCC_GRID_NO_CELL) continue;
         double v[32];
-        uint32_t ijk[3] = { 0, 0, 0 };
-        if (!fd->cells) cell_ijk(g, c, ijk); /* dense: stored cell c is full-grid cell c */
-        gather_cell(g, fd, (uint32_t)c, ijk, v);
+        uint32_t ijk[3];
+        cell_ijk(g, l, ijk);
+        gather_cell(g, fd, c, ijk, v);
         int hole = 0;
         for (int a = 0; a < 32; ++a) hole |= v[a] == SCC_GRID_NO_VALUE;
         if (hole) { g->cell_lipschitz[c] = -1.0f; continue; }
@@ -707,7 +713,7 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
             g->block_count = nb;
         }
     }
-    g->dense_layout = g->blocks != NULL;
+    g->dense_layout = g->blocks != NULL && g->vertex_block == NULL;
 
     /* Per-cell gradient bounds. */
     g->cell_lipschitz = scc_alloc(a, (size_t)fd->cell_count * sizeof(float));
@@ -715,7 +721,7 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     if ((fd->cell_count && !g->cell_lipschitz) || !bt) { scc_free(a, bt, sizeof *bt); return SCC_GRID_OUT_OF_MEMORY; }
     bern_tables_init(bt);
     finalize_ctx ctx = { g, bt, 2048 };
-    const uint32_t tasks = (uint32_t)((fd->cell_count + ctx.chunk - 1) / ctx.chunk);
+    const uint32_t tasks = (uint32_t)((g->n_cells + ctx.chunk - 1) / ctx.chunk);
     const int cancelled = run_tasks(parallel_for, parallel_user, SCC_GRID_STAGE_CELLS, tasks, cell_bound_task, &ctx);
     if (cancelled) { scc_free(a, bt, sizeof *bt); return SCC_GRID_CANCELLED; }
 

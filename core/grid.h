@@ -73,9 +73,12 @@ typedef struct scc_grid {
     int outside_positive;      /* every boundary node >= 0: outside the box phi is positive */
     int dense_layout;          /* field 0 is dense in Discregrid's numbering: fields[0].cells and
                                   fields[0].nodes are NULL (node_count stays the file's count) and
-                                  the values live in `blocks` */
-    double* blocks;            /* dense field 0: 7 values per grid vertex (scc_grid_dense_block_index) */
-    uint64_t block_count;
+                                  the values live in `blocks` (vertex_block NULL) */
+    double* blocks;            /* field 0 built in-tree or dense: 7 values per grid vertex
+                                  (scc_grid_dense_block_index); fields[0].nodes/cells are NULL */
+    uint64_t block_count;      /* doubles in blocks */
+    uint32_t* vertex_block;    /* narrow band built in-tree: per grid vertex, its block in `blocks`
+                                  (only vertices of kept cells have one); NULL when dense */
     scc_allocator allocator;   /* what freed the arrays (copied at creation) */
 } scc_grid;
 
@@ -120,7 +123,8 @@ const uint32_t* scc_grid_cell_ids(const scc_grid* g, uint32_t field, uint32_t c,
  * two nodes of each of the x, y and z edges starting at it. A cell's 32 values then come from
  * 8 blocks (4 pairs of neighbours), which keeps evaluation cache- and TLB-friendly. */
 uint64_t scc_grid_dense_block_index(const uint32_t res[3], uint64_t l);
-/* Value of node `id` (file numbering) of `field`, whatever the storage. */
+/* Value of node `id` (file numbering) of `field`, whatever the storage (NAN for a band grid built
+ * in-tree, whose node numbering only exists in the files it saves). */
 double scc_grid_node_value(const scc_grid* g, uint32_t field, uint64_t id);
 
 /* Bytes owned by the grid (header, fields, derived arrays). */

@@ -168,34 +168,54 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
             return SCC_GRID_BUILD_EMPTY_BAND;
         }
         uint64_t used = 0;
-        for (uint64_t n = 0; n < n_nodes; ++n)
-            if (renumber[n] == 0) renumber[n] = (uint32_t)used++;
-        fd->nodes = scc_alloc(a, (size_t)used * sizeof(double));
-        fd->cells = scc_alloc(a, (size_t)kept * 32 * sizeof(uint32_t));
-        if (!fd->nodes || !fd->cells) {
-            scc_free(a, fd->nodes, (size_t)used * sizeof(double));
-            scc_free(a, fd->cells, (size_t)kept * 32 * sizeof(uint32_t));
-            fd->nodes = NULL; fd->cells = NULL;
-            scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
-            scc_free(a, nodes, (size_t)nodes_len * sizeof(double));
-            scc_grid_destroy(g);
-            return SCC_GRID_BUILD_OUT_OF_MEMORY;
-        }
-        fd->node_count = used;
-        fd->cell_count = kept;
-        for (uint64_t n = 0; n < n_nodes; ++n)
-            if (renumber[n] != 0xFFFFFFFFu) fd->nodes[renumber[n]] = nodes[n];
+        for (uint64_t n = 0; n < n_nodes; ++n) used += renumber[n] == 0;
+        scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
+        /* Block-sparse storage: every vertex of a kept cell owns a block of 7 values (its own and
+         * the nodes of the edges starting there), so kept cells need no 128-byte id table. */
+        const uint64_t nv1 = (uint64_t)(def->res[0] + 1) * (def->res[1] + 1) * (def->res[2] + 1);
+        uint32_t* vb = scc_alloc(a, (size_t)nv1 * sizeof(uint32_t));
+        if (!vb) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
+        memset(vb, 0xFF, (size_t)nv1 * sizeof(uint32_t));
+        uint64_t nblocks = 0;
         l = 0;
         for (uint32_t k = 0; k < def->res[2]; ++k)
             for (uint32_t j = 0; j < def->res[1]; ++j)
                 for (uint32_t i = 0; i < def->res[0]; ++i, ++l) {
-                    const uint32_t c = fd->map[l];
-                    if (c == SCC_GRID_NO_CELL) continue;
-                    scc_grid_dense_cell_nodes(def->res, i, j, k, ids);
-                    for (int s = 0; s < 32; ++s) fd->cells[(size_t)c * 32 + s] = renumber[ids[s]];
+                    if (fd->map[l] == SCC_GRID_NO_CELL) continue;
+                    for (int c = 0; c < 8; ++c) {
+                        const uint64_t vtx = (i + (c & 1)) + (def->res[0] + 1) * ((uint64_t)(j + ((c >> 1) & 1)) + (def->res[1] + 1) * (uint64_t)(k + (c >> 2)));
+                        if (vb[vtx] == 0xFFFFFFFFu) vb[vtx] = 0; /* mark */
+                    }
                 }
-        scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
+        for (uint64_t vtx = 0; vtx < nv1; ++vtx)
+            if (vb[vtx] == 0) vb[vtx] = (uint32_t)nblocks++;
+        double* blocks = scc_alloc(a, (size_t)nblocks * 7 * sizeof(double));
+        if (!blocks) {
+            scc_free(a, vb, (size_t)nv1 * sizeof(uint32_t));
+            scc_free(a, nodes, (size_t)nodes_len * sizeof(double));
+            scc_grid_destroy(g);
+            return SCC_GRID_BUILD_OUT_OF_MEMORY;
+        }
+        for (uint64_t q = 0; q < nblocks * 7; ++q) blocks[q] = SCC_GRID_NO_VALUE; /* slots no kept cell uses */
+        l = 0;
+        for (uint32_t k = 0; k < def->res[2]; ++k)
+            for (uint32_t j = 0; j < def->res[1]; ++j)
+                for (uint32_t i = 0; i < def->res[0]; ++i, ++l) {
+                    if (fd->map[l] == SCC_GRID_NO_CELL) continue;
+                    scc_grid_dense_cell_nodes(def->res, i, j, k, ids);
+                    for (int s = 0; s < 32; ++s) {
+                        const uint64_t bi = scc_grid_dense_block_index(def->res, ids[s]);
+                        blocks[7 * (uint64_t)vb[bi / 7] + bi % 7] = nodes[ids[s]];
+                    }
+                }
         scc_free(a, nodes, (size_t)nodes_len * sizeof(double));
+        g->blocks = blocks;
+        g->block_count = nblocks * 7;
+        g->vertex_block = vb;
+        fd->nodes = NULL;
+        fd->cells = NULL;
+        fd->node_count = used;
+        fd->cell_count = kept;
     }
 
     switch (scc_grid_finalize(g, banded ? def->band : 0.0, def->parallel_for, def->parallel_user)) {

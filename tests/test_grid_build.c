@@ -151,7 +151,7 @@ START_TEST(test_narrow_band)
             (long long)di.stored_cells, (long long)di.node_count, (long long)di.memory_bytes, w, (long long)bi.stored_cells,
             (long long)bi.node_count, (long long)bi.memory_bytes);
     ck_assert_int_lt(bi.stored_cells, di.stored_cells / 3);
-    ck_assert_int_lt(bi.memory_bytes, di.memory_bytes * 4 / 5); /* dense grids need no cell table; bands pay 128 B per kept cell */
+    ck_assert_int_lt(bi.memory_bytes, di.memory_bytes / 2);
     ck_assert_double_eq(bi.band, w);
 
     char path[512];

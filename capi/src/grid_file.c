@@ -195,6 +195,48 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
     if (!host_is_little_endian()) return capi_error(SDFCCD_UNSUPPORTED, "sdfccd_save_grid: .cdf files are little-endian; this host is not");
     FILE* f = fopen(path, "wb");
     if (!f) return capi_error(SDFCCD_IO_ERROR, "sdfccd_save_grid: cannot create '%s': %s", path, strerror(errno));
+    /* A band grid built in-tree keeps field 0 in vertex blocks: number its nodes (first use in
+     * cell order) and build the id table the file needs. */
+    double* band_nodes = NULL;
+    uint32_t* band_cells = NULL;
+    size_t band_nodes_bytes = 0, band_cells_bytes = 0;
+    if (g->vertex_block) {
+        const scc_grid_field* fd = &g->fields[0];
+        band_nodes_bytes = (size_t)fd->node_count * sizeof(double);
+        band_cells_bytes = (size_t)fd->cell_count * 128;
+        const size_t key_bytes = (size_t)g->block_count * sizeof(uint32_t);
+        band_nodes = capi_alloc(band_nodes_bytes);
+        band_cells = capi_alloc(band_cells_bytes);
+        uint32_t* id_of_key = capi_alloc(key_bytes);
+        if (!band_nodes || !band_cells || !id_of_key) {
+            capi_free(band_nodes, band_nodes_bytes);
+            capi_free(band_cells, band_cells_bytes);
+            capi_free(id_of_key, key_bytes);
+            fclose(f);
+            remove(path);
+            return capi_oom("a band grid's node numbering");
+        }
+        memset(id_of_key, 0xFF, key_bytes);
+        uint64_t next = 0;
+        for (uint64_t l = 0; l < g->n_cells; ++l) {
+            const uint32_t c = fd->map[l];
+            if (c == SCC_GRID_NO_CELL) continue;
+            const uint32_t i = (uint32_t)(l % g->res[0]), j = (uint32_t)((l / g->res[0]) % g->res[1]), k = (uint32_t)(l / ((uint64_t)g->res[0] * g->res[1]));
+            uint32_t ids[32];
+            scc_grid_dense_cell_nodes(g->res, i, j, k, ids);
+            for (int a = 0; a < 32; ++a) {
+                const uint64_t bi = scc_grid_dense_block_index(g->res, ids[a]);
+                const uint64_t key = 7 * (uint64_t)g->vertex_block[bi / 7] + bi % 7;
+                if (id_of_key[key] == 0xFFFFFFFFu) {
+                    id_of_key[key] = (uint32_t)next;
+                    band_nodes[next++] = g->blocks[key];
+                }
+                band_cells[(size_t)c * 32 + a] = id_of_key[key];
+            }
+        }
+        capi_free(id_of_key, key_bytes);
+    }
+
     const double dom[6] = { g->lo.x, g->lo.y, g->lo.z, g->hi.x, g->hi.y, g->hi.z };
     const double h[3] = { g->h.x, g->h.y, g->h.z }, ih[3] = { g->inv_h.x, g->inv_h.y, g->inv_h.z };
     const uint64_t n_cells = g->n_cells, n_fields = g->field_count;
@@ -205,6 +247,7 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
         const uint64_t c = g->fields[i].node_count;
         ok = wr(f, &c, 8);
         if (g->fields[i].nodes) ok = ok && wr(f, g->fields[i].nodes, (size_t)c * 8);
+        else if (i == 0 && band_nodes) ok = ok && wr(f, band_nodes, (size_t)c * 8);
         else { /* dense field 0 in the vertex-block layout: back to file order */
             double buf[1024];
             for (uint64_t k = 0; ok && k < c; k += 1024) {
@@ -219,6 +262,7 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
         const uint64_t c = g->fields[i].cell_count;
         ok = wr(f, &c, 8);
         if (g->fields[i].cells) ok = ok && wr(f, g->fields[i].cells, (size_t)c * 128);
+        else if (i == 0 && band_cells) ok = ok && wr(f, band_cells, (size_t)c * 128);
         else /* dense field 0: the table is implied; write it out */
             for (uint64_t k = 0; ok && k < c; ++k) {
                 uint32_t scratch[32];
@@ -227,6 +271,8 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
     }
     ok = ok && wr(f, &n_fields, 8);
     for (uint32_t i = 0; ok && i < g->field_count; ++i) ok = wr(f, &n_cells, 8) && wr(f, g->fields[i].map, (size_t)n_cells * 4);
+    capi_free(band_nodes, band_nodes_bytes);
+    capi_free(band_cells, band_cells_bytes);
     if (fclose(f) != 0) ok = 0;
     if (!ok) {
         remove(path);
