@@ -8,7 +8,8 @@ if(SDFCCD_MESHOPT_LIB AND SDFCCD_MESHOPT_INC AND NOT SDFCCD_BUILD_SHARED)
   # The scaling table times single triangles through the core's instrumented mesh query.
   target_link_libraries(sdfccd_bench PRIVATE sdfccd sdfccd_core ${SDFCCD_MESHOPT_LIB} m)
   target_include_directories(sdfccd_bench PRIVATE ${SDFCCD_MESHOPT_INC})
-  target_compile_definitions(sdfccd_bench PRIVATE SDFCCD_BENCH_DATA_DIR="${PROJECT_SOURCE_DIR}/data")
+  target_compile_definitions(sdfccd_bench PRIVATE SDFCCD_BENCH_DATA_DIR="${PROJECT_SOURCE_DIR}/data"
+    SDFCCD_BENCH_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   sdfccd_target_defaults(sdfccd_bench)
 else()
   message(STATUS "sdfccd_bench: not built (needs libmeshoptimizer-dev and a static libsdfccd)")
