@@ -175,9 +175,11 @@ typedef struct scc_grid_build_def {
                                   (cell diagonal); <= 0 or INFINITY: dense */
     scc_grid_sample_fn* sample;
     void* sample_user;
-    double sample_lipschitz;   /* > 0: a Lipschitz bound of the sampled function (1 for exact
+    double sample_lipschitz;   /* > 0: a Lipschitz bound L of the sampled function (1 for exact
                                   distances); lets a narrow-band build skip the edge nodes of cells
-                                  that are certainly culled. 0: sample every node. */
+                                  that are certainly culled, and gives culled cells the known bound
+                                  |phi| >= band + |h| (1 - L). 0: unknown (every node sampled, no
+                                  known bound in culled cells). */
     scc_parallel_for_fn* parallel_for; /* NULL: serial */
     void* parallel_user;
 } scc_grid_build_def;

@@ -113,7 +113,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
             for (uint64_t l = 0; l < nv; ++l)
                 if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
     } else {
-        node_ctx nc = { def, g, nodes, 1, NULL, INFINITY, n_nodes, 1024 };
+        node_ctx nc = { def, g, nodes, !banded, NULL, INFINITY, n_nodes, 1024 };
         cancelled = sample_nodes(def, &nc, SCC_GRID_STAGE_NODES);
     }
     if (cancelled) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED; }
@@ -218,7 +218,12 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
         fd->cell_count = kept;
     }
 
-    switch (scc_grid_finalize(g, banded ? def->band : 0.0, def->parallel_for, def->parallel_user)) {
+    /* Every point of a culled cell is within |h| of a corner whose |value| >= band + |h|, so
+     * |phi| >= band + |h| (1 - L) there for an L-Lipschitz source (band itself for distances). */
+    double band_lb = 0.0;
+    if (banded && def->sample_lipschitz > 0.0 && isfinite(def->sample_lipschitz))
+        band_lb = fmax(0.0, def->band + scc_len(g->h) * (1.0 - def->sample_lipschitz));
+    switch (scc_grid_finalize(g, band_lb, def->parallel_for, def->parallel_user)) {
     case SCC_GRID_OK: break;
     case SCC_GRID_CANCELLED: scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED;
     case SCC_GRID_EMPTY: scc_grid_destroy(g); return SCC_GRID_BUILD_EMPTY_BAND;

@@ -479,6 +479,50 @@ START_TEST(test_mesh_import_formats)
 }
 END_TEST
 
+static double core_sphere_sample(void* user, scc_vec3 p, uint32_t* state, double cap)
+{
+    (void)user; (void)state; (void)cap;
+    return scc_len(p) - 0.5;
+}
+
+/* The core builder with an unknown Lipschitz bound (0) and a band: every node is sampled, the
+ * band grid matches the dense one in kept cells, and culled cells keep their side. */
+START_TEST(test_core_band_unknown_lipschitz)
+{
+    scc_grid_build_def d;
+    memset(&d, 0, sizeof d);
+    d.lo = scc_v3(-1, -1, -1);
+    d.hi = scc_v3(1, 1, 1);
+    d.res[0] = d.res[1] = d.res[2] = 10;
+    d.sample = core_sphere_sample;
+    scc_grid *dense = NULL, *band = NULL;
+    ck_assert_int_eq(scc_grid_build(capi_allocator(), &d, &dense), SCC_GRID_BUILD_OK);
+    d.band = 0.1;
+    d.sample_lipschitz = 0.0;
+    ck_assert_int_eq(scc_grid_build(capi_allocator(), &d, &band), SCC_GRID_BUILD_OK);
+    ck_assert_uint_lt(band->fields[0].cell_count, dense->fields[0].cell_count);
+    ck_assert_double_eq(band->band, 0.0);
+    test_rng rng = { 61 };
+    for (int i = 0; i < 2000; ++i) {
+        scc_vec3 p = scc_v3(test_rng_uniform(&rng, -1, 1), test_rng_uniform(&rng, -1, 1), test_rng_uniform(&rng, -1, 1));
+        double raw;
+        const double vb = scc_grid_eval(&band->base, p, NULL), vd = scc_grid_eval(&dense->base, p, NULL);
+        if (scc_grid_interpolate(band, 0, p, &raw, NULL)) ck_assert_double_eq(vb, vd);
+        else ck_assert((vb < 0) == (scc_len(p) < 0.5) && fabs(vb) <= fabs(scc_len(p) - 0.5) + 1e-12);
+    }
+    scc_grid_destroy(dense);
+    scc_grid_destroy(band);
+}
+END_TEST
+
+static double sphere_cb(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
+{
+    (void)user;
+    const double l = sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+    if (g) *g = l > 0 ? (sdfccd_Vec3){ p.x / l, p.y / l, p.z / l } : (sdfccd_Vec3){ 0, 0, 1 };
+    return l - 0.5;
+}
+
 START_TEST(test_bad_defs)
 {
     sdfccd_MeshId mesh = load_mesh("bullet3/cube.obj");
@@ -519,6 +563,31 @@ START_TEST(test_bad_defs)
     def.band = 1e-3;
     def.resolution[0] = def.resolution[1] = def.resolution[2] = 4;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_INVALID_ARGUMENT);
+    /* a band grid of a callback SDF with Lipschitz bound 3: culled cells still evaluate to the
+     * right side with a magnitude below the distance */
+    {
+        sdfccd_SdfId cb, bg;
+        sdfccd_CallbackSdfDef cdef = sdfccd_default_callback_sdf_def();
+        cdef.eval = sphere_cb;
+        cdef.lipschitz = 3.0; /* a valid, loose bound: the band's known lower bound drops to 0 */
+        cdef.bounds = (sdfccd_Aabb){ { -0.5, -0.5, -0.5 }, { 0.5, 0.5, 0.5 } };
+        ck_assert_int_eq(sdfccd_create_callback_sdf(&cdef, &cb), SDFCCD_OK);
+        {
+            sdfccd_GridDef bdef = sdfccd_default_grid_def();
+            bdef.resolution[0] = bdef.resolution[1] = bdef.resolution[2] = 12;
+            bdef.fit_domain = 0;
+            bdef.domain = (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } };
+            bdef.band = 0.1;
+            ck_assert_int_eq(sdfccd_create_grid_from_sdf(cb, &bdef, &bg), SDFCCD_OK);
+            double v;
+            ck_assert_int_eq(sdfccd_sdf_eval(bg, (sdfccd_Vec3){ 0.9, 0.9, 0.9 }, &v, NULL), SDFCCD_OK);
+            ck_assert(v > 0.0 && v <= sqrt(3 * 0.81) - 0.5 + 1e-12);
+            ck_assert_int_eq(sdfccd_sdf_eval(bg, (sdfccd_Vec3){ 0.0, 0.0, 0.05 }, &v, NULL), SDFCCD_OK);
+            ck_assert(v < 0.0 && v >= -0.5 - 1e-9);
+            ck_assert_int_eq(sdfccd_destroy_sdf(bg), SDFCCD_OK);
+            ck_assert_int_eq(sdfccd_destroy_sdf(cb), SDFCCD_OK);
+        }
+    }
     /* an unbounded SDF needs an explicit domain */
     ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, 0.0, &plane), SDFCCD_OK);
     def = sdfccd_default_grid_def();
@@ -564,6 +633,7 @@ int main(void)
     tcase_add_test(tc, test_ccd_on_grid);
     tcase_add_test(tc, test_mesh_import_formats);
     tcase_add_test(tc, test_bad_defs);
+    tcase_add_test(tc, test_core_band_unknown_lipschitz);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }
