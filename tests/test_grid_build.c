@@ -5,6 +5,7 @@
  * the per-cell gradient bounds against sampled gradients, the grid inside CCD queries, mesh
  * import of several formats, and argument errors. */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -515,6 +516,53 @@ START_TEST(test_core_band_unknown_lipschitz)
 }
 END_TEST
 
+typedef struct eval_job { sdfccd_SdfId grid; const sdfccd_Vec3* p; double* out; int n; } eval_job;
+static void* eval_thread(void* arg)
+{
+    eval_job* j = arg;
+    for (int i = 0; i < j->n; ++i) {
+        sdfccd_Vec3 g;
+        sdfccd_sdf_eval(j->grid, j->p[i], &j->out[i], &g);
+        j->out[i] += 1e-3 * (g.x + g.y + g.z);
+    }
+    return NULL;
+}
+
+/* Evaluation is thread-safe: four threads evaluating one band grid at once (holes, outside
+ * points and kept cells) give exactly the serial results. */
+START_TEST(test_concurrent_eval)
+{
+    sdfccd_MeshId mesh = load_mesh("bullet3/torus_textured.obj");
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 20;
+    def.band = 0.05;
+    def.padding = 0.2;
+    sdfccd_SdfId g;
+    ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_OK);
+    enum { N = 20000, T = 4 };
+    sdfccd_Vec3* p = malloc(N * sizeof *p);
+    double* serial = malloc(N * sizeof *serial);
+    double* par = malloc(T * N * sizeof *par);
+    test_rng rng = { 71 };
+    for (int i = 0; i < N; ++i) p[i] = (sdfccd_Vec3){ test_rng_uniform(&rng, -1.2, 1.2), test_rng_uniform(&rng, -0.6, 0.6), test_rng_uniform(&rng, -1.2, 1.2) };
+    eval_job js = { g, p, serial, N };
+    eval_thread(&js);
+    pthread_t th[T];
+    eval_job jobs[T];
+    for (int t = 0; t < T; ++t) {
+        jobs[t] = (eval_job){ g, p, par + (size_t)t * N, N };
+        ck_assert_int_eq(pthread_create(&th[t], NULL, eval_thread, &jobs[t]), 0);
+    }
+    for (int t = 0; t < T; ++t) pthread_join(th[t], NULL);
+    for (int t = 0; t < T; ++t) ck_assert_int_eq(memcmp(serial, par + (size_t)t * N, N * sizeof(double)), 0);
+    free(p);
+    free(serial);
+    free(par);
+    ck_assert_int_eq(sdfccd_destroy_sdf(g), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
+}
+END_TEST
+
 static double sphere_cb(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 {
     (void)user;
@@ -634,6 +682,7 @@ int main(void)
     tcase_add_test(tc, test_mesh_import_formats);
     tcase_add_test(tc, test_bad_defs);
     tcase_add_test(tc, test_core_band_unknown_lipschitz);
+    tcase_add_test(tc, test_concurrent_eval);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }
