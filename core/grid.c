@@ -195,6 +195,7 @@ void scc_grid_destroy(scc_grid* g)
     }
     scc_free(&al, g->hole_source, (size_t)g->n_cells * sizeof(uint32_t));
     scc_free(&al, g->blocks, (size_t)g->block_count * sizeof(double));
+    scc_free(&al, g->block_lipschitz, (size_t)((g->res[0] + 3) / 4) * ((g->res[1] + 3) / 4) * ((g->res[2] + 3) / 4) * sizeof(float));
     scc_free(&al, g->vertex_block, (size_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1) * sizeof(uint32_t));
     scc_free(&al, g->fields, (size_t)g->field_count * sizeof *g->fields);
     scc_free(&al, g, sizeof *g);
@@ -211,6 +212,7 @@ size_t scc_grid_memory(const scc_grid* g)
     if (g->cell_lipschitz) b += (size_t)g->fields[0].cell_count * sizeof(float);
     if (g->hole_source) b += (size_t)g->n_cells * sizeof(uint32_t);
     b += (size_t)g->block_count * sizeof(double);
+    if (g->block_lipschitz) b += (size_t)((g->res[0] + 3) / 4) * ((g->res[1] + 3) / 4) * ((g->res[2] + 3) / 4) * sizeof(float);
     if (g->vertex_block) b += (size_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1) * sizeof(uint32_t);
     return b;
 }
@@ -544,7 +546,16 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
     locate(g, clamp_box(box->hi, &dom), b);
     const uint64_t count = (uint64_t)(b[0] - a[0] + 1) * (b[1] - a[1] + 1) * (b[2] - a[2] + 1);
     double L = 0.0;
-    if (count > 32768) L = global;
+    if (count > 512 && g->block_lipschitz) {
+        /* large boxes: the per-block maxima (4^3 cells) of the blocks the box touches */
+        const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4;
+        for (uint32_t k = a[2] / 4; k <= b[2] / 4; ++k)
+            for (uint32_t j = a[1] / 4; j <= b[1] / 4; ++j)
+                for (uint32_t i = a[0] / 4; i <= b[0] / 4; ++i) {
+                    const double bl = g->block_lipschitz[i + (uint64_t)nbx * (j + (uint64_t)nby * k)];
+                    if (bl > L) L = bl;
+                }
+    } else if (count > 32768) L = global;
     else {
         const scc_grid_field* fd = &g->fields[0];
         for (uint32_t k = a[2]; k <= b[2]; ++k)
@@ -790,6 +801,23 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
      * unbounded (phi_q - d continues the inside). Non-negativity of each boundary face is
      * proved with the face's Bernstein coefficients (the face restriction of the cell's
      * tensor Bernstein form), which enclose the interpolant on the face. */
+    /* Per-block maxima of the cell bounds (blocks of 4^3 cells; cells without values count 1)
+     * for the Lipschitz bound of large boxes. */
+    {
+        const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4, nbz = (g->res[2] + 3) / 4;
+        g->block_lipschitz = scc_alloc(a, (size_t)nbx * nby * nbz * sizeof(float));
+        if (!g->block_lipschitz) { scc_free(a, bt, sizeof *bt); return SCC_GRID_OUT_OF_MEMORY; }
+        for (size_t q = 0; q < (size_t)nbx * nby * nbz; ++q) g->block_lipschitz[q] = 0.0f;
+        for (uint64_t l = 0; l < g->n_cells; ++l) {
+            uint32_t ijk[3];
+            cell_ijk(g, l, ijk);
+            const uint32_t c = fd->map[l];
+            const float cl = (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) ? 1.0f : g->cell_lipschitz[c];
+            float* bl = &g->block_lipschitz[ijk[0] / 4 + (uint64_t)nbx * (ijk[1] / 4 + (uint64_t)nby * (ijk[2] / 4))];
+            if (cl > *bl) *bl = cl;
+        }
+    }
+
     /* outside_positive: every node on the domain boundary is >= 0 (and no inside hole touches
      * it), i.e. the sampled surface lies inside the box. */
     g->outside_positive = 1;

@@ -62,6 +62,7 @@ typedef struct scc_grid {
     scc_grid_field* fields;    /* field_count entries */
 
     /* Derived data for field 0 (scc_grid_finalize). */
+    float* block_lipschitz;    /* max of the cell bounds per block of 4^3 cells (cells without values: 1) */
     float* cell_lipschitz;     /* per stored cell of field 0: bound on |grad phi| inside it, or -1
                                   when the cell touches a not-sampled node (then it has no value) */
     uint32_t* hole_source;     /* n_cells entries when some cell has no value, else NULL: for a cell
