@@ -23,9 +23,11 @@
  *    value is phi(q) - d where phi(q) < 0, a 1-Lipschitz lower bound that keeps points beyond an
  *    inside boundary inside; the two rules meet discontinuously where the surface crosses the
  *    boundary, and `bounds` are infinite unless phi >= 0 on the boundary is proved face by face.
- * The per-cell bound on |grad phi| used by the certified method is exact for the interpolant in
- * cells with values (a Bernstein enclosure), 1 in culled cells (sound for the true distance the
- * conservative value bounds from below) and sqrt(1 + L^2) outside the domain.
+ * The bound on |grad phi| the certified method uses in a box (sdfccd_grid_lipschitz_bound) is the
+ * largest per-cell bound of the cells the box touches: in cells with values a rigorous upper bound
+ * on the interpolant's gradient (Bernstein enclosure of each partial derivative; about 1.3x the
+ * sampled maximum on average), 1 in culled cells (sound for the true distance the conservative
+ * value bounds from below), and sqrt(1 + L^2) where the box leaves the domain.
  */
 #ifndef SDFCCD_GRID_H
 #define SDFCCD_GRID_H
