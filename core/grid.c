@@ -86,6 +86,28 @@ void scc_cell_shape(scc_vec3 xi, double N[32], double dN[32][3])
     }
 }
 
+/* One edge family of the factored element: e[4 dp + 2 dr + t] are the values of the edge
+ * nodes along axis d (at -1/3, +1/3 for t = 0, 1); Lp, Lr the linear factors of the outer and
+ * inner axes. Adds the family's value to *phi and its derivatives to g[d], g[p], g[r]. */
+static inline void edge_family(const double e[8], double xd, const double Lp[2], const double Lr[2], double* phi, double* g, int d, int p, int r)
+{
+    const double w = 1.0 - xd * xd;
+    const double m0 = 1.0 - 3.0 * xd, m1 = 1.0 + 3.0 * xd;
+    const double l00 = Lp[0] * Lr[0], l01 = Lp[0] * Lr[1], l10 = Lp[1] * Lr[0], l11 = Lp[1] * Lr[1];
+    const double B0 = e[0] * l00 + e[2] * l01 + e[4] * l10 + e[6] * l11;
+    const double B1 = e[1] * l00 + e[3] * l01 + e[5] * l10 + e[7] * l11;
+    const double m = m0 * B0 + m1 * B1;
+    *phi += (9.0 / 64.0) * w * m;
+    if (g) {
+        /* d/dx_p of Lp[dp] is -1, +1; d/dx_r of Lr[dr] likewise */
+        const double Bp0 = (e[4] - e[0]) * Lr[0] + (e[6] - e[2]) * Lr[1], Bp1 = (e[5] - e[1]) * Lr[0] + (e[7] - e[3]) * Lr[1];
+        const double Br0 = (e[2] - e[0]) * Lp[0] + (e[6] - e[4]) * Lp[1], Br1 = (e[3] - e[1]) * Lp[0] + (e[7] - e[5]) * Lp[1];
+        g[d] += (9.0 / 64.0) * (-2.0 * xd * m + w * 3.0 * (B1 - B0));
+        g[p] += (9.0 / 64.0) * w * (m0 * Bp0 + m1 * Bp1);
+        g[r] += (9.0 / 64.0) * w * (m0 * Br0 + m1 * Br1);
+    }
+}
+
 void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double out_grad[3])
 {
     /* The same interpolant as sum_a v[a] N_a, factored: the corner part is
@@ -94,16 +116,16 @@ void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double ou
     const double x[3] = { xi.x, xi.y, xi.z };
     double L[3][2];
     for (int d = 0; d < 3; ++d) { L[d][0] = 1.0 - x[d]; L[d][1] = 1.0 + x[d]; }
-    double S = 0.0, Sx = 0.0, Sy = 0.0, Sz = 0.0;
-    for (int a = 0; a < 8; ++a) {
-        const int i0 = a & 1, i1 = (a >> 1) & 1, i2 = (a >> 2) & 1;
-        const double yz = L[1][i1] * L[2][i2];
-        S += v[a] * L[0][i0] * yz;
-        if (out_grad) {
-            Sx += (i0 ? v[a] : -v[a]) * yz;
-            Sy += (i1 ? v[a] : -v[a]) * L[0][i0] * L[2][i2];
-            Sz += (i2 ? v[a] : -v[a]) * L[0][i0] * L[1][i1];
-        }
+    /* trilinear form of the corner values (slot di + 2 dj + 4 dk) and its derivatives */
+    const double a00 = v[0] * L[0][0] + v[1] * L[0][1], a10 = v[2] * L[0][0] + v[3] * L[0][1];
+    const double a01 = v[4] * L[0][0] + v[5] * L[0][1], a11 = v[6] * L[0][0] + v[7] * L[0][1];
+    const double y0z0 = L[1][0] * L[2][0], y1z0 = L[1][1] * L[2][0], y0z1 = L[1][0] * L[2][1], y1z1 = L[1][1] * L[2][1];
+    const double S = a00 * y0z0 + a10 * y1z0 + a01 * y0z1 + a11 * y1z1;
+    double Sx = 0.0, Sy = 0.0, Sz = 0.0;
+    if (out_grad) {
+        Sx = (v[1] - v[0]) * y0z0 + (v[3] - v[2]) * y1z0 + (v[5] - v[4]) * y0z1 + (v[7] - v[6]) * y1z1;
+        Sy = (a10 - a00) * L[2][0] + (a11 - a01) * L[2][1];
+        Sz = (a01 - a00) * L[1][0] + (a11 - a10) * L[1][1];
     }
     const double q = 9.0 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) - 19.0;
     double phi = (1.0 / 64.0) * q * S;
@@ -113,31 +135,10 @@ void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double ou
         g[1] = (1.0 / 64.0) * (q * Sy + 18.0 * x[1] * S);
         g[2] = (1.0 / 64.0) * (q * Sz + 18.0 * x[2] * S);
     }
-    for (int d = 0; d < 3; ++d) {
-        const int p = d == 0 ? 1 : (d == 1 ? 2 : 0); /* outer axis of the slot nesting */
-        const int r = d == 0 ? 2 : (d == 1 ? 0 : 1); /* inner axis */
-        const double* e = v + 8 + 8 * d;             /* e[4 dp + 2 dr + s] */
-        const double w = 1.0 - x[d] * x[d];
-        const double m0 = 1.0 - 3.0 * x[d], m1 = 1.0 + 3.0 * x[d];
-        double B[2] = { 0.0, 0.0 }, Bp[2] = { 0.0, 0.0 }, Br[2] = { 0.0, 0.0 };
-        for (int dp = 0; dp < 2; ++dp)
-            for (int dr = 0; dr < 2; ++dr)
-                for (int t = 0; t < 2; ++t) {
-                    const double val = e[4 * dp + 2 * dr + t];
-                    B[t] += val * L[p][dp] * L[r][dr];
-                    if (out_grad) {
-                        Bp[t] += (dp ? val : -val) * L[r][dr];
-                        Br[t] += (dr ? val : -val) * L[p][dp];
-                    }
-                }
-        const double m = m0 * B[0] + m1 * B[1];
-        phi += (9.0 / 64.0) * w * m;
-        if (out_grad) {
-            g[d] += (9.0 / 64.0) * (-2.0 * x[d] * m + w * 3.0 * (B[1] - B[0]));
-            g[p] += (9.0 / 64.0) * w * (m0 * Bp[0] + m1 * Bp[1]);
-            g[r] += (9.0 / 64.0) * w * (m0 * Br[0] + m1 * Br[1]);
-        }
-    }
+    /* edge families: x (outer y, inner z), y (outer z, inner x), z (outer x, inner y) */
+    edge_family(v + 8, x[0], L[1], L[2], &phi, out_grad ? g : NULL, 0, 1, 2);
+    edge_family(v + 16, x[1], L[2], L[0], &phi, out_grad ? g : NULL, 1, 2, 0);
+    edge_family(v + 24, x[2], L[0], L[1], &phi, out_grad ? g : NULL, 2, 0, 1);
     *out_value = phi;
     if (out_grad) { out_grad[0] = g[0]; out_grad[1] = g[1]; out_grad[2] = g[2]; }
 }
@@ -334,17 +335,22 @@ double scc_grid_node_value(const scc_grid* g, uint32_t field, uint64_t id)
 static inline void gather_cell(const scc_grid* g, const scc_grid_field* fd, uint32_t c, const uint32_t ijk[3], double v[32])
 {
     if (fd == &g->fields[0] && g->blocks) {
-        const uint64_t n1x = (uint64_t)g->res[0] + 1, n1y = (uint64_t)g->res[1] + 1;
-        for (int dk = 0; dk < 2; ++dk)
-            for (int dj = 0; dj < 2; ++dj)
-                for (int di = 0; di < 2; ++di) {
-                    const uint64_t vtx = (ijk[0] + di) + n1x * ((ijk[1] + dj) + n1y * (uint64_t)(ijk[2] + dk));
-                    const double* b = g->blocks + 7 * (uint64_t)(g->vertex_block ? g->vertex_block[vtx] : vtx);
-                    v[di + 2 * dj + 4 * dk] = b[0];
-                    if (!di) { v[8 + 4 * dj + 2 * dk] = b[1]; v[9 + 4 * dj + 2 * dk] = b[2]; }
-                    if (!dj) { v[16 + 4 * dk + 2 * di] = b[3]; v[17 + 4 * dk + 2 * di] = b[4]; }
-                    if (!dk) { v[24 + 4 * di + 2 * dj] = b[5]; v[25 + 4 * di + 2 * dj] = b[6]; }
-                }
+        const uint64_t sy = (uint64_t)g->res[0] + 1, sz = sy * ((uint64_t)g->res[1] + 1);
+        const uint64_t base = ijk[0] + sy * ijk[1] + sz * ijk[2];
+        const uint64_t vid[8] = { base, base + 1, base + sy, base + sy + 1, base + sz, base + sz + 1, base + sz + sy, base + sz + sy + 1 };
+        const double* b[8];
+        for (int q = 0; q < 8; ++q) b[q] = g->blocks + 7 * (uint64_t)(g->vertex_block ? g->vertex_block[vid[q]] : vid[q]);
+        /* corners: slot di + 2 dj + 4 dk = block index q */
+        for (int q = 0; q < 8; ++q) v[q] = b[q][0];
+        /* x edges (slot 8 + 4 dj + 2 dk + s) start at corner c = 2 dj + 4 dk */
+        v[8] = b[0][1]; v[9] = b[0][2]; v[10] = b[4][1]; v[11] = b[4][2];
+        v[12] = b[2][1]; v[13] = b[2][2]; v[14] = b[6][1]; v[15] = b[6][2];
+        /* y edges (slot 16 + 4 dk + 2 di + s) start at corner c = di + 4 dk */
+        v[16] = b[0][3]; v[17] = b[0][4]; v[18] = b[1][3]; v[19] = b[1][4];
+        v[20] = b[4][3]; v[21] = b[4][4]; v[22] = b[5][3]; v[23] = b[5][4];
+        /* z edges (slot 24 + 4 di + 2 dj + s) start at corner c = di + 2 dj */
+        v[24] = b[0][5]; v[25] = b[0][6]; v[26] = b[2][5]; v[27] = b[2][6];
+        v[28] = b[1][5]; v[29] = b[1][6]; v[30] = b[3][5]; v[31] = b[3][6];
         return;
     }
     uint32_t scratch[32];
