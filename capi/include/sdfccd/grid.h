@@ -60,6 +60,11 @@ SDFCCD_API sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void);
 /** Loads a triangle mesh from any format assimp reads (OBJ, PLY, STL, OFF, glTF, ...). Polygons
  * are triangulated, node transforms of the file are applied, and every sub-mesh is appended to
  * one mesh. Points and lines are ignored. `def` may be NULL for the defaults.
+ * `.obj` files are read by a built-in reader in double precision (Debian's assimp stores
+ * positions as float, which would round coordinates written with more digits): `v` and `f`
+ * records only, polygons fan-triangulated, `i/t/n` and negative indices accepted, numbers parsed
+ * with strtod (the C locale's '.' decimal point). Other formats go through assimp (float
+ * positions). */
  * Errors: ::SDFCCD_IO_ERROR when the file cannot be opened; ::SDFCCD_FORMAT_ERROR when assimp
  * cannot parse it (the message carries assimp's); ::SDFCCD_DEGENERATE when it holds no triangle;
  * ::SDFCCD_UNSUPPORTED when the library was built without assimp (SDFCCD_WITH_ASSIMP=OFF). */
