@@ -64,10 +64,11 @@ SDFCCD_API sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void);
  * positions as float, which would round coordinates written with more digits): `v` and `f`
  * records only, polygons fan-triangulated, `i/t/n` and negative indices accepted, numbers parsed
  * with strtod (the C locale's '.' decimal point). Other formats go through assimp (float
- * positions). */
- * Errors: ::SDFCCD_IO_ERROR when the file cannot be opened; ::SDFCCD_FORMAT_ERROR when assimp
- * cannot parse it (the message carries assimp's); ::SDFCCD_DEGENERATE when it holds no triangle;
- * ::SDFCCD_UNSUPPORTED when the library was built without assimp (SDFCCD_WITH_ASSIMP=OFF). */
+ * positions).
+ * Errors: ::SDFCCD_IO_ERROR when the file cannot be opened; ::SDFCCD_FORMAT_ERROR when it cannot
+ * be parsed (a bad OBJ record with its line number, or assimp's message); ::SDFCCD_DEGENERATE when
+ * it holds no triangle; ::SDFCCD_UNSUPPORTED for a non-OBJ file when the library was built without
+ * assimp (SDFCCD_WITH_ASSIMP=OFF). */
 SDFCCD_API sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, sdfccd_MeshId* out_mesh);
 
 /* ------------------------------------------------------------------------------------------ */
