@@ -892,6 +892,10 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     }
     g->base.lipschitz = sqrt(1.0 + fmax(g->lipschitz_max, 1.0) * fmax(g->lipschitz_max, 1.0));
     g->base.kind = SCC_SDF_GRID;
+    /* An interpolated grid is not known to be convex anywhere: the certified TOI must use the
+     * Lipschitz bounds only. */
+    g->base.convex = 0;
+    g->base.convex_in = NULL;
     return SCC_GRID_OK;
 }
 

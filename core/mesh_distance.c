@@ -140,6 +140,8 @@ int scc_mesh_sdf_init(scc_mesh_sdf* m, const scc_allocator* a, const scc_mesh* m
     m->base.bounds = mesh->bounds;
     m->base.lipschitz = 1.0;
     m->base.kind = SCC_SDF_CALLBACK;
+    m->base.convex = 0; /* a mesh is not known to be convex */
+    m->base.convex_in = NULL;
     return 0;
 }
 
