@@ -25,8 +25,3 @@ else()
   message(STATUS "sdfccd_peers: not built (needs libfcl-dev and the Bullet bridge)")
 endif()
 
-# A smoke run of the benchmark (4 cases per mesh, accuracy tables and chart only): ctest checks
-# only that it runs; benchmark figures never decide a test.
-if(TARGET sdfccd_bench AND SDFCCD_BUILD_TESTS)
-  add_test(NAME sdfccd_bench_smoke COMMAND sdfccd_bench report ${CMAKE_CURRENT_BINARY_DIR}/bench_smoke --smoke)
-endif()
