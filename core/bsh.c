@@ -409,6 +409,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
 {
     stats->evals = stats->nodes_visited = stats->candidates = 0;
     if (!bsh || bsh->node_count == 0) return 1;
+    if (!mm->body && !moving) return 0; /* linear motion needs the refit */
     trav tr;
     tr.bsh = bsh;
     tr.moving = moving;
