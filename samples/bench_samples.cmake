@@ -7,7 +7,7 @@ if(SDFCCD_MESHOPT_LIB AND SDFCCD_MESHOPT_INC AND NOT SDFCCD_BUILD_SHARED)
   add_executable(sdfccd_bench ${CMAKE_CURRENT_LIST_DIR}/sdfccd_bench.c)
   # The scaling table times single triangles through the core's instrumented mesh query.
   target_link_libraries(sdfccd_bench PRIVATE sdfccd sdfccd_core ${SDFCCD_MESHOPT_LIB} m)
-  target_include_directories(sdfccd_bench PRIVATE ${SDFCCD_MESHOPT_INC})
+  target_include_directories(sdfccd_bench PRIVATE ${SDFCCD_MESHOPT_INC} ${PROJECT_SOURCE_DIR}/capi/src)
   target_compile_definitions(sdfccd_bench PRIVATE SDFCCD_BENCH_DATA_DIR="${PROJECT_SOURCE_DIR}/data"
     SDFCCD_BENCH_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   sdfccd_target_defaults(sdfccd_bench)

@@ -40,6 +40,7 @@
 #include "bsh.h"
 #include "ccd.h"
 #include "sdf_analytic.h"
+#include "capi_internal.h" /* capi_convert_params */
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -677,27 +678,15 @@ static void subdivide4(const mesh_data* src, mesh_data* out)
     free(vals);
 }
 
+/* The core's params for the instrumented query, converted by the ABI's own converter. */
 static scc_params core_params(const sdfccd_QueryParams* in)
 {
     scc_params p;
     memset(&p, 0, sizeof p);
-    p.method = in->method == SDFCCD_METHOD_FWGSS ? SCC_METHOD_FWGSS
-             : in->method == SDFCCD_METHOD_FW ? SCC_METHOD_FW
-             : in->method == SDFCCD_METHOD_DCD ? SCC_METHOD_DCD : SCC_METHOD_CERTIFIED;
-    p.margin = in->margin;
-    p.time_tol = in->time_tolerance;
-    p.dist_tol = in->distance_tolerance;
-    p.max_iter = in->max_iterations;
-    p.max_ls_iter = in->max_line_search_iterations;
-    p.fwgss_restarts = in->fwgss_restarts;
-    p.subdivision = in->subdivision;
-    p.sub_min_area = in->subdivision_min_area;
-    p.contact_slop = in->contact_slop;
-    p.toi_window = in->toi_window;
-    p.max_rotation = in->max_rotation_per_segment;
-    p.cert_time_tol = in->certified_time_tolerance;
-    p.cert_max_regions = in->certified_max_regions;
-    p.broad_phase = in->broad_phase;
+    if (capi_convert_params(in, "sdfccd_bench", &p) != SDFCCD_OK) {
+        fprintf(stderr, "sdfccd_bench: %s\n", sdfccd_last_error());
+        exit(1);
+    }
     return p;
 }
 

@@ -151,6 +151,7 @@ static scc_params default_params(scc_method method)
     p.fwgss_restarts = 2;
     p.subdivision = 0;
     p.sub_min_area = 1e-6;
+    p.sub_max_depth = 3;
     p.contact_slop = 1e-4;
     p.toi_window = 1e-5;
     p.max_rotation = SCC_PI;

@@ -75,4 +75,10 @@ sdfccd_Status capi_mesh_create(const double* vertices, uint32_t vertex_count, co
                                sdfccd_MeshId* out_mesh);
 capi_mesh* capi_mesh_lookup(sdfccd_MeshId id);
 
+/* Validates public query params and converts them to the core's (the only place this is done;
+ * internal tools that call the core directly use it too). Declared with an incomplete type so
+ * this header does not pull in core/ccd.h. */
+struct scc_params;
+sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, struct scc_params* out);
+
 #endif

@@ -41,7 +41,7 @@ sdfccd_RigidMotion sdfccd_default_rigid_motion(void)
     return m;
 }
 
-static sdfccd_Status convert_params(const sdfccd_QueryParams* in, const char* fn, scc_params* out)
+sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, scc_params* out)
 {
     if (!in) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
     if (in->internal_value != DEF_COOKIE)
@@ -129,7 +129,7 @@ static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motio
     if ((st = capi_check_ptr(out_result, what))) return st;
     if (capacity < 0 || (capacity > 0 && !out_contacts))
         return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: out_contacts is NULL or capacity (%d) < 0", fn, capacity);
-    if ((st = convert_params(params, fn, &q->p)) || (st = check_interval(t0, t1, fn))) return st;
+    if ((st = capi_convert_params(params, fn, &q->p)) || (st = check_interval(t0, t1, fn))) return st;
     q->sdf_motion_ptr = NULL;
     if (sdf_motion) {
         snprintf(what, sizeof what, "%s: sdf_motion", fn);
