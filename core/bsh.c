@@ -2,6 +2,7 @@
  * sdfccd core: bounding-sphere hierarchy and padded sphere tracing (Section 4.6 of
  * Pelletier-Guenette et al., SCA 2025). The contract and the padding argument are in bsh.h. */
 #include "bsh.h"
+#include "min_heap.h"
 
 #include <string.h>
 
@@ -225,51 +226,7 @@ typedef struct item {
     uint32_t seg;     /* | SEG_UNTRACED for a root not yet marched */
 } item;
 
-typedef struct item_heap {
-    item* a;
-    size_t n, cap;
-    const scc_allocator* alloc;
-} item_heap;
-
-static int heap_push(item_heap* h, item it)
-{
-    if (h->n == h->cap) {
-        size_t cap = h->cap ? 2 * h->cap : 64;
-        item* na = scc_alloc(h->alloc, cap * sizeof *na);
-        if (!na) return 0;
-        if (h->n) memcpy(na, h->a, h->n * sizeof *na);
-        scc_free(h->alloc, h->a, h->cap * sizeof *h->a);
-        h->a = na;
-        h->cap = cap;
-    }
-    size_t i = h->n++;
-    while (i > 0) {
-        size_t parent = (i - 1) / 2;
-        if (h->a[parent].key <= it.key) break;
-        h->a[i] = h->a[parent];
-        i = parent;
-    }
-    h->a[i] = it;
-    return 1;
-}
-
-static item heap_pop(item_heap* h)
-{
-    item top = h->a[0];
-    item last = h->a[--h->n];
-    size_t i = 0;
-    for (;;) {
-        size_t l = 2 * i + 1, r = l + 1, m = i;
-        double km = last.key;
-        if (l < h->n && h->a[l].key < km) { m = l; km = h->a[l].key; }
-        if (r < h->n && h->a[r].key < km) m = r;
-        if (m == i) break;
-        h->a[i] = h->a[m];
-        i = m;
-    }
-    if (h->n) h->a[i] = last;
-    return top;
-}
+SCC_MIN_HEAP(item_heap, item, key)
 
 typedef struct trav {
     const scc_bsh* bsh;
@@ -468,12 +425,12 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
                 else { sg->q[k] = scc_quat_identity(); sg->p[k] = scc_v3(0, 0, 0); }
             }
             item root = { sg->ta, 0, s | SEG_UNTRACED };
-            if (!(ok = heap_push(&heap, root))) break;
+            if (!(ok = item_heap_push(&heap, root))) break;
         }
     }
     double te = t_end;
     while (ok && heap.n) {
-        item it = heap_pop(&heap);
+        item it = item_heap_pop(&heap);
         if (it.key > te) break;
         uint32_t s = it.seg & ~SEG_UNTRACED;
         double to = fmin(seg[s].tb, te);
@@ -481,7 +438,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
             double tc;
             if (march(&tr, it.node, s, it.key, to, &tc)) {
                 item c = { tc, it.node, s };
-                ok = heap_push(&heap, c);
+                ok = item_heap_push(&heap, c);
             }
             continue;
         }
@@ -498,7 +455,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
             double tc;
             if (march(&tr, n->first + k, s, it.key, to, &tc)) {
                 item c = { tc, n->first + k, s };
-                ok = heap_push(&heap, c);
+                ok = item_heap_push(&heap, c);
             }
         }
     }

@@ -17,57 +17,14 @@
  * distance of a convex shape) the first-order bound phi(x) >= phi(c) + grad(c).(x - c) prunes
  * tangential contacts far sooner than the Lipschitz ball. */
 #include "ccd.h"
+#include "min_heap.h"
 
 typedef struct region {
     double ta, tb;
     double u[3], v[3]; /* barycentric corners: weights (u, v, 1 - u - v) */
 } region;
 
-typedef struct heap {
-    region* a;
-    size_t n, cap;
-    const scc_allocator* alloc;
-} heap;
-
-static int heap_push(heap* h, const region* r)
-{
-    if (h->n == h->cap) {
-        size_t cap = h->cap ? 2 * h->cap : 256;
-        region* na = scc_alloc(h->alloc, cap * sizeof *na);
-        if (!na) return 0;
-        for (size_t i = 0; i < h->n; ++i) na[i] = h->a[i];
-        scc_free(h->alloc, h->a, h->cap * sizeof *h->a);
-        h->a = na;
-        h->cap = cap;
-    }
-    size_t i = h->n++;
-    while (i > 0) {
-        size_t parent = (i - 1) / 2;
-        if (h->a[parent].ta <= r->ta) break;
-        h->a[i] = h->a[parent];
-        i = parent;
-    }
-    h->a[i] = *r;
-    return 1;
-}
-
-static region heap_pop(heap* h)
-{
-    region top = h->a[0];
-    region last = h->a[--h->n];
-    size_t i = 0;
-    for (;;) {
-        size_t l = 2 * i + 1, r = l + 1, m = i;
-        double mt = last.ta;
-        if (l < h->n && h->a[l].ta < mt) { m = l; mt = h->a[l].ta; }
-        if (r < h->n && h->a[r].ta < mt) m = r;
-        if (m == i) break;
-        h->a[i] = h->a[m];
-        i = m;
-    }
-    if (h->n) h->a[i] = last;
-    return top;
-}
+SCC_MIN_HEAP(region_heap, region, ta)
 
 static scc_vec3 corner(const scc_tri_state* st, double u, double v)
 {
@@ -77,9 +34,9 @@ static scc_vec3 corner(const scc_tri_state* st, double u, double v)
 int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                   const scc_allocator* alloc, scc_tri_hit* out)
 {
-    heap h = { NULL, 0, 0, alloc };
+    region_heap h = { NULL, 0, 0, alloc };
     region root = { ta, tb, { 1, 0, 0 }, { 0, 1, 0 } };
-    if (!heap_push(&h, &root)) return 0;
+    if (!region_heap_push(&h, root)) return 0;
     const double speed = scc_tri_speed_bound(m);
     const double accel = scc_tri_accel_bound(m);
     double hi = INFINITY, lo = ta;
@@ -87,7 +44,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
     int64_t processed = 0, evals = 0;
     int capped = 0, ok = 1;
     while (h.n) {
-        region r = heap_pop(&h);
+        region r = region_heap_pop(&h);
         lo = r.ta;
         if (r.ta >= hi) { lo = hi; break; }
         if (hi - lo <= p->cert_time_tol) break;
@@ -168,7 +125,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
             region a = r, b = r;
             a.tb = tm;
             b.ta = tm;
-            if (!heap_push(&h, &a) || (b.ta < hi && !heap_push(&h, &b))) { ok = 0; break; }
+            if (!region_heap_push(&h, a) || (b.ta < hi && !region_heap_push(&h, b))) { ok = 0; break; }
         } else {
             double mu[3], mv[3];
             for (int i = 0; i < 3; ++i) {
@@ -182,7 +139,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
                 { r.ta, r.tb, { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] } },
                 { r.ta, r.tb, { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] } },
             };
-            for (int i = 0; i < 4 && ok; ++i) ok = heap_push(&h, &k[i]);
+            for (int i = 0; i < 4 && ok; ++i) ok = region_heap_push(&h, k[i]);
             if (!ok) break;
         }
     }
