@@ -21,6 +21,7 @@ typedef struct scc_params {
     int max_iter;
     int max_ls_iter;
     int fwgss_restarts;     /* extra FWGSS descents from the other vertices (0..2) */
+    int fwgss_vertex_trace; /* conservative-advancement steps per vertex before the descents (0: off) */
     int subdivision;
     double sub_min_area;    /* m^2 */
     int sub_max_depth;      /* levels of splitting */

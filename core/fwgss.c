@@ -131,10 +131,39 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
     return 0;
 }
 
+/* Conservative advancement of one vertex path (ours): with |grad phi| <= L and the vertex's speed
+ * <= S, phi cannot reach the margin sooner than (phi - margin) / (L S), so stepping by that never
+ * skips a crossing (steps are at least the time tolerance). Stops at the first witness (which
+ * shrinks te), at te, or after `cap` steps. */
+static void trace_vertex(scc_fw_state* s, int i, double speed, int cap)
+{
+    const double b[3] = { i == 0, i == 1, i == 2 };
+    double t = s->ts;
+    for (int k = 0; k < cap && t < s->te; ++k) {
+        scc_vec3 x = scc_tri_point_at(s->m, b, t, NULL);
+        double phi = scc_sdf_eval(s->sdf, x, NULL);
+        s->evals++;
+        if (phi <= s->p->margin) {
+            scc_fw_witness(s, t, b, phi);
+            return;
+        }
+        scc_aabb box = { scc_sub(x, scc_v3(phi, phi, phi)), scc_add(x, scc_v3(phi, phi, phi)) };
+        double step = (phi - s->p->margin) / (fmax(scc_sdf_lipschitz(s->sdf, &box), 1e-12) * speed);
+        /* Near the surface the steps shrink geometrically; a step of the time tolerance can then
+         * pass a crossing by at most that tolerance. */
+        t += fmax(step, s->p->time_tol);
+    }
+}
+
 void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out)
 {
     scc_fw_state s;
     scc_fw_begin(&s, sdf, m, p, ta, tb);
+    if (p->fwgss_vertex_trace > 0) {
+        double speed = scc_tri_speed_bound(m);
+        if (speed > 0.0)
+            for (int i = 0; i < 3; ++i) trace_vertex(&s, i, speed, p->fwgss_vertex_trace);
+    }
     int order[3];
     scc_fw_start_order(&s, order);
     int converged = 1;

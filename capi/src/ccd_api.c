@@ -20,6 +20,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.max_iterations = 32;
     p.max_line_search_iterations = 64;
     p.fwgss_restarts = 2;
+    p.fwgss_vertex_trace = 64;
     p.subdivision = 1;
     p.subdivision_min_area = 1e-4;
     p.subdivision_max_depth = 3;
@@ -73,6 +74,9 @@ sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, 
     if (in->fwgss_restarts < 0 || in->fwgss_restarts > 2)
         return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_restarts must be 0, 1 or 2 (got %d)", fn, in->fwgss_restarts);
     out->fwgss_restarts = in->fwgss_restarts;
+    if (in->fwgss_vertex_trace < 0)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_vertex_trace must be >= 0 (got %d)", fn, in->fwgss_vertex_trace);
+    out->fwgss_vertex_trace = in->fwgss_vertex_trace;
     out->subdivision = in->subdivision != 0;
     out->sub_min_area = in->subdivision_min_area;
     if (in->subdivision_max_depth < 1 || in->subdivision_max_depth > 32)

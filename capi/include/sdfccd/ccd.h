@@ -50,6 +50,10 @@ typedef struct sdfccd_QueryParams {
     int32_t fwgss_restarts;        /**< FWGSS: extra descents from the other two vertices after the Section 4.4 start
                                         (0 = the paper's single descent, up to 2). They share the shrinking interval and
                                         correct local minima and later entries. Default 2. */
+    int32_t fwgss_vertex_trace;    /**< FWGSS: before the descents, each vertex path is advanced conservatively
+                                        (steps of (phi - margin) / (L * speed), which cannot skip a crossing) for
+                                        at most this many steps; a contact found there bounds the TOI. 0 = off
+                                        (the paper's method). Default 64. */
     int32_t subdivision;           /**< Adaptive triangle subdivision at the TOI (Section 4.5). Default 1 (on). */
     double subdivision_min_area;   /**< Smallest sub-triangle area searched (m^2). Default 1e-4 (1 cm^2). */
     int32_t subdivision_max_depth; /**< Levels of recursive splitting (1 = only the paper's first three regions). Default 3. */
