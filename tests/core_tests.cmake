@@ -25,3 +25,7 @@ add_executable(readme_example ${CMAKE_CURRENT_BINARY_DIR}/readme_example.c)
 target_link_libraries(readme_example PRIVATE sdfccd m)
 sdfccd_target_defaults(readme_example)
 add_test(NAME readme_example COMMAND readme_example)
+
+# The threading contract of base.h (concurrent queries, per-thread errors, concurrent handles).
+sdfccd_add_check_test(test_threads test_threads.c)
+target_link_libraries(test_threads PRIVATE Threads::Threads)
