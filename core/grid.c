@@ -698,6 +698,19 @@ static int run_tasks(scc_parallel_for_fn* pf, void* user, int stage, uint32_t co
     return 0;
 }
 
+/* Cell l's grid coordinates and which domain faces it touches; 0 when it touches none. */
+static int boundary_cell(const scc_grid* g, uint64_t l, uint32_t ijk[3], int lo_face[3], int hi_face[3])
+{
+    int any = 0;
+    cell_ijk(g, l, ijk);
+    for (int d = 0; d < 3; ++d) {
+        lo_face[d] = ijk[d] == 0;
+        hi_face[d] = ijk[d] == g->res[d] - 1;
+        any |= lo_face[d] | hi_face[d];
+    }
+    return any;
+}
+
 scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn* parallel_for, void* parallel_user)
 {
     const scc_allocator* a = &g->allocator;
@@ -829,14 +842,8 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     g->outside_positive = 1;
     for (uint64_t l = 0; l < g->n_cells && g->outside_positive; ++l) {
         uint32_t ijk[3];
-        cell_ijk(g, l, ijk);
-        int lo_face[3], hi_face[3], any = 0;
-        for (int d = 0; d < 3; ++d) {
-            lo_face[d] = ijk[d] == 0;
-            hi_face[d] = ijk[d] == g->res[d] - 1;
-            any |= lo_face[d] | hi_face[d];
-        }
-        if (!any) continue;
+        int lo_face[3], hi_face[3];
+        if (!boundary_cell(g, l, ijk, lo_face, hi_face)) continue;
         const uint32_t c = fd->map[l];
         if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) {
             if (g->hole_source[l] & 0x80000000u) g->outside_positive = 0;
@@ -853,14 +860,8 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     int boundary_nonneg = 1;
     for (uint64_t l = 0; l < g->n_cells && boundary_nonneg && !g->outside_positive; ++l) {
         uint32_t ijk[3];
-        cell_ijk(g, l, ijk);
-        int lo_face[3], hi_face[3], any = 0;
-        for (int d = 0; d < 3; ++d) {
-            lo_face[d] = ijk[d] == 0;
-            hi_face[d] = ijk[d] == g->res[d] - 1;
-            any |= lo_face[d] | hi_face[d];
-        }
-        if (!any) continue;
+        int lo_face[3], hi_face[3];
+        if (!boundary_cell(g, l, ijk, lo_face, hi_face)) continue;
         const uint32_t c = fd->map[l];
         if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) {
             if (g->hole_source[l] & 0x80000000u) boundary_nonneg = 0;

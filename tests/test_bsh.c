@@ -21,6 +21,7 @@
 #include "ccd.h"
 #include "sdf_analytic.h"
 #include "test_util.h"
+#include "capi_internal.h" /* capi_convert_params */
 
 #define DT (1.0 / 60.0)
 
@@ -138,26 +139,18 @@ static void make_fields(fields* f)
     f->list[3] = &f->spikes.base;
 }
 
+/* The library's defaults, converted by the ABI (so new parameters cannot be missed), with
+ * this suite's settings: no subdivision, a finer area floor, a smaller certified cap. */
 static scc_params default_params(scc_method method)
 {
+    sdfccd_QueryParams pub = sdfccd_default_query_params();
     scc_params p;
     memset(&p, 0, sizeof p);
+    ck_assert_int_eq(capi_convert_params(&pub, "test_bsh", &p), SDFCCD_OK);
     p.method = method;
-    p.margin = 0.0;
-    p.time_tol = 1e-7;
-    p.dist_tol = 1e-7;
-    p.max_iter = 32;
-    p.max_ls_iter = 64;
-    p.fwgss_restarts = 2;
     p.subdivision = 0;
     p.sub_min_area = 1e-6;
-    p.sub_max_depth = 3;
-    p.contact_slop = 1e-4;
-    p.toi_window = 1e-5;
-    p.max_rotation = SCC_PI;
-    p.cert_time_tol = 1e-7;
     p.cert_max_regions = 400000;
-    p.broad_phase = 1;
     return p;
 }
 
