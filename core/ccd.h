@@ -112,4 +112,13 @@ typedef struct scc_mesh_motion {
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum);
 
+/* scc_query_mesh with instrumentation for benchmarks (mesh_query.c): `probe` (may be NULL) is
+ * called with begin = 1 right before and begin = 0 right after each narrow-phase triangle test,
+ * so a caller can time triangles; *out_broad_evals (may be NULL) receives the broad phase's
+ * share of sum->evals. */
+typedef void scc_mesh_probe_fn(void* user, uint32_t triangle, int begin);
+int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
+                          scc_contact* out, int capacity, scc_query_summary* sum, scc_mesh_probe_fn* probe, void* probe_user,
+                          int64_t* out_broad_evals);
+
 #endif

@@ -16,6 +16,8 @@
  *  - outside the domain box: a lower bound built from the distance d to the box and the value
  *    phi(p) at the nearest box point p (see scc_grid_eval).
  * All routines are pure; evaluation is thread-safe. Memory comes from the caller's allocator.
+ * Files: the element in grid_cell.c, storage and evaluation in grid.c, the derived bounds
+ * (scc_grid_finalize) in grid_bounds.c, building in grid_build.c.
  */
 #ifndef SCC_GRID_H
 #define SCC_GRID_H
@@ -23,22 +25,13 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "alloc.h"
+#include "grid_cell.h"
 #include "mesh.h"
 #include "sdf.h"
 
 #define SCC_GRID_NO_CELL 0xFFFFFFFFu
 /* Discregrid's "not sampled" node value (DBL_MAX). */
 #define SCC_GRID_NO_VALUE 1.7976931348623157e308
-
-/* ---- the 32-node element ---- */
-
-/* Local coordinates (in [-1,1]^3) of the node in slot `slot` (0..31). */
-scc_vec3 scc_cell_node_local(int slot);
-/* Shape functions N[32] at local point xi; when dN is not NULL also dN/dxi (dN[a][d]). */
-void scc_cell_shape(scc_vec3 xi, double N[32], double dN[32][3]);
-/* sum_a v[a] N_a(xi) and, when out_grad is not NULL, its derivatives with respect to xi, in a
- * factored form (about 4x fewer operations than going through scc_cell_shape). */
-void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double out_grad[3]);
 
 /* ---- grid data ---- */
 
@@ -110,8 +103,9 @@ typedef enum scc_grid_status {
     SCC_GRID_TOO_LARGE        /* more than 2^31 - 1 cells */
 } scc_grid_status;
 
-/* Computes the derived data of field 0 (per-cell gradient bounds, the hole sources for
- * culled cells) and fills the scc_sdf interface. Safe to call once after the fields are set.
+/* Computes the derived data of field 0 (grid_bounds.c): adopts the vertex-block layout for a
+ * dense field 0, per-cell gradient bounds, the hole sources for culled cells, per-block bounds,
+ * whether phi >= 0 on the domain boundary, and fills the scc_sdf interface. Safe to call once after the fields are set.
  * `band`: a known lower bound on |phi| inside culled cells (0 when unknown). */
 scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn* parallel_for, void* parallel_user);
 

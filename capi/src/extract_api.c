@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT
- * sdfccd C ABI: isosurface extraction (extract.h) over core/marching_cubes. */
+ * sdfccd C ABI: isosurface extraction (extract.h) over core/marching_tetrahedra. */
 #include "capi_internal.h"
-#include "../../core/marching_cubes.h"
+#include "../../core/marching_tetrahedra.h"
 
 sdfccd_Status sdfccd_extract_isosurface(sdfccd_SdfId sdf, sdfccd_Aabb box, int32_t resolution,
                                         sdfccd_MeshId* out_mesh)
@@ -14,16 +14,16 @@ sdfccd_Status sdfccd_extract_isosurface(sdfccd_SdfId sdf, sdfccd_Aabb box, int32
     if ((st = capi_check_vec(box.hi, "box.hi")) != SDFCCD_OK) return st;
     if (!(box.hi.x > box.lo.x && box.hi.y > box.lo.y && box.hi.z > box.lo.z))
         return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_extract_isosurface: the box is empty (hi must exceed lo on every axis)");
-    if (resolution < 1 || resolution > SCC_MC_MAX_RESOLUTION)
+    if (resolution < 1 || resolution > SCC_MT_MAX_RESOLUTION)
         return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_extract_isosurface: resolution %d is outside [1, %d]",
-                          (int)resolution, SCC_MC_MAX_RESOLUTION);
+                          (int)resolution, SCC_MT_MAX_RESOLUTION);
 
     scc_isosurface iso;
-    scc_mc_status ms = scc_marching_cubes(s->sdf, capi_box(box), resolution, 0.0, capi_allocator(), &iso);
-    if (ms == SCC_MC_OUT_OF_MEMORY) return capi_oom("sdfccd_extract_isosurface");
-    if (ms == SCC_MC_TOO_LARGE)
+    scc_mt_status ms = scc_marching_tetrahedra(s->sdf, capi_box(box), resolution, 0.0, capi_allocator(), &iso);
+    if (ms == SCC_MT_OUT_OF_MEMORY) return capi_oom("sdfccd_extract_isosurface");
+    if (ms == SCC_MT_TOO_LARGE)
         return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_extract_isosurface: the mesh would exceed 2^32 vertices or triangles");
-    if (ms != SCC_MC_OK)
+    if (ms != SCC_MT_OK)
         return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_extract_isosurface: invalid box or resolution");
     if (iso.triangle_count == 0) {
         scc_isosurface_free(&iso, capi_allocator());

@@ -1,12 +1,12 @@
 /* SPDX-License-Identifier: MIT
- * Isosurface extraction (core/marching_cubes.c, sdfccd_extract_isosurface) against an analytic
+ * Isosurface extraction (core/marching_tetrahedra.c, sdfccd_extract_isosurface) against an analytic
  * sphere: every vertex on the surface, the mesh closed and outward-oriented, the volume close to
  * 4/3 pi r^3; plus argument errors and allocator balance. */
 #include <math.h>
 #include <stdlib.h>
 
 #include "test_util.h"
-#include "marching_cubes.h"
+#include "marching_tetrahedra.h"
 
 typedef struct edge_rec { uint32_t a, b; } edge_rec;
 
@@ -132,7 +132,7 @@ START_TEST(core_torus)
     scc_allocator a = { t_alloc, t_free, &live };
     scc_isosurface out;
     scc_aabb box = { { -1.4, -1.4, -0.4 }, { 1.4, 1.4, 0.4 } };
-    ck_assert_int_eq(scc_marching_cubes(&sdf, box, 48, 0.0, &a, &out), SCC_MC_OK);
+    ck_assert_int_eq(scc_marching_tetrahedra(&sdf, box, 48, 0.0, &a, &out), SCC_MT_OK);
     ck_assert_int_eq(count_bad_edges(out.indices, out.triangle_count), 0);
     /* Euler characteristic of a torus: V - E + F = 0, with E = 3F/2 for a closed mesh. */
     long chi = (long)out.vertex_count - 3L * out.triangle_count / 2 + (long)out.triangle_count;
@@ -147,9 +147,9 @@ START_TEST(core_torus)
     scc_isosurface_free(&out, &a);
     ck_assert_int_eq(live, 0);
     /* Errors leave nothing allocated. */
-    ck_assert_int_eq(scc_marching_cubes(&sdf, box, 0, 0.0, &a, &out), SCC_MC_BAD_INPUT);
+    ck_assert_int_eq(scc_marching_tetrahedra(&sdf, box, 0, 0.0, &a, &out), SCC_MT_BAD_INPUT);
     scc_aabb flat = { { 0, 0, 0 }, { 1, 1, 0 } };
-    ck_assert_int_eq(scc_marching_cubes(&sdf, flat, 8, 0.0, &a, &out), SCC_MC_BAD_INPUT);
+    ck_assert_int_eq(scc_marching_tetrahedra(&sdf, flat, 8, 0.0, &a, &out), SCC_MT_BAD_INPUT);
     ck_assert_int_eq(live, 0);
 }
 END_TEST

@@ -17,8 +17,8 @@
  *    so no triangle collapses to zero area when the surface passes through a node.
  * Features thinner than a cell can be missed (as with any sampling method).
  */
-#ifndef SCC_MARCHING_CUBES_H
-#define SCC_MARCHING_CUBES_H
+#ifndef SCC_MARCHING_TETRAHEDRA_H
+#define SCC_MARCHING_TETRAHEDRA_H
 
 #include <stdint.h>
 #include "alloc.h"
@@ -33,21 +33,21 @@ typedef struct scc_isosurface {
     size_t index_capacity;
 } scc_isosurface;
 
-typedef enum scc_mc_status {
-    SCC_MC_OK = 0,
-    SCC_MC_BAD_INPUT,       /* empty or non-finite box, resolution out of [1, SCC_MC_MAX_RESOLUTION] */
-    SCC_MC_OUT_OF_MEMORY,
-    SCC_MC_TOO_LARGE        /* more than 2^32 - 1 vertices or triangles */
-} scc_mc_status;
+typedef enum scc_mt_status {
+    SCC_MT_OK = 0,
+    SCC_MT_BAD_INPUT,       /* empty or non-finite box, resolution out of [1, SCC_MT_MAX_RESOLUTION] */
+    SCC_MT_OUT_OF_MEMORY,
+    SCC_MT_TOO_LARGE        /* more than 2^32 - 1 vertices or triangles */
+} scc_mt_status;
 
-#define SCC_MC_MAX_RESOLUTION 1024
+#define SCC_MT_MAX_RESOLUTION 1024
 
 /* Extracts {phi = iso} inside `box`. `resolution` is the number of cells along the box's longest
  * axis; the other axes get as many cells as keep them nearly cubic (at least 1). On success `out`
  * owns its arrays (free them with scc_isosurface_free); on failure `out` is zeroed and nothing is
- * left allocated. An SDF with no surface in the box gives SCC_MC_OK with zero triangles. */
-scc_mc_status scc_marching_cubes(const scc_sdf* sdf, scc_aabb box, int resolution, double iso,
-                                 const scc_allocator* alloc, scc_isosurface* out);
+ * left allocated. An SDF with no surface in the box gives SCC_MT_OK with zero triangles. */
+scc_mt_status scc_marching_tetrahedra(const scc_sdf* sdf, scc_aabb box, int resolution, double iso,
+                                       const scc_allocator* alloc, scc_isosurface* out);
 
 void scc_isosurface_free(scc_isosurface* s, const scc_allocator* alloc);
 

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT
  * sdfccd core: isosurface extraction by marching tetrahedra over a padded regular grid.
- * See marching_cubes.h for the method and its guarantees. Used by the Bullet bridge (a cached
+ * See marching_tetrahedra.h for the method and its guarantees. Used by the Bullet bridge (a cached
  * triangulation for Bullet's triangle paths) and by benchmarks (an SDF's surface as a mesh). */
-#include "marching_cubes.h"
+#include "marching_tetrahedra.h"
 
 #include <float.h>
 #include <string.h>
@@ -101,7 +101,7 @@ typedef struct mc_ctx {
     size_t values_count;
     edge_map map;
     scc_isosurface* out;
-    scc_mc_status fail;
+    scc_mt_status fail;
 } mc_ctx;
 
 static int64_t node_id(const mc_ctx* c, int64_t i, int64_t j, int64_t k)
@@ -171,15 +171,15 @@ static uint32_t edge_vertex(mc_ctx* c, const mc_corner* a, const mc_corner* b)
     int dir = lo->bits ^ hi->bits; /* 1..7 */
     uint64_t key = (uint64_t)node_id(c, lo->i, lo->j, lo->k) * 7u + (uint64_t)(dir - 1);
     if ((c->map.count + 1) * 2 > c->map.cap && !edge_map_rehash(&c->map, c->a)) {
-        c->fail = SCC_MC_OUT_OF_MEMORY;
+        c->fail = SCC_MT_OUT_OF_MEMORY;
         return UINT32_MAX;
     }
     size_t s = edge_map_slot(&c->map, key);
     if (c->map.keys[s]) return c->map.values[s];
     scc_isosurface* o = c->out;
-    if (o->vertex_count == UINT32_MAX - 1) { c->fail = SCC_MC_TOO_LARGE; return UINT32_MAX; }
+    if (o->vertex_count == UINT32_MAX - 1) { c->fail = SCC_MT_TOO_LARGE; return UINT32_MAX; }
     if (!grow(c->a, (void**)&o->vertices, &o->vertex_capacity, sizeof(scc_vec3), (size_t)o->vertex_count + 1)) {
-        c->fail = SCC_MC_OUT_OF_MEMORY;
+        c->fail = SCC_MT_OUT_OF_MEMORY;
         return UINT32_MAX;
     }
     o->vertices[o->vertex_count] = edge_point(c, lo, hi);
@@ -194,9 +194,9 @@ static void emit(mc_ctx* c, uint32_t a, uint32_t b, uint32_t d, scc_vec3 outward
 {
     if (c->fail) return;
     scc_isosurface* o = c->out;
-    if (o->triangle_count == UINT32_MAX / 3) { c->fail = SCC_MC_TOO_LARGE; return; }
+    if (o->triangle_count == UINT32_MAX / 3) { c->fail = SCC_MT_TOO_LARGE; return; }
     if (!grow(c->a, (void**)&o->indices, &o->index_capacity, sizeof(uint32_t), 3 * ((size_t)o->triangle_count + 1))) {
-        c->fail = SCC_MC_OUT_OF_MEMORY;
+        c->fail = SCC_MT_OUT_OF_MEMORY;
         return;
     }
     scc_vec3 pa = o->vertices[a], pb = o->vertices[b], pd = o->vertices[d];
@@ -249,16 +249,16 @@ void scc_isosurface_free(scc_isosurface* s, const scc_allocator* alloc)
     memset(s, 0, sizeof *s);
 }
 
-scc_mc_status scc_marching_cubes(const scc_sdf* sdf, scc_aabb box, int resolution, double iso,
-                                 const scc_allocator* alloc, scc_isosurface* out)
+scc_mt_status scc_marching_tetrahedra(const scc_sdf* sdf, scc_aabb box, int resolution, double iso,
+                                       const scc_allocator* alloc, scc_isosurface* out)
 {
-    if (!out) return SCC_MC_BAD_INPUT;
+    if (!out) return SCC_MT_BAD_INPUT;
     memset(out, 0, sizeof *out);
-    if (!sdf || !alloc || resolution < 1 || resolution > SCC_MC_MAX_RESOLUTION || !isfinite(iso))
-        return SCC_MC_BAD_INPUT;
-    if (!scc_vfinite(box.lo) || !scc_vfinite(box.hi)) return SCC_MC_BAD_INPUT;
+    if (!sdf || !alloc || resolution < 1 || resolution > SCC_MT_MAX_RESOLUTION || !isfinite(iso))
+        return SCC_MT_BAD_INPUT;
+    if (!scc_vfinite(box.lo) || !scc_vfinite(box.hi)) return SCC_MT_BAD_INPUT;
     scc_vec3 ext = scc_sub(box.hi, box.lo);
-    if (!(ext.x > 0.0 && ext.y > 0.0 && ext.z > 0.0)) return SCC_MC_BAD_INPUT;
+    if (!(ext.x > 0.0 && ext.y > 0.0 && ext.z > 0.0)) return SCC_MT_BAD_INPUT;
 
     mc_ctx c;
     memset(&c, 0, sizeof c);
@@ -278,12 +278,12 @@ scc_mc_status scc_marching_cubes(const scc_sdf* sdf, scc_aabb box, int resolutio
     }
     c.h = scc_v3(h3[0], h3[1], h3[2]);
     c.values_count = (size_t)(c.e[0] * c.e[1] * c.e[2]);
-    if (c.values_count > SIZE_MAX / sizeof(double)) return SCC_MC_OUT_OF_MEMORY;
+    if (c.values_count > SIZE_MAX / sizeof(double)) return SCC_MT_OUT_OF_MEMORY;
     c.values = (double*)scc_alloc(alloc, c.values_count * sizeof(double));
-    if (!c.values) return SCC_MC_OUT_OF_MEMORY;
+    if (!c.values) return SCC_MT_OUT_OF_MEMORY;
     if (!edge_map_init(&c.map, alloc, 1024)) {
         scc_free(alloc, c.values, c.values_count * sizeof(double));
-        return SCC_MC_OUT_OF_MEMORY;
+        return SCC_MT_OUT_OF_MEMORY;
     }
 
     /* Sample: virtual nodes (and non-finite samples) count as outside, one cell above iso. */
@@ -331,5 +331,5 @@ scc_mc_status scc_marching_cubes(const scc_sdf* sdf, scc_aabb box, int resolutio
         scc_isosurface_free(out, alloc);
         return c.fail;
     }
-    return SCC_MC_OK;
+    return SCC_MT_OK;
 }

@@ -1,0 +1,341 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: the grid's bounds, computed once by scc_grid_finalize after the fields are set
+ * (loaded from a file or built): per-cell bounds on |grad phi| from the Bernstein form of the
+ * element (grid_cell.c), per-block maxima of those bounds, the nearest valued cell and the side
+ * of every cell without values (hole sources), and whether phi >= 0 on the domain boundary
+ * (which decides the SDF's `bounds` and the continuation outside the domain).
+ */
+#include "grid.h"
+#include "grid_access.h"
+
+#include <string.h>
+
+/* ------------------------------------------------------------------------------------------
+ * Finalisation: per-cell gradient bounds and hole sources.
+ *
+ * Gradient bound: phi on a cell is a polynomial of degree <= 3 in each local coordinate, so it
+ * has a tensor cubic Bernstein form on [-1,1]^3 (64 coefficients, a fixed 64x32 map from the
+ * node values). Each partial derivative then has a Bernstein form with coefficients from
+ * differences, and Bernstein coefficients enclose the range of their polynomial (convex hull
+ * property), so max |coefficient| bounds |dphi/dxi_d| on the whole cell; grad phi scales that
+ * by 2/h_d.
+ * ---------------------------------------------------------------------------------------- */
+
+typedef struct bern_tables { double val[64][32]; } bern_tables;
+
+typedef struct finalize_ctx {
+    scc_grid* g;
+    const bern_tables* bt;
+    uint64_t chunk;
+} finalize_ctx;
+
+static float round_up_float(double v)
+{
+    float f = (float)v;
+    if ((double)f < v) f = nextafterf(f, INFINITY);
+    return f;
+}
+
+static void cell_bound_task(void* vctx, uint32_t task)
+{
+    finalize_ctx* ctx = vctx;
+    scc_grid* g = ctx->g;
+    const scc_grid_field* fd = &g->fields[0];
+    const uint64_t begin = (uint64_t)task * ctx->chunk;
+    uint64_t end = begin + ctx->chunk;
+    if (end > g->n_cells) end = g->n_cells;
+    const double c0[3] = { 2.0 / g->h.x, 2.0 / g->h.y, 2.0 / g->h.z };
+    for (uint64_t l = begin; l < end; ++l) {
+        const uint32_t c = fd->map[l];
+        if (c == SCC_GRID_NO_CELL) continue;
+        double v[32];
+        uint32_t ijk[3];
+        cell_ijk(g, l, ijk);
+        gather_cell(g, fd, c, ijk, v);
+        int hole = 0;
+        for (int a = 0; a < 32; ++a) hole |= v[a] == SCC_GRID_NO_VALUE;
+        if (hole) { g->cell_lipschitz[c] = -1.0f; continue; }
+        /* Bernstein coefficients of phi on the cell (degree 3 per axis), then those of each
+         * partial derivative by differences: d/dxi of a cubic Bernstein form on [-1,1] has the
+         * degree-2 coefficients 1.5 (b[i+1] - b[i]) along that axis. */
+        double b[64];
+        for (int s = 0; s < 64; ++s) {
+            const double* row = ctx->bt->val[s];
+            double acc = 0.0;
+            for (int k = 0; k < 32; ++k) acc += row[k] * v[k];
+            b[s] = acc;
+        }
+        double sum2 = 0.0;
+        for (int d = 0; d < 3; ++d) {
+            const int stride = d == 0 ? 1 : (d == 1 ? 4 : 16);
+            double bmax = 0.0;
+            for (int s = 0; s < 64; ++s) {
+                if ((s / stride) % 4 != 0) continue;
+                /* degree-2 coefficients along d, elevated back to degree 3 (convex combinations,
+                 * so the enclosure only gets tighter) */
+                const double e0 = 1.5 * (b[s + stride] - b[s]), e1 = 1.5 * (b[s + 2 * stride] - b[s + stride]),
+                             e2 = 1.5 * (b[s + 3 * stride] - b[s + 2 * stride]);
+                const double q[4] = { e0, (e0 + 2.0 * e1) / 3.0, (2.0 * e1 + e2) / 3.0, e2 };
+                for (int m = 0; m < 4; ++m)
+                    if (fabs(q[m]) > bmax) bmax = fabs(q[m]);
+            }
+            sum2 += (c0[d] * bmax) * (c0[d] * bmax);
+        }
+        /* Small relative margin for rounding in the sums above. */
+        g->cell_lipschitz[c] = round_up_float(sqrt(sum2) * (1.0 + 1e-9) + 1e-300);
+    }
+}
+
+static int run_tasks(scc_parallel_for_fn* pf, void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx)
+{
+    if (pf) return pf(user, stage, count, task, ctx);
+    for (uint32_t i = 0; i < count; ++i) task(ctx, i);
+    return 0;
+}
+
+/* Cell l's grid coordinates and which domain faces it touches; 0 when it touches none. */
+static int boundary_cell(const scc_grid* g, uint64_t l, uint32_t ijk[3], int lo_face[3], int hi_face[3])
+{
+    int any = 0;
+    cell_ijk(g, l, ijk);
+    for (int d = 0; d < 3; ++d) {
+        lo_face[d] = ijk[d] == 0;
+        hi_face[d] = ijk[d] == g->res[d] - 1;
+        any |= lo_face[d] | hi_face[d];
+    }
+    return any;
+}
+
+/* Job 1, layout: a field 0 loaded in Discregrid's dense layout (identity map, tables equal to the
+ * formulas) has implied node ids, so its 128-byte-per-cell table is dropped and the values move
+ * to the vertex-block layout (the builder writes them there directly). */
+static scc_grid_status adopt_dense_layout(scc_grid* g)
+{
+    const scc_allocator* a = &g->allocator;
+    scc_grid_field* fd = &g->fields[0];
+    if (fd->cells && !g->blocks) {
+        int dense = fd->cell_count == g->n_cells && fd->node_count == scc_grid_dense_node_count(g->res);
+        for (uint64_t l = 0; l < g->n_cells && dense; ++l) {
+            uint32_t ijk[3], ids[32];
+            cell_ijk(g, l, ijk);
+            scc_grid_dense_cell_nodes(g->res, ijk[0], ijk[1], ijk[2], ids);
+            dense = fd->map[l] == l && memcmp(ids, fd->cells + l * 32, sizeof ids) == 0;
+        }
+        if (dense) {
+            const uint64_t nb = 7 * (uint64_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1);
+            double* blocks = scc_alloc(a, (size_t)nb * sizeof(double));
+            if (!blocks) return SCC_GRID_OUT_OF_MEMORY;
+            memset(blocks, 0, (size_t)nb * sizeof(double));
+            for (uint64_t l = 0; l < fd->node_count; ++l) blocks[scc_grid_dense_block_index(g->res, l)] = fd->nodes[l];
+            scc_free(a, fd->cells, (size_t)fd->cell_count * 32 * sizeof(uint32_t));
+            scc_free(a, fd->nodes, (size_t)fd->node_count * sizeof(double));
+            fd->cells = NULL;
+            fd->nodes = NULL;
+            g->blocks = blocks;
+            g->block_count = nb;
+        }
+    }
+    g->dense_layout = g->blocks != NULL && g->vertex_block == NULL;
+    return SCC_GRID_OK;
+}
+
+/* Job 2: the per-cell gradient bounds (cell_lipschitz), in parallel tasks of 2048 cells. */
+static scc_grid_status compute_cell_bounds(scc_grid* g, const bern_tables* bt, scc_parallel_for_fn* parallel_for, void* parallel_user)
+{
+    g->cell_lipschitz = scc_alloc(&g->allocator, (size_t)g->fields[0].cell_count * sizeof(float));
+    if (g->fields[0].cell_count && !g->cell_lipschitz) return SCC_GRID_OUT_OF_MEMORY;
+    finalize_ctx ctx = { g, bt, 2048 };
+    const uint32_t tasks = (uint32_t)((g->n_cells + ctx.chunk - 1) / ctx.chunk);
+    const int cancelled = run_tasks(parallel_for, parallel_user, SCC_GRID_STAGE_CELLS, tasks, cell_bound_task, &ctx);
+    return cancelled ? SCC_GRID_CANCELLED : SCC_GRID_OK;
+}
+
+/* Job 3: how many cells have values and the largest of their bounds. */
+static scc_grid_status count_valued_cells(scc_grid* g)
+{
+    const scc_grid_field* fd = &g->fields[0];
+    g->lipschitz_max = 0.0;
+    g->valued_cells = 0;
+    for (uint64_t l = 0; l < g->n_cells; ++l) {
+        const uint32_t c = fd->map[l];
+        if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) continue;
+        g->valued_cells++;
+        if (g->cell_lipschitz[c] > g->lipschitz_max) g->lipschitz_max = g->cell_lipschitz[c];
+    }
+    return g->valued_cells == 0 ? SCC_GRID_EMPTY : SCC_GRID_OK;
+}
+
+/* Job 4, hole sources: multi-source breadth-first search over the 26-neighbourhood from every
+ * cell with values, so each hole cell learns a valued cell at the least Chebyshev distance;
+ * then the side (sign) from that cell's value at the point nearest the hole's centre. */
+static scc_grid_status find_hole_sources(scc_grid* g)
+{
+    const scc_allocator* a = &g->allocator;
+    const scc_grid_field* fd = &g->fields[0];
+    if (g->valued_cells == g->n_cells) return SCC_GRID_OK;
+    g->hole_source = scc_alloc(a, (size_t)g->n_cells * sizeof(uint32_t));
+    uint32_t* queue = scc_alloc(a, (size_t)g->n_cells * sizeof(uint32_t));
+    if (!g->hole_source || !queue) {
+        scc_free(a, queue, (size_t)g->n_cells * sizeof(uint32_t));
+        return SCC_GRID_OUT_OF_MEMORY;
+    }
+    uint64_t head = 0, tail = 0;
+    for (uint64_t l = 0; l < g->n_cells; ++l) {
+        const uint32_t c = fd->map[l];
+        if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f) { g->hole_source[l] = (uint32_t)l; queue[tail++] = (uint32_t)l; }
+        else g->hole_source[l] = 0xFFFFFFFFu;
+    }
+    while (head < tail) {
+        const uint32_t l = queue[head++];
+        uint32_t ijk[3];
+        cell_ijk(g, l, ijk);
+        for (int dk = -1; dk <= 1; ++dk)
+            for (int dj = -1; dj <= 1; ++dj)
+                for (int di = -1; di <= 1; ++di) {
+                    const int64_t ni = (int64_t)ijk[0] + di, nj = (int64_t)ijk[1] + dj, nk = (int64_t)ijk[2] + dk;
+                    if (ni < 0 || nj < 0 || nk < 0 || ni >= g->res[0] || nj >= g->res[1] || nk >= g->res[2]) continue;
+                    const uint64_t n = (uint64_t)ni + g->res[0] * ((uint64_t)nj + (uint64_t)g->res[1] * (uint64_t)nk);
+                    if (g->hole_source[n] != 0xFFFFFFFFu) continue;
+                    g->hole_source[n] = g->hole_source[l];
+                    queue[tail++] = (uint32_t)n;
+                }
+    }
+    scc_free(a, queue, (size_t)g->n_cells * sizeof(uint32_t));
+    for (uint64_t l = 0; l < g->n_cells; ++l) {
+        const uint32_t c = fd->map[l];
+        if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f) continue;
+        const uint32_t src = g->hole_source[l];
+        uint32_t ijk[3], sijk[3];
+        cell_ijk(g, l, ijk);
+        cell_ijk(g, src, sijk);
+        const scc_aabb cb = cell_box(g, ijk), sb = cell_box(g, sijk);
+        const scc_vec3 q = clamp_box(scc_scale(scc_add(cb.lo, cb.hi), 0.5), &sb);
+        double v = 0.0;
+        interpolate_cell(g, fd, fd->map[src], sijk, q, &v, NULL);
+        if (v < 0.0) g->hole_source[l] = src | 0x80000000u;
+    }
+    return SCC_GRID_OK;
+}
+
+/* Job 5: per-block maxima of the cell bounds (blocks of 4^3 cells; cells without values count
+ * 1) for the Lipschitz bound of large boxes. */
+static scc_grid_status compute_block_bounds(scc_grid* g)
+{
+    const scc_grid_field* fd = &g->fields[0];
+    const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4, nbz = (g->res[2] + 3) / 4;
+    g->block_lipschitz = scc_alloc(&g->allocator, (size_t)nbx * nby * nbz * sizeof(float));
+    if (!g->block_lipschitz) return SCC_GRID_OUT_OF_MEMORY;
+    for (size_t q = 0; q < (size_t)nbx * nby * nbz; ++q) g->block_lipschitz[q] = 0.0f;
+    for (uint64_t l = 0; l < g->n_cells; ++l) {
+        uint32_t ijk[3];
+        cell_ijk(g, l, ijk);
+        const uint32_t c = fd->map[l];
+        const float cl = (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) ? 1.0f : g->cell_lipschitz[c];
+        float* bl = &g->block_lipschitz[ijk[0] / 4 + (uint64_t)nbx * (ijk[1] / 4 + (uint64_t)nby * (ijk[2] / 4))];
+        if (cl > *bl) *bl = cl;
+    }
+    return SCC_GRID_OK;
+}
+
+/* Job 6a: every node on the domain boundary is >= 0 (and no inside hole touches it), i.e. the
+ * sampled surface lies inside the box (sets outside_positive). */
+static int boundary_nodes_nonnegative(const scc_grid* g)
+{
+    const scc_grid_field* fd = &g->fields[0];
+    for (uint64_t l = 0; l < g->n_cells; ++l) {
+        uint32_t ijk[3];
+        int lo_face[3], hi_face[3];
+        if (!boundary_cell(g, l, ijk, lo_face, hi_face)) continue;
+        const uint32_t c = fd->map[l];
+        if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) {
+            if (g->hole_source[l] & 0x80000000u) return 0;
+            continue;
+        }
+        double v[32];
+        gather_cell(g, fd, c, ijk, v);
+        for (int slot = 0; slot < 32; ++slot) {
+            const scc_vec3 xi = scc_cell_node_local(slot);
+            const double x[3] = { xi.x, xi.y, xi.z };
+            for (int d = 0; d < 3; ++d)
+                if ((lo_face[d] && x[d] == -1.0) || (hi_face[d] && x[d] == 1.0))
+                    if (v[slot] < 0.0) return 0;
+        }
+    }
+    return 1;
+}
+
+/* Job 6b: phi >= 0 on the whole domain boundary, proved with each boundary face's Bernstein
+ * coefficients (the face restriction of the cell's tensor Bernstein form), which enclose the
+ * interpolant on the face. */
+static int boundary_faces_nonnegative(const scc_grid* g, const bern_tables* bt)
+{
+    const scc_grid_field* fd = &g->fields[0];
+    for (uint64_t l = 0; l < g->n_cells; ++l) {
+        uint32_t ijk[3];
+        int lo_face[3], hi_face[3];
+        if (!boundary_cell(g, l, ijk, lo_face, hi_face)) continue;
+        const uint32_t c = fd->map[l];
+        if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) {
+            if (g->hole_source[l] & 0x80000000u) return 0;
+            continue;
+        }
+        double v[32];
+        gather_cell(g, fd, c, ijk, v);
+        for (int s = 0; s < 64; ++s) {
+            const int idx[3] = { s % 4, (s / 4) % 4, s / 16 };
+            int on_face = 0;
+            for (int d = 0; d < 3; ++d) on_face |= (lo_face[d] && idx[d] == 0) || (hi_face[d] && idx[d] == 3);
+            if (!on_face) continue;
+            double acc = 0.0;
+            for (int k = 0; k < 32; ++k) acc += bt->val[s][k] * v[k];
+            if (acc < 0.0) return 0;
+        }
+    }
+    return 1;
+}
+
+/* The scc_sdf interface. bounds must contain every point with phi <= 0: the domain when phi >= 0
+ * on the whole domain boundary (then the outside continuation is positive), else unbounded
+ * (phi_q - d continues the inside). */
+static void fill_sdf_interface(scc_grid* g, int boundary_nonneg)
+{
+    g->base.eval = scc_grid_eval;
+    g->base.lipschitz_in = scc_grid_lipschitz_in;
+    g->base.domain.lo = g->lo;
+    g->base.domain.hi = g->hi;
+    if (boundary_nonneg) {
+        g->base.bounds.lo = g->lo;
+        g->base.bounds.hi = g->hi;
+    } else {
+        g->base.bounds.lo = scc_v3(-INFINITY, -INFINITY, -INFINITY);
+        g->base.bounds.hi = scc_v3(INFINITY, INFINITY, INFINITY);
+    }
+    g->base.lipschitz = sqrt(1.0 + fmax(g->lipschitz_max, 1.0) * fmax(g->lipschitz_max, 1.0));
+    g->base.kind = SCC_SDF_GRID;
+    /* An interpolated grid is not known to be convex anywhere: the certified TOI must use the
+     * Lipschitz bounds only. */
+    g->base.convex = 0;
+    g->base.convex_in = NULL;
+}
+
+scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn* parallel_for, void* parallel_user)
+{
+    const scc_allocator* a = &g->allocator;
+    if (g->n_cells > 0x7FFFFFFEu) return SCC_GRID_TOO_LARGE;
+    g->band = band > 0.0 && isfinite(band) ? band : 0.0;
+    scc_grid_status st = adopt_dense_layout(g);
+    if (st != SCC_GRID_OK) return st;
+    bern_tables* bt = scc_alloc(a, sizeof *bt);
+    if (!bt) return SCC_GRID_OUT_OF_MEMORY;
+    scc_cell_bernstein(bt->val);
+    st = compute_cell_bounds(g, bt, parallel_for, parallel_user);
+    if (st == SCC_GRID_OK) st = count_valued_cells(g);
+    if (st == SCC_GRID_OK) st = find_hole_sources(g);
+    if (st == SCC_GRID_OK) st = compute_block_bounds(g);
+    if (st == SCC_GRID_OK) {
+        g->outside_positive = boundary_nodes_nonnegative(g);
+        fill_sdf_interface(g, g->outside_positive || boundary_faces_nonnegative(g, bt));
+    }
+    scc_free(a, bt, sizeof *bt);
+    return st;
+}
