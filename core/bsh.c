@@ -429,7 +429,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
         }
     }
     double te = t_end;
-    while (ok && heap.n) {
+    while (ok && heap.n && stats->evals < p->max_evals) { /* marching alone may use up the budget */
         item it = item_heap_pop(&heap);
         if (it.key > te) break;
         uint32_t s = it.seg & ~SEG_UNTRACED;

@@ -31,6 +31,7 @@ typedef struct scc_params {
     double cert_time_tol;   /* s */
     int64_t cert_max_regions;
     int broad_phase;
+    int64_t max_evals;      /* SDF evaluation budget of this call (> 0); solvers stop at it (NOT_CONVERGED) */
 } scc_params;
 
 typedef enum scc_state { SCC_NO_HIT, SCC_HIT, SCC_PENETRATING, SCC_NOT_CONVERGED } scc_state;

@@ -48,7 +48,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
         lo = r.ta;
         if (r.ta >= hi) { lo = hi; break; }
         if (hi - lo <= p->cert_time_tol) break;
-        if (processed >= p->cert_max_regions) { capped = 1; break; }
+        if (processed >= p->cert_max_regions || evals >= p->max_evals) { capped = 1; break; }
         ++processed;
         scc_tri_state st;
         scc_tri_state_at(m, r.ta, &st);

@@ -35,7 +35,7 @@ scc_dcd_result scc_dcd(const scc_sdf* sdf, const scc_vec3 tri[3], const scc_para
     scc_vec3 g;
     double fx = scc_sdf_eval(sdf, x, &g);
     r.evals++;
-    while (r.iterations < p->max_iter) {
+    while (r.iterations < p->max_iter && r.evals < p->max_evals) {
         r.iterations++;
         int s = 0;
         double ds = scc_dot(g, tri[0]);

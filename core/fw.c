@@ -89,7 +89,7 @@ void scc_fw(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, c
     double t = ta;
     int converged = 0;
     int64_t it = 0;
-    while (it < p->max_iter) {
+    while (it < p->max_iter && s.evals < p->max_evals) {
         double alpha = 2.0 / ((double)it + 2.0);
         ++it;
         scc_vec3 x, g, v;

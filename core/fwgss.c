@@ -75,7 +75,7 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
     const scc_params* p = s->p;
     double t = s->ts;
     int64_t it = 0;
-    while (it < p->max_iter) {
+    while (it < p->max_iter && s->evals < p->max_evals) {
         ++it;
         /* Temporal sub-problem (lines 5-21). */
         scc_vec3 x, g, v;
@@ -139,7 +139,7 @@ static void trace_vertex(scc_fw_state* s, int i, double speed, int cap)
 {
     const double b[3] = { i == 0, i == 1, i == 2 };
     double t = s->ts;
-    for (int k = 0; k < cap && t < s->te; ++k) {
+    for (int k = 0; k < cap && t < s->te && s->evals < s->p->max_evals; ++k) {
         scc_vec3 x = scc_tri_point_at(s->m, b, t, NULL);
         double phi = scc_sdf_eval(s->sdf, x, NULL);
         s->evals++;

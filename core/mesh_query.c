@@ -75,13 +75,27 @@ typedef struct mesh_ctx {
     scc_mesh_probe_fn* probe;
     void* probe_user;
     int64_t broad_evals;
+    const scc_bsh_stats* broad;  /* live broad-phase counters (NULL without the broad phase) */
+    int budget_exhausted;        /* the evaluation budget ran out before every triangle was tested */
 } mesh_ctx;
+
+/* Evaluations left of the query's budget (narrow phase so far plus the broad phase's marching). */
+static int64_t budget_left(const mesh_ctx* c)
+{
+    return c->p->max_evals - c->sum->evals - (c->broad ? c->broad->evals : 0);
+}
 
 /* Narrow phase of triangle t on [ta, min(t1, best + window)], where ta is t0 or the broad phase's
  * candidate time (a proven lower bound of the triangle's contacts). Returns 0 on allocation failure. */
 static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
 {
-    const scc_params* p = c->p;
+    scc_params tp = *c->p;
+    const scc_params* p = &tp;
+    tp.max_evals = budget_left(c);
+    if (tp.max_evals <= 0) {
+        c->budget_exhausted = 1;
+        return 1;
+    }
     scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     double tb = fmin(c->mm->t1, c->best + p->toi_window);
     scc_tri_motion m;
@@ -123,6 +137,7 @@ static int visit_candidate(void* user, uint32_t triangle, double t_candidate, do
     double ta = c->p->method == SCC_METHOD_CERTIFIED ? fmax(c->mm->t0, t_candidate) : c->mm->t0;
     if (!test_triangle(c, triangle, ta)) return 0;
     *io_t_end = fmin(*io_t_end, fmin(c->mm->t1, c->best + c->p->toi_window));
+    if (c->budget_exhausted) *io_t_end = -INFINITY; /* stops the traversal */
     return 1;
 }
 
@@ -148,8 +163,11 @@ static int run_broad_phase(mesh_ctx* c)
         else scc_bsh_refit_linear(bsh, mm->mesh, mm->start, mm->end, moving);
     }
     if (ok) {
-        scc_bsh_stats st;
+        scc_bsh_stats st = { 0, 0, 0 };
+        c->broad = &st;
         ok = scc_bsh_traverse(bsh, moving, c->sdf, mm, c->p, alloc, mm->t1, visit_candidate, c, &st);
+        if (budget_left(c) <= 0) c->budget_exhausted = 1;
+        c->broad = NULL;
         c->sum->evals += st.evals;
         c->broad_evals += st.evals;
     }
@@ -183,18 +201,20 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     c.probe = probe;
     c.probe_user = probe_user;
     c.broad_evals = 0;
+    c.broad = NULL;
+    c.budget_exhausted = 0;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
     int ok = 1;
     if (p->broad_phase && mm->mesh->triangle_count > 0) {
         ok = run_broad_phase(&c);
     } else {
-        for (uint32_t t = 0; t < mm->mesh->triangle_count && ok; ++t) ok = test_triangle(&c, t, mm->t0);
+        for (uint32_t t = 0; t < mm->mesh->triangle_count && ok && !c.budget_exhausted; ++t) ok = test_triangle(&c, t, mm->t0);
     }
     if (out_broad_evals) *out_broad_evals = c.broad_evals;
     contact_buf buf = c.buf;
     double best = c.best, lower = c.lower;
     scc_state best_state = c.best_state;
-    int any_not_converged = c.any_not_converged;
+    int any_not_converged = c.any_not_converged || c.budget_exhausted;
     if (!ok) {
         scc_free(alloc, buf.a, buf.cap * sizeof *buf.a);
         return 0;
@@ -209,7 +229,8 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     sum->hit = isfinite(best);
     sum->toi = sum->hit ? best : mm->t1;
     sum->toi_lower = fmin(lower, sum->toi); /* certified: no triangle touches before this */
-    sum->state = sum->hit ? best_state : (any_not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT);
+    sum->state = sum->hit ? (c.budget_exhausted ? SCC_NOT_CONVERGED : best_state)
+                          : (any_not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT);
     sum->contacts_found = (int)buf.n;
     for (size_t i = 0; i < buf.n && (int)i < capacity; ++i) out[i] = buf.a[i];
     scc_free(alloc, buf.a, buf.cap * sizeof *buf.a);

@@ -67,7 +67,7 @@ int scc_subdivide(const scc_sdf* sdf, const scc_vec3 tri[3], const double primar
     sub_region root = { { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } }, { primary[0], primary[1], primary[2] }, 0 };
     queue[tail++] = root;
 
-    while (head < tail && count < capacity) {
+    while (head < tail && count < capacity && *io_evals < p->max_evals) {
         sub_region r = queue[head++];
         if (full_area * region_fraction(&r) / 3.0 < p->sub_min_area || r.depth >= p->sub_max_depth) continue;
         double g[3];

@@ -40,13 +40,17 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
         }
         h.hit = 0;
         h.state = SCC_NO_HIT;
+        /* One evaluation budget for all segments: each solver gets what the earlier ones left. */
+        scc_params sp = *p;
         for (int k = 0; k < segments; ++k) {
+            if (evals >= p->max_evals) { not_converged = 1; break; }
+            sp.max_evals = p->max_evals - evals;
             double sa = ta + (tb - ta) * k / segments;
             double sb = k + 1 == segments ? tb : ta + (tb - ta) * (k + 1) / segments;
             scc_tri_hit seg;
-            if (p->method == SCC_METHOD_FWGSS) scc_fwgss(sdf, m, sa, sb, p, &seg);
-            else if (p->method == SCC_METHOD_FW) scc_fw(sdf, m, sa, sb, p, &seg);
-            else if (!scc_certified(sdf, m, sa, sb, p, alloc, &seg)) return 0;
+            if (p->method == SCC_METHOD_FWGSS) scc_fwgss(sdf, m, sa, sb, &sp, &seg);
+            else if (p->method == SCC_METHOD_FW) scc_fw(sdf, m, sa, sb, &sp, &seg);
+            else if (!scc_certified(sdf, m, sa, sb, &sp, alloc, &seg)) return 0;
             evals += seg.evals;
             iterations += seg.iterations;
             if (seg.hit) {

@@ -29,3 +29,6 @@ add_test(NAME readme_example COMMAND readme_example)
 # The threading contract of base.h (concurrent queries, per-thread errors, concurrent handles).
 sdfccd_add_check_test(test_threads test_threads.c)
 target_link_libraries(test_threads PRIVATE Threads::Threads)
+
+# Regression tests of the hardening findings (issue 11).
+sdfccd_add_check_test(test_hardening test_hardening.c)

@@ -57,6 +57,7 @@ static scc_params default_params(void)
     p.dist_tol = 1e-9;
     p.max_iter = 64;
     p.max_ls_iter = 100;
+    p.max_evals = INT64_MAX;
     return p;
 }
 

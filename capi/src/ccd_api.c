@@ -31,6 +31,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.certified_max_regions = 2000000;
     p.broad_phase = 1;
     p.internal_value = DEF_COOKIE;
+    p.max_sdf_evaluations = SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS;
     return p;
 }
 
@@ -63,6 +64,12 @@ sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, 
     if (!isfinite(in->margin)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->margin is not finite", fn);
     if (in->max_iterations < 1 || in->max_line_search_iterations < 1 || in->certified_max_regions < 1)
         return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: iteration caps must be >= 1", fn);
+    if (in->max_line_search_iterations > 4096)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->max_line_search_iterations must be <= 4096 (got %d)", fn,
+                          in->max_line_search_iterations);
+    if (in->max_sdf_evaluations < 1)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->max_sdf_evaluations must be >= 1 (got %lld)", fn,
+                          (long long)in->max_sdf_evaluations);
     out->method = in->method == SDFCCD_METHOD_FWGSS ? SCC_METHOD_FWGSS
                 : in->method == SDFCCD_METHOD_FW ? SCC_METHOD_FW
                 : in->method == SDFCCD_METHOD_DCD ? SCC_METHOD_DCD : SCC_METHOD_CERTIFIED;
@@ -88,17 +95,40 @@ sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, 
     out->cert_time_tol = in->certified_time_tolerance;
     out->cert_max_regions = in->certified_max_regions;
     out->broad_phase = in->broad_phase != 0;
+    out->max_evals = in->max_sdf_evaluations;
     return SDFCCD_OK;
 }
 
-static sdfccd_Status convert_motion(const sdfccd_RigidMotion* in, double t0, const char* what, scc_rigid* out)
+/* Finite and within SDFCCD_MAX_QUERY_MAGNITUDE in every coordinate. */
+static sdfccd_Status check_magnitude(sdfccd_Vec3 v, const char* what)
+{
+    sdfccd_Status st;
+    if ((st = capi_check_vec(v, what))) return st;
+    double m = fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
+    if (m > SDFCCD_MAX_QUERY_MAGNITUDE)
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s has a coordinate of magnitude %g, above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
+                          what, m, SDFCCD_MAX_QUERY_MAGNITUDE);
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status convert_motion(const sdfccd_RigidMotion* in, double t0, double t1, const char* what, scc_rigid* out)
 {
     sdfccd_Status st;
     scc_xform xf;
     if ((st = capi_check_pose(in->pose, what, &xf))) return st;
-    if ((st = capi_check_vec(in->local_center, what)) || (st = capi_check_vec(in->linear_velocity, what)) ||
-        (st = capi_check_vec(in->angular_velocity, what)))
+    if ((st = check_magnitude(in->pose.position, what)) || (st = check_magnitude(in->local_center, what)) ||
+        (st = check_magnitude(in->linear_velocity, what)) || (st = check_magnitude(in->angular_velocity, what)))
         return st;
+    /* Lengths of vectors within the magnitude limit do not overflow; t1 - t0 is finite (check_interval). */
+    double dt = t1 - t0;
+    double shift = scc_len(capi_v(in->linear_velocity)) * dt;
+    if (!(shift <= SDFCCD_MAX_QUERY_MAGNITUDE))
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the displacement |v| (t1 - t0) = %g is above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
+                          what, shift, SDFCCD_MAX_QUERY_MAGNITUDE);
+    double angle = scc_len(capi_v(in->angular_velocity)) * dt;
+    if (!(angle <= SDFCCD_MAX_ROTATION_ANGLE))
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the rotation |w| (t1 - t0) = %g rad is above SDFCCD_MAX_ROTATION_ANGLE (%g rad), "
+                          "beyond which the motion model is not accurate", what, angle, SDFCCD_MAX_ROTATION_ANGLE);
     out->p0 = xf.p;
     out->q0 = xf.q;
     out->c_local = capi_v(in->local_center);
@@ -108,10 +138,31 @@ static sdfccd_Status convert_motion(const sdfccd_RigidMotion* in, double t0, con
     return SDFCCD_OK;
 }
 
+/* The body's and the SDF's rotations add up: their sum must stay within SDFCCD_MAX_ROTATION_ANGLE. */
+static sdfccd_Status check_total_rotation(const scc_rigid* body, const scc_rigid* sdf, double dt, const char* fn)
+{
+    double angle = (scc_len(body->w) + (sdf ? scc_len(sdf->w) : 0.0)) * dt;
+    if (!(angle <= SDFCCD_MAX_ROTATION_ANGLE))
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the relative rotation over the interval (%g rad) is above "
+                          "SDFCCD_MAX_ROTATION_ANGLE (%g rad), beyond which the motion model is not accurate",
+                          fn, angle, SDFCCD_MAX_ROTATION_ANGLE);
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status check_mesh_bounds(const capi_mesh* m, const char* fn)
+{
+    double b = fmax(scc_maxc(scc_vabs(m->mesh.bounds.lo)), scc_maxc(scc_vabs(m->mesh.bounds.hi)));
+    if (!(b <= SDFCCD_MAX_QUERY_MAGNITUDE))
+        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the mesh has a vertex coordinate of magnitude %g, above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
+                          fn, b, SDFCCD_MAX_QUERY_MAGNITUDE);
+    return SDFCCD_OK;
+}
+
 static sdfccd_Status check_interval(double t0, double t1, const char* fn)
 {
     if (!isfinite(t0) || !isfinite(t1)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: t0 and t1 must be finite (got %g, %g)", fn, t0, t1);
     if (t1 < t0) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: t1 (%g) < t0 (%g)", fn, t1, t0);
+    if (!isfinite(t1 - t0)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: t1 - t0 overflows (t0 = %g, t1 = %g)", fn, t0, t1);
     return SDFCCD_OK;
 }
 
@@ -137,7 +188,7 @@ static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motio
     q->sdf_motion_ptr = NULL;
     if (sdf_motion) {
         snprintf(what, sizeof what, "%s: sdf_motion", fn);
-        if ((st = convert_motion(sdf_motion, t0, what, &q->sdf_motion))) return st;
+        if ((st = convert_motion(sdf_motion, t0, t1, what, &q->sdf_motion))) return st;
         q->sdf_motion_ptr = &q->sdf_motion;
     }
     q->sdf = capi_sdf_lookup(sdf);
@@ -213,11 +264,12 @@ sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* 
     scc_tri_motion m;
     memset(&m, 0, sizeof m);
     for (int i = 0; i < 3; ++i) {
-        if ((st = capi_check_vec(triangle[i], "sdfccd_query_triangle: triangle vertex"))) return st;
+        if ((st = check_magnitude(triangle[i], "sdfccd_query_triangle: triangle vertex"))) return st;
         m.local[i] = capi_v(triangle[i]);
     }
     if (degenerate(m.local)) return capi_error(SDFCCD_DEGENERATE, "%s: the triangle has zero area", fn);
-    if ((st = convert_motion(motion, t0, "sdfccd_query_triangle: motion", &body))) return st;
+    if ((st = convert_motion(motion, t0, t1, "sdfccd_query_triangle: motion", &body))) return st;
+    if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
     m.kind = SCC_TRI_RIGID;
     m.body = &body;
     m.sdf = q.sdf_motion_ptr;
@@ -239,8 +291,8 @@ sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
     scc_tri_motion m;
     memset(&m, 0, sizeof m);
     for (int i = 0; i < 3; ++i) {
-        if ((st = capi_check_vec(start[i], "sdfccd_query_triangle_linear: start vertex")) ||
-            (st = capi_check_vec(end[i], "sdfccd_query_triangle_linear: end vertex")))
+        if ((st = check_magnitude(start[i], "sdfccd_query_triangle_linear: start vertex")) ||
+            (st = check_magnitude(end[i], "sdfccd_query_triangle_linear: end vertex")))
             return st;
         m.start[i] = capi_v(start[i]);
         m.end[i] = capi_v(end[i]);
@@ -277,9 +329,11 @@ sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_
     if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
     if ((st = capi_check_ptr(motion, "sdfccd_query_mesh: motion"))) return st;
     scc_rigid body;
-    if ((st = convert_motion(motion, t0, "sdfccd_query_mesh: motion", &body))) return st;
+    if ((st = convert_motion(motion, t0, t1, "sdfccd_query_mesh: motion", &body))) return st;
+    if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
     capi_mesh* m = capi_mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
+    if ((st = check_mesh_bounds(m, fn))) return st;
     scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1 };
     return run_mesh(&q, &mm, out_contacts, capacity, out_result, fn);
 }
@@ -299,8 +353,8 @@ sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotio
     if (!m) return SDFCCD_INVALID_HANDLE;
     uint32_t nv = m->mesh.vertex_count;
     for (uint32_t i = 0; i < 3 * nv; ++i)
-        if (!isfinite(start[i]) || !isfinite(end[i]))
-            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate", fn, i / 3);
+        if (!(fabs(start[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE) || !(fabs(end[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE))
+            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i / 3);
     size_t bytes = 2 * (size_t)nv * sizeof(scc_vec3);
     scc_vec3* v = capi_alloc(bytes);
     if (!v) return capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
