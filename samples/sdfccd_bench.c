@@ -40,7 +40,7 @@
 #include "bsh.h"
 #include "ccd.h"
 #include "sdf_analytic.h"
-#include "capi_internal.h" /* capi_convert_params */
+#include "capi_internal.h" /* sdfccd__convert_params */
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -683,7 +683,7 @@ static scc_params core_params(const sdfccd_QueryParams* in)
 {
     scc_params p;
     memset(&p, 0, sizeof p);
-    if (capi_convert_params(in, "sdfccd_bench", &p) != SDFCCD_OK) {
+    if (sdfccd__convert_params(in, "sdfccd_bench", &p) != SDFCCD_OK) {
         fprintf(stderr, "sdfccd_bench: %s\n", sdfccd_last_error());
         exit(1);
     }

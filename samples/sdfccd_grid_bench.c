@@ -74,14 +74,14 @@ static double time_abi(sdfccd_SdfId id, const sdfccd_Vec3* p, int n, double* sin
 
 static double time_core(sdfccd_SdfId id, const sdfccd_Vec3* p, int n, double* sink)
 {
-    const scc_sdf* s = capi_sdf_lookup(id)->sdf;
+    const scc_sdf* s = sdfccd__sdf_lookup(id)->sdf;
     double best = INFINITY;
     for (int rep = 0; rep < 5; ++rep) {
         const double t0 = now();
         double acc = 0;
         for (int i = 0; i < n; ++i) {
             scc_vec3 g;
-            acc += scc_sdf_eval(s, capi_v(p[i]), &g) + g.x;
+            acc += scc_sdf_eval(s, sdfccd__v(p[i]), &g) + g.x;
         }
         best = fmin(best, (now() - t0) / n * 1e9);
         *sink += acc;

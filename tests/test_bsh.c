@@ -21,7 +21,7 @@
 #include "ccd.h"
 #include "sdf_analytic.h"
 #include "test_util.h"
-#include "capi_internal.h" /* capi_convert_params */
+#include "capi_internal.h" /* sdfccd__convert_params */
 
 #define DT (1.0 / 60.0)
 
@@ -146,7 +146,7 @@ static scc_params default_params(scc_method method)
     sdfccd_QueryParams pub = sdfccd_default_query_params();
     scc_params p;
     memset(&p, 0, sizeof p);
-    ck_assert_int_eq(capi_convert_params(&pub, "test_bsh", &p), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd__convert_params(&pub, "test_bsh", &p), SDFCCD_OK);
     p.method = method;
     p.subdivision = 0;
     p.sub_min_area = 1e-6;

@@ -101,8 +101,8 @@ START_TEST(test_threads_identical_and_progress)
     def.progress_user = &log;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &b), SDFCCD_OK);
     scc_grid *ga, *gb;
-    ck_assert_int_eq(capi_grid_lookup(a, "t", &ga), SDFCCD_OK);
-    ck_assert_int_eq(capi_grid_lookup(b, "t", &gb), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd__grid_lookup(a, "t", &ga), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd__grid_lookup(b, "t", &gb), SDFCCD_OK);
     ck_assert_uint_eq(ga->fields[0].node_count, gb->fields[0].node_count);
     for (uint64_t l = 0; l < ga->fields[0].node_count; ++l) ck_assert(scc_grid_node_value(ga, 0, l) == scc_grid_node_value(gb, 0, l));
     ck_assert_int_eq(memcmp(ga->cell_lipschitz, gb->cell_lipschitz, ga->fields[0].cell_count * 4), 0);
@@ -129,12 +129,12 @@ START_TEST(test_narrow_band)
     sdfccd_MeshInfo mi;
     ck_assert_int_eq(sdfccd_mesh_get_info(mesh, &mi), SDFCCD_OK);
     /* a domain with room around the bunny, as a scene would use */
-    const scc_vec3 ext = scc_sub(capi_v(mi.bounds.hi), capi_v(mi.bounds.lo));
+    const scc_vec3 ext = scc_sub(sdfccd__v(mi.bounds.hi), sdfccd__v(mi.bounds.lo));
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[0] = def.resolution[1] = def.resolution[2] = 40;
     def.fit_domain = 0;
-    def.domain.lo = capi_pv(scc_sub(capi_v(mi.bounds.lo), scc_scale(ext, 0.3)));
-    def.domain.hi = capi_pv(scc_add(capi_v(mi.bounds.hi), scc_scale(ext, 0.3)));
+    def.domain.lo = sdfccd__pv(scc_sub(sdfccd__v(mi.bounds.lo), scc_scale(ext, 0.3)));
+    def.domain.hi = sdfccd__pv(scc_add(sdfccd__v(mi.bounds.hi), scc_scale(ext, 0.3)));
     sdfccd_SdfId dense, band;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &dense), SDFCCD_OK);
     sdfccd_GridInfo di, bi;
@@ -215,7 +215,7 @@ START_TEST(test_outside_domain)
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_OK);
     sdfccd_GridInfo info;
     ck_assert_int_eq(sdfccd_grid_get_info(g, &info), SDFCCD_OK);
-    const scc_aabb dom = capi_box(info.domain);
+    const scc_aabb dom = sdfccd__box(info.domain);
     const scc_vec3 c = scc_scale(scc_add(dom.lo, dom.hi), 0.5), e = scc_sub(dom.hi, dom.lo);
     enum { N = 3000 };
     sdfccd_Vec3* p = malloc(N * sizeof *p);
@@ -224,14 +224,14 @@ START_TEST(test_outside_domain)
     int n = 0;
     while (n < N) {
         scc_vec3 q = scc_v3(c.x + e.x * test_rng_uniform(&rng, -1.5, 1.5), c.y + e.y * test_rng_uniform(&rng, -1.5, 1.5), c.z + e.z * test_rng_uniform(&rng, -1.5, 1.5));
-        if (scc_aabb_distance(&dom, q) > 0) p[n++] = capi_pv(q);
+        if (scc_aabb_distance(&dom, q) > 0) p[n++] = sdfccd__pv(q);
     }
     ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, p, N, 0, exact, NULL), SDFCCD_OK);
     for (int i = 0; i < N; ++i) {
         double v;
         sdfccd_Vec3 gr;
         ck_assert_int_eq(sdfccd_sdf_eval(g, p[i], &v, &gr), SDFCCD_OK);
-        const double d = scc_aabb_distance(&dom, capi_v(p[i]));
+        const double d = scc_aabb_distance(&dom, sdfccd__v(p[i]));
         ck_assert(v >= d - 1e-12);
         ck_assert_msg(v <= exact[i] + 1e-3, "outside value %g above exact %g", v, exact[i]); /* 1e-3: grid error at 24^3 */
         const double gl = sqrt(gr.x * gr.x + gr.y * gr.y + gr.z * gr.z);
@@ -277,7 +277,7 @@ START_TEST(test_lipschitz_bounds)
     sdfccd_SdfId id;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &id), SDFCCD_OK);
     scc_grid* g;
-    ck_assert_int_eq(capi_grid_lookup(id, "t", &g), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd__grid_lookup(id, "t", &g), SDFCCD_OK);
     double worst_ratio = 0, sum_ratio = 0;
     for (uint64_t l = 0; l < g->n_cells; ++l) {
         const uint32_t i = (uint32_t)(l % 10), j = (uint32_t)(l / 10 % 10), k = (uint32_t)(l / 100);
@@ -302,7 +302,7 @@ START_TEST(test_lipschitz_bounds)
     for (int it = 0; it < 300; ++it) {
         scc_vec3 c = scc_v3(test_rng_uniform(&rng, g->lo.x, g->hi.x), test_rng_uniform(&rng, g->lo.y, g->hi.y), test_rng_uniform(&rng, g->lo.z, g->hi.z));
         const double r = test_rng_uniform(&rng, 0.01, it % 3 ? 0.3 : 0.8); /* some boxes use the block maxima */
-        sdfccd_Aabb box = { capi_pv(scc_sub(c, scc_v3(r, r, r))), capi_pv(scc_add(c, scc_v3(r, r, r))) };
+        sdfccd_Aabb box = { sdfccd__pv(scc_sub(c, scc_v3(r, r, r))), sdfccd__pv(scc_add(c, scc_v3(r, r, r))) };
         double L;
         ck_assert_int_eq(sdfccd_grid_lipschitz_bound(id, box, &L), SDFCCD_OK);
         for (int s = 0; s < 20; ++s) {
@@ -497,10 +497,10 @@ START_TEST(test_core_band_unknown_lipschitz)
     d.res[0] = d.res[1] = d.res[2] = 10;
     d.sample = core_sphere_sample;
     scc_grid *dense = NULL, *band = NULL;
-    ck_assert_int_eq(scc_grid_build(capi_allocator(), &d, &dense), SCC_GRID_BUILD_OK);
+    ck_assert_int_eq(scc_grid_build(sdfccd__allocator(), &d, &dense), SCC_GRID_BUILD_OK);
     d.band = 0.1;
     d.sample_lipschitz = 0.0;
-    ck_assert_int_eq(scc_grid_build(capi_allocator(), &d, &band), SCC_GRID_BUILD_OK);
+    ck_assert_int_eq(scc_grid_build(sdfccd__allocator(), &d, &band), SCC_GRID_BUILD_OK);
     ck_assert_uint_lt(band->fields[0].cell_count, dense->fields[0].cell_count);
     ck_assert_double_eq(band->band, 0.0);
     test_rng rng = { 61 };

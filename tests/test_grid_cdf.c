@@ -31,7 +31,7 @@ static unsigned char* read_all(const char* path, size_t* out_size)
 static scc_grid* grid_of(sdfccd_SdfId id)
 {
     scc_grid* g = NULL;
-    ck_assert_int_eq(capi_grid_lookup(id, "test", &g), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd__grid_lookup(id, "test", &g), SDFCCD_OK);
     return g;
 }
 
@@ -216,7 +216,7 @@ START_TEST(test_box_cdf_loads_and_matches_analytic)
      * box distance is linear (z - 1 on both sides of the face), the cubic reproduces it exactly. */
     for (uint64_t l = 0; l < g->fields[0].node_count; ++l) {
         double v;
-        ck_assert_int_eq(sdfccd_sdf_eval(id, capi_pv(scc_grid_dense_node_position(g, l)), &v, NULL), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_sdf_eval(id, sdfccd__pv(scc_grid_dense_node_position(g, l)), &v, NULL), SDFCCD_OK);
         ck_assert_double_near(v, scc_grid_node_value(g, 0, l), 1e-12);
     }
     test_rng rng = { 5 };
@@ -345,7 +345,7 @@ static void compare_with_generated(const char* mesh_rel, const char* cdf_rel, in
     ck_assert_msg(sdfccd_create_grid_from_mesh(mesh, &def, &ours) == SDFCCD_OK, "%s", sdfccd_last_error());
     scc_grid* a = grid_of(ours);
     scc_grid* b = grid_of(theirs);
-    const scc_mesh* m = &capi_mesh_lookup(mesh)->mesh;
+    const scc_mesh* m = &sdfccd__mesh_lookup(mesh)->mesh;
     ck_assert_int_eq(memcmp(&a->lo, &b->lo, sizeof a->lo), 0);
     ck_assert_int_eq(memcmp(&a->hi, &b->hi, sizeof a->hi), 0);
     ck_assert_int_eq(memcmp(&a->h, &b->h, sizeof a->h), 0);
@@ -377,7 +377,7 @@ static void compare_with_generated(const char* mesh_rel, const char* cdf_rel, in
     int compared = 0;
     for (int it = 0; it < 2000; ++it) {
         sdfccd_Vec3 p = { test_rng_uniform(&rng, a->lo.x, a->hi.x), test_rng_uniform(&rng, a->lo.y, a->hi.y), test_rng_uniform(&rng, a->lo.z, a->hi.z) };
-        const uint64_t l = scc_grid_cell_of(a, capi_v(p));
+        const uint64_t l = scc_grid_cell_of(a, sdfccd__v(p));
         int touches = 0;
         uint32_t scratch[32];
         const uint32_t* ids = scc_grid_cell_ids(a, 0, (uint32_t)l, scratch);
@@ -548,7 +548,7 @@ START_TEST(test_corrupt_files)
         ck_assert_int_eq(sdfccd_grid_interpolate(id, 0, p, &raw, NULL, &has), SDFCCD_OK);
         ck_assert_int_eq(has, 0);
         ck_assert_int_eq(sdfccd_sdf_eval(id, p, &v, &gr), SDFCCD_OK);
-        const double exact = box_sdf(capi_v(p), 1.0); /* the point is inside the box, in the +x face cell */
+        const double exact = box_sdf(sdfccd__v(p), 1.0); /* the point is inside the box, in the +x face cell */
         ck_assert_msg(isfinite(v) && (v < 0) == (exact < 0) && fabs(v) <= fabs(exact) + 1e-12, "fallback %g, box distance %g", v, exact);
         ck_assert_double_near(gr.x * gr.x + gr.y * gr.y + gr.z * gr.z, 1.0, 1e-9);
         ck_assert_int_eq(sdfccd_destroy_sdf(id), SDFCCD_OK);

@@ -87,9 +87,9 @@ START_TEST(test_bvh_vs_brute_force)
     test_rng rng = { 2 };
     for (size_t mi = 0; mi < sizeof meshes / sizeof meshes[0]; ++mi) {
         sdfccd_MeshId id = load_mesh(meshes[mi]);
-        const scc_mesh* m = &capi_mesh_lookup(id)->mesh;
+        const scc_mesh* m = &sdfccd__mesh_lookup(id)->mesh;
         scc_tri_bvh bvh;
-        ck_assert_int_eq(scc_tri_bvh_build(&bvh, capi_allocator(), m), 0);
+        ck_assert_int_eq(scc_tri_bvh_build(&bvh, sdfccd__allocator(), m), 0);
         const scc_vec3 c = scc_scale(scc_add(m->bounds.lo, m->bounds.hi), 0.5), e = scc_sub(m->bounds.hi, m->bounds.lo);
         for (int it = 0; it < 2000; ++it) {
             const double s = it < 1000 ? 0.6 : 2.0; /* near and far */
@@ -112,7 +112,7 @@ START_TEST(test_bvh_vs_brute_force)
         scc_tri_bvh_destroy(&bvh);
         /* capped signed distance: exact below the cap, the cap above it */
         scc_mesh_sdf ms;
-        ck_assert_int_eq(scc_mesh_sdf_init(&ms, capi_allocator(), m), 0);
+        ck_assert_int_eq(scc_mesh_sdf_init(&ms, sdfccd__allocator(), m), 0);
         uint32_t hint = UINT32_MAX, hint2 = UINT32_MAX;
         for (int it = 0; it < 500; ++it) {
             scc_vec3 p = scc_v3(c.x + e.x * test_rng_uniform(&rng, -1, 1), c.y + e.y * test_rng_uniform(&rng, -1, 1), c.z + e.z * test_rng_uniform(&rng, -1, 1));
@@ -145,7 +145,7 @@ START_TEST(test_cube_closed_form)
     test_rng rng = { 3 };
     for (int i = 0; i < N; ++i) p[i] = (sdfccd_Vec3){ test_rng_uniform(&rng, -1.5, 1.5), test_rng_uniform(&rng, -1.5, 1.5), test_rng_uniform(&rng, -1.5, 1.5) };
     ck_assert_int_eq(sdfccd_mesh_signed_distance(id, p, N, 0, d, NULL), SDFCCD_OK);
-    for (int i = 0; i < N; ++i) ck_assert_double_near(d[i], box_sdf(capi_v(p[i]), 0.5), 1e-12);
+    for (int i = 0; i < N; ++i) ck_assert_double_near(d[i], box_sdf(sdfccd__v(p[i]), 0.5), 1e-12);
     free(p);
     free(d);
     ck_assert_int_eq(sdfccd_destroy_mesh(id), SDFCCD_OK);
@@ -230,7 +230,7 @@ START_TEST(test_icosphere_bounds)
     }
     ck_assert_int_eq(sdfccd_mesh_signed_distance(id, p, N, 0, d, NULL), SDFCCD_OK);
     for (int i = 0; i < N; ++i) {
-        double r = scc_len(capi_v(p[i]));
+        double r = scc_len(sdfccd__v(p[i]));
         if (r >= 1.0) { ck_assert(d[i] >= r - 1.0 - 1e-12); ck_assert(d[i] <= r - rin + 1e-12); }
         else { ck_assert(d[i] <= -(rin - r) + 1e-12); ck_assert(d[i] >= -(1.0 - r) - 1e-12); }
     }
@@ -249,7 +249,7 @@ START_TEST(test_signs_vs_winding_number)
     test_rng rng = { 5 };
     for (size_t mi = 0; mi < sizeof meshes / sizeof meshes[0]; ++mi) {
         sdfccd_MeshId id = load_mesh(meshes[mi]);
-        const scc_mesh* m = &capi_mesh_lookup(id)->mesh;
+        const scc_mesh* m = &sdfccd__mesh_lookup(id)->mesh;
         sdfccd_MeshTopology topo;
         ck_assert_int_eq(sdfccd_mesh_get_topology(id, &topo), SDFCCD_OK);
         ck_assert_msg(topo.closed && topo.volume > 0, "%s should be closed and outward", meshes[mi]);
@@ -264,7 +264,7 @@ START_TEST(test_signs_vs_winding_number)
         int inside = 0;
         for (int i = 0; i < n; ++i) {
             if (fabs(d[i]) < 1e-9) continue;
-            double w = winding_number(m, capi_v(p[i]));
+            double w = winding_number(m, sdfccd__v(p[i]));
             ck_assert_msg((w > 0.5) == (d[i] < 0), "%s: point (%g %g %g) d %g winding %g", meshes[mi], p[i].x, p[i].y, p[i].z, d[i], w);
             inside += d[i] < 0;
         }

@@ -39,23 +39,23 @@ static void counted_free(void* p, size_t size, void* user)
 
 static const scc_allocator s_core_allocator = { counted_alloc, counted_free, NULL };
 
-void* capi_alloc(size_t size) { return counted_alloc(size, NULL); }
-void* capi_calloc(size_t size)
+void* sdfccd__alloc(size_t size) { return counted_alloc(size, NULL); }
+void* sdfccd__calloc(size_t size)
 {
     void* p = counted_alloc(size, NULL);
     if (p) memset(p, 0, size);
     return p;
 }
-void capi_free(void* p, size_t size) { counted_free(p, size, NULL); }
-const scc_allocator* capi_allocator(void) { return &s_core_allocator; }
+void sdfccd__free(void* p, size_t size) { counted_free(p, size, NULL); }
+const scc_allocator* sdfccd__allocator(void) { return &s_core_allocator; }
 
 sdfccd_Status sdfccd_set_allocator(sdfccd_AllocFcn* alloc, sdfccd_FreeFcn* free_fcn, void* user)
 {
     if ((alloc == NULL) != (free_fcn == NULL))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_set_allocator: alloc and free must both be set or both be NULL");
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_set_allocator: alloc and free must both be set or both be NULL");
     if (atomic_load(&s_bytes) != 0)
-        return capi_error(SDFCCD_BAD_STATE, "sdfccd_set_allocator: %lld bytes are still allocated; destroy every handle first",
-                          (long long)atomic_load(&s_bytes));
+        return sdfccd__error(SDFCCD_BAD_STATE, "sdfccd_set_allocator: %lld bytes are still allocated; destroy every handle first",
+                             (long long)atomic_load(&s_bytes));
     s_alloc = alloc ? alloc : default_alloc;
     s_free = free_fcn ? free_fcn : default_free;
     s_alloc_user = alloc ? user : NULL;
@@ -68,7 +68,7 @@ int64_t sdfccd_byte_count(void) { return atomic_load(&s_bytes); }
 
 static _Thread_local char s_message[512];
 
-sdfccd_Status capi_error(sdfccd_Status status, const char* fmt, ...)
+sdfccd_Status sdfccd__error(sdfccd_Status status, const char* fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -77,25 +77,25 @@ sdfccd_Status capi_error(sdfccd_Status status, const char* fmt, ...)
     return status;
 }
 
-sdfccd_Status capi_oom(const char* what)
+sdfccd_Status sdfccd__oom(const char* what)
 {
-    return capi_error(SDFCCD_OUT_OF_MEMORY, "out of memory while creating %s", what);
+    return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "out of memory while creating %s", what);
 }
 
-sdfccd_Status capi_check_ptr(const void* p, const char* what)
+sdfccd_Status sdfccd__check_ptr(const void* p, const char* what)
 {
-    return p ? SDFCCD_OK : capi_error(SDFCCD_INVALID_ARGUMENT, "%s is NULL", what);
+    return p ? SDFCCD_OK : sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s is NULL", what);
 }
 
-sdfccd_Status capi_check_finite(double v, const char* what)
+sdfccd_Status sdfccd__check_finite(double v, const char* what)
 {
-    return isfinite(v) ? SDFCCD_OK : capi_error(SDFCCD_INVALID_ARGUMENT, "%s is not finite (%g)", what, v);
+    return isfinite(v) ? SDFCCD_OK : sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s is not finite (%g)", what, v);
 }
 
-sdfccd_Status capi_check_vec(sdfccd_Vec3 v, const char* what)
+sdfccd_Status sdfccd__check_vec(sdfccd_Vec3 v, const char* what)
 {
     if (isfinite(v.x) && isfinite(v.y) && isfinite(v.z)) return SDFCCD_OK;
-    return capi_error(SDFCCD_INVALID_ARGUMENT, "%s is not finite (%g, %g, %g)", what, v.x, v.y, v.z);
+    return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s is not finite (%g, %g, %g)", what, v.x, v.y, v.z);
 }
 
 const char* sdfccd_last_error(void) { return s_message; }
@@ -223,12 +223,12 @@ static void* registry_remove(uint32_t index1, uint32_t generation, uint32_t kind
 
 /* ---------------- SDF objects ---------------- */
 
-capi_sdf* capi_sdf_new(size_t storage_size)
+sdfccd__sdf* sdfccd__sdf_new(size_t storage_size)
 {
-    capi_sdf* s = capi_calloc(sizeof *s);
+    sdfccd__sdf* s = sdfccd__calloc(sizeof *s);
     if (!s) return NULL;
-    s->storage = capi_calloc(storage_size);
-    if (!s->storage) { capi_free(s, sizeof *s); return NULL; }
+    s->storage = sdfccd__calloc(storage_size);
+    if (!s->storage) { sdfccd__free(s, sizeof *s); return NULL; }
     s->storage_size = storage_size;
     s->sdf = (const scc_sdf*)s->storage;
     s->memory_bytes = (int64_t)storage_size;
@@ -236,7 +236,7 @@ capi_sdf* capi_sdf_new(size_t storage_size)
     return s;
 }
 
-void capi_sdf_release(capi_sdf* s)
+void sdfccd__sdf_release(sdfccd__sdf* s)
 {
     if (!s) return;
     /* References only change under the registry lock so concurrent destroys stay consistent. */
@@ -245,82 +245,82 @@ void capi_sdf_release(capi_sdf* s)
     pthread_mutex_unlock(&s_lock);
     if (left) return;
     if (s->release_extra) s->release_extra(s);
-    for (int i = 0; i < 2; ++i) capi_sdf_release(s->children[i]);
-    capi_free(s->storage, s->storage_size);
-    capi_free(s, sizeof *s);
+    for (int i = 0; i < 2; ++i) sdfccd__sdf_release(s->children[i]);
+    sdfccd__free(s->storage, s->storage_size);
+    sdfccd__free(s, sizeof *s);
 }
 
-void capi_sdf_retain(capi_sdf* s)
+void sdfccd__sdf_retain(sdfccd__sdf* s)
 {
     pthread_mutex_lock(&s_lock);
     s->refs++;
     pthread_mutex_unlock(&s_lock);
 }
 
-sdfccd_Status capi_sdf_register(capi_sdf* s, sdfccd_SdfId* out_id)
+sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id)
 {
     sdfccd_SdfId id = { 0, 0 };
     if (!registry_add(s, KIND_SDF, &id.index1, &id.generation)) {
-        capi_sdf_release(s);
-        return capi_oom("an SDF handle");
+        sdfccd__sdf_release(s);
+        return sdfccd__oom("an SDF handle");
     }
     *out_id = id;
     return SDFCCD_OK;
 }
 
-capi_sdf* capi_sdf_lookup(sdfccd_SdfId id)
+sdfccd__sdf* sdfccd__sdf_lookup(sdfccd_SdfId id)
 {
-    capi_sdf* s = registry_get(id.index1, id.generation, KIND_SDF);
-    if (!s) capi_error(SDFCCD_INVALID_HANDLE, "SDF handle {%u, %u} is not a live SDF", id.index1, id.generation);
+    sdfccd__sdf* s = registry_get(id.index1, id.generation, KIND_SDF);
+    if (!s) sdfccd__error(SDFCCD_INVALID_HANDLE, "SDF handle {%u, %u} is not a live SDF", id.index1, id.generation);
     return s;
 }
 
 sdfccd_Status sdfccd_destroy_sdf(sdfccd_SdfId id)
 {
-    capi_sdf* s = registry_remove(id.index1, id.generation, KIND_SDF);
-    if (!s) return capi_error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_sdf: handle {%u, %u} is not a live SDF", id.index1, id.generation);
-    capi_sdf_release(s);
+    sdfccd__sdf* s = registry_remove(id.index1, id.generation, KIND_SDF);
+    if (!s) return sdfccd__error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_sdf: handle {%u, %u} is not a live SDF", id.index1, id.generation);
+    sdfccd__sdf_release(s);
     return SDFCCD_OK;
 }
 
 /* ---------------- mesh objects ---------------- */
 
-sdfccd_Status capi_mesh_create(const double* vertices, uint32_t vertex_count, const uint32_t* indices,
-                               uint32_t triangle_count, int drop_degenerate, const char* what,
+sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count, const uint32_t* indices,
+                                  uint32_t triangle_count, int drop_degenerate, const char* what,
                                sdfccd_MeshId* out_mesh)
 {
-    if (!vertices || !indices) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: vertices or indices is NULL", what);
+    if (!vertices || !indices) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertices or indices is NULL", what);
     if (vertex_count == 0 || triangle_count == 0)
-        return capi_error(SDFCCD_DEGENERATE, "%s: the mesh is empty (%u vertices, %u triangles)", what, vertex_count, triangle_count);
+        return sdfccd__error(SDFCCD_DEGENERATE, "%s: the mesh is empty (%u vertices, %u triangles)", what, vertex_count, triangle_count);
     if (vertex_count > (1u << 30) || triangle_count > (1u << 30))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: too many vertices or triangles", what);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: too many vertices or triangles", what);
     for (uint32_t i = 0; i < 3 * vertex_count; ++i)
         if (!isfinite(vertices[i]))
-            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate", what, i / 3);
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate", what, i / 3);
     uint32_t kept = 0;
     for (uint32_t t = 0; t < triangle_count; ++t) {
         const uint32_t* f = indices + 3 * t;
         if (f[0] >= vertex_count || f[1] >= vertex_count || f[2] >= vertex_count)
-            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: triangle %u has a vertex index out of range (%u vertices)", what, t, vertex_count);
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: triangle %u has a vertex index out of range (%u vertices)", what, t, vertex_count);
         scc_vec3 a = { vertices[3 * f[0]], vertices[3 * f[0] + 1], vertices[3 * f[0] + 2] };
         scc_vec3 b = { vertices[3 * f[1]], vertices[3 * f[1] + 1], vertices[3 * f[1] + 2] };
         scc_vec3 c = { vertices[3 * f[2]], vertices[3 * f[2] + 1], vertices[3 * f[2] + 2] };
         double scale = fmax(scc_len2(scc_sub(b, a)), scc_len2(scc_sub(c, a)));
         int degenerate = !(scc_triangle_area2(a, b, c) > 1e-12 * scale) || scale == 0.0;
         if (degenerate && !drop_degenerate)
-            return capi_error(SDFCCD_DEGENERATE, "%s: triangle %u (vertices %u %u %u) has zero area", what, t, f[0], f[1], f[2]);
+            return sdfccd__error(SDFCCD_DEGENERATE, "%s: triangle %u (vertices %u %u %u) has zero area", what, t, f[0], f[1], f[2]);
         kept += !degenerate;
     }
-    if (kept == 0) return capi_error(SDFCCD_DEGENERATE, "%s: every triangle has zero area", what);
+    if (kept == 0) return sdfccd__error(SDFCCD_DEGENERATE, "%s: every triangle has zero area", what);
 
     size_t vbytes = (size_t)vertex_count * sizeof(scc_vec3);
     size_t ibytes = (size_t)kept * 3 * sizeof(uint32_t);
-    capi_mesh* m = capi_calloc(sizeof *m);
-    void* block = capi_alloc(vbytes + ibytes);
+    sdfccd__mesh* m = sdfccd__calloc(sizeof *m);
+    void* block = sdfccd__alloc(vbytes + ibytes);
     if (!m || !block) {
-        capi_free(m, sizeof *m);
-        capi_free(block, vbytes + ibytes);
-        return capi_oom("a mesh");
+        sdfccd__free(m, sizeof *m);
+        sdfccd__free(block, vbytes + ibytes);
+        return sdfccd__oom("a mesh");
     }
     scc_vec3* v = block;
     uint32_t* idx = (uint32_t*)((char*)block + vbytes);
@@ -347,38 +347,38 @@ sdfccd_Status capi_mesh_create(const double* vertices, uint32_t vertex_count, co
     m->mesh.bounds = box;
     m->dropped_triangles = triangle_count - kept;
     m->refs = 1;
-    m->bsh = scc_bsh_build(&m->mesh, capi_allocator()); /* broad phase of the mesh query */
+    m->bsh = scc_bsh_build(&m->mesh, sdfccd__allocator()); /* broad phase of the mesh query */
     if (!m->bsh) {
-        capi_free(block, m->block_size);
-        capi_free(m, sizeof *m);
-        return capi_oom("a mesh's bounding-sphere hierarchy");
+        sdfccd__free(block, m->block_size);
+        sdfccd__free(m, sizeof *m);
+        return sdfccd__oom("a mesh's bounding-sphere hierarchy");
     }
     m->mesh.bsh = m->bsh;
     sdfccd_MeshId id = { 0, 0 };
     if (!registry_add(m, KIND_MESH, &id.index1, &id.generation)) {
-        scc_bsh_destroy(m->bsh, capi_allocator());
-        capi_free(block, m->block_size);
-        capi_free(m, sizeof *m);
-        return capi_oom("a mesh handle");
+        scc_bsh_destroy(m->bsh, sdfccd__allocator());
+        sdfccd__free(block, m->block_size);
+        sdfccd__free(m, sizeof *m);
+        return sdfccd__oom("a mesh handle");
     }
     *out_mesh = id;
     return SDFCCD_OK;
 }
 
-capi_mesh* capi_mesh_lookup(sdfccd_MeshId id)
+sdfccd__mesh* sdfccd__mesh_lookup(sdfccd_MeshId id)
 {
-    capi_mesh* m = registry_get(id.index1, id.generation, KIND_MESH);
-    if (!m) capi_error(SDFCCD_INVALID_HANDLE, "mesh handle {%u, %u} is not a live mesh", id.index1, id.generation);
+    sdfccd__mesh* m = registry_get(id.index1, id.generation, KIND_MESH);
+    if (!m) sdfccd__error(SDFCCD_INVALID_HANDLE, "mesh handle {%u, %u} is not a live mesh", id.index1, id.generation);
     return m;
 }
 
 sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId id)
 {
-    capi_mesh* m = registry_remove(id.index1, id.generation, KIND_MESH);
-    if (!m) return capi_error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_mesh: handle {%u, %u} is not a live mesh", id.index1, id.generation);
-    scc_bsh_destroy(m->bsh, capi_allocator());
-    capi_free(m->block, m->block_size);
-    capi_free(m, sizeof *m);
+    sdfccd__mesh* m = registry_remove(id.index1, id.generation, KIND_MESH);
+    if (!m) return sdfccd__error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_mesh: handle {%u, %u} is not a live mesh", id.index1, id.generation);
+    scc_bsh_destroy(m->bsh, sdfccd__allocator());
+    sdfccd__free(m->block, m->block_size);
+    sdfccd__free(m, sizeof *m);
     return SDFCCD_OK;
 }
 
@@ -393,31 +393,31 @@ sdfccd_MeshDef sdfccd_default_mesh_def(void)
 sdfccd_Status sdfccd_create_mesh(const sdfccd_MeshDef* def, sdfccd_MeshId* out_mesh)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(def, "sdfccd_create_mesh: def")) || (st = capi_check_ptr(out_mesh, "sdfccd_create_mesh: out_mesh")))
+    if ((st = sdfccd__check_ptr(def, "sdfccd_create_mesh: def")) || (st = sdfccd__check_ptr(out_mesh, "sdfccd_create_mesh: out_mesh")))
         return st;
     if (def->internal_value != 0x5DFCCD01)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_mesh: def was not initialised with sdfccd_default_mesh_def()");
-    return capi_mesh_create(def->vertices, def->vertex_count, def->indices, def->triangle_count,
-                            def->drop_degenerate, "sdfccd_create_mesh", out_mesh);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_mesh: def was not initialised with sdfccd_default_mesh_def()");
+    return sdfccd__mesh_create(def->vertices, def->vertex_count, def->indices, def->triangle_count,
+                               def->drop_degenerate, "sdfccd_create_mesh", out_mesh);
 }
 
 sdfccd_Status sdfccd_mesh_get_info(sdfccd_MeshId id, sdfccd_MeshInfo* out_info)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_info, "sdfccd_mesh_get_info: out_info"))) return st;
-    capi_mesh* m = capi_mesh_lookup(id);
+    if ((st = sdfccd__check_ptr(out_info, "sdfccd_mesh_get_info: out_info"))) return st;
+    sdfccd__mesh* m = sdfccd__mesh_lookup(id);
     if (!m) return SDFCCD_INVALID_HANDLE;
     out_info->vertex_count = m->mesh.vertex_count;
     out_info->triangle_count = m->mesh.triangle_count;
     out_info->dropped_triangles = m->dropped_triangles;
-    out_info->bounds = capi_pbox(m->mesh.bounds);
+    out_info->bounds = sdfccd__pbox(m->mesh.bounds);
     out_info->memory_bytes = (int64_t)(m->block_size + sizeof *m + (m->bsh ? m->bsh->bytes : 0));
     return SDFCCD_OK;
 }
 
 sdfccd_Status sdfccd_mesh_get_data(sdfccd_MeshId id, double* out_vertices, uint32_t* out_indices)
 {
-    capi_mesh* m = capi_mesh_lookup(id);
+    sdfccd__mesh* m = sdfccd__mesh_lookup(id);
     if (!m) return SDFCCD_INVALID_HANDLE;
     if (out_vertices)
         for (uint32_t i = 0; i < m->mesh.vertex_count; ++i) {

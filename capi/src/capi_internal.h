@@ -1,6 +1,10 @@
 /* SPDX-License-Identifier: MIT
  * sdfccd C ABI internals: the allocator, error messages and the handle registry.
- * Only files under capi/src include this. */
+ * Only files under capi/src (and tests that say so in their CMake) include this.
+ *
+ * Names: the public API is sdfccd_* / SDFCCD_*; what the ABI layer shares between its own files
+ * is sdfccd__* (two underscores: internal, never in an installed header; hidden in the shared
+ * library); the core is scc_* (core/). So every symbol of libsdfccd starts with sdfccd_ or scc_. */
 #ifndef SDFCCD_CAPI_INTERNAL_H
 #define SDFCCD_CAPI_INTERNAL_H
 
@@ -11,55 +15,55 @@
 #include "../../core/sdf.h"
 
 /* ---- allocation (counted; routed to the user's hooks) ---- */
-void* capi_alloc(size_t size);          /* NULL on failure (no message set) */
-void* capi_calloc(size_t size);         /* zeroed */
-void capi_free(void* p, size_t size);
-const scc_allocator* capi_allocator(void); /* what to hand to core routines */
+void* sdfccd__alloc(size_t size);          /* NULL on failure (no message set) */
+void* sdfccd__calloc(size_t size);         /* zeroed */
+void sdfccd__free(void* p, size_t size);
+const scc_allocator* sdfccd__allocator(void); /* what to hand to core routines */
 
 /* ---- errors: set the thread's message and return `status` ---- */
-sdfccd_Status capi_error(sdfccd_Status status, const char* fmt, ...)
+sdfccd_Status sdfccd__error(sdfccd_Status status, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
-sdfccd_Status capi_oom(const char* what);
+sdfccd_Status sdfccd__oom(const char* what);
 /* Validation helpers: return SDFCCD_OK or an INVALID_ARGUMENT status with a message naming `what`. */
-sdfccd_Status capi_check_ptr(const void* p, const char* what);
-sdfccd_Status capi_check_finite(double v, const char* what);
-sdfccd_Status capi_check_vec(sdfccd_Vec3 v, const char* what);
-sdfccd_Status capi_check_pose(sdfccd_Pose pose, const char* what, scc_xform* out); /* validated, normalised */
+sdfccd_Status sdfccd__check_ptr(const void* p, const char* what);
+sdfccd_Status sdfccd__check_finite(double v, const char* what);
+sdfccd_Status sdfccd__check_vec(sdfccd_Vec3 v, const char* what);
+sdfccd_Status sdfccd__check_pose(sdfccd_Pose pose, const char* what, scc_xform* out); /* validated, normalised */
 
-static inline scc_vec3 capi_v(sdfccd_Vec3 v) { scc_vec3 r = { v.x, v.y, v.z }; return r; }
-static inline sdfccd_Vec3 capi_pv(scc_vec3 v) { sdfccd_Vec3 r = { v.x, v.y, v.z }; return r; }
-static inline scc_aabb capi_box(sdfccd_Aabb b) { scc_aabb r = { capi_v(b.lo), capi_v(b.hi) }; return r; }
-static inline sdfccd_Aabb capi_pbox(scc_aabb b) { sdfccd_Aabb r = { capi_pv(b.lo), capi_pv(b.hi) }; return r; }
+static inline scc_vec3 sdfccd__v(sdfccd_Vec3 v) { scc_vec3 r = { v.x, v.y, v.z }; return r; }
+static inline sdfccd_Vec3 sdfccd__pv(scc_vec3 v) { sdfccd_Vec3 r = { v.x, v.y, v.z }; return r; }
+static inline scc_aabb sdfccd__box(sdfccd_Aabb b) { scc_aabb r = { sdfccd__v(b.lo), sdfccd__v(b.hi) }; return r; }
+static inline sdfccd_Aabb sdfccd__pbox(scc_aabb b) { sdfccd_Aabb r = { sdfccd__pv(b.lo), sdfccd__pv(b.hi) }; return r; }
 
 /* ---- SDF objects ----
- * A capi_sdf owns one block `storage` (the concrete core SDF, which embeds scc_sdf first),
+ * A sdfccd__sdf owns one block `storage` (the concrete core SDF, which embeds scc_sdf first),
  * optional extra memory freed by `release_extra`, and references to up to two children. */
-typedef struct capi_sdf {
+typedef struct sdfccd__sdf {
     const scc_sdf* sdf;              /* == storage for built-in kinds */
     void* storage;
     size_t storage_size;
-    void (*release_extra)(struct capi_sdf* self); /* may be NULL */
+    void (*release_extra)(struct sdfccd__sdf* self); /* may be NULL */
     void* extra;                     /* free for release_extra's use */
-    struct capi_sdf* children[2];
+    struct sdfccd__sdf* children[2];
     int64_t memory_bytes;            /* storage + extra, reported by sdfccd_sdf_get_info */
     uint32_t refs;
-} capi_sdf;
+} sdfccd__sdf;
 
 /* Allocates a wrapper with `storage_size` zeroed bytes of storage; sdf = storage. NULL on OOM. */
-capi_sdf* capi_sdf_new(size_t storage_size);
+sdfccd__sdf* sdfccd__sdf_new(size_t storage_size);
 /* Drops one reference; frees storage, extra (via release_extra) and child references at zero. */
-void capi_sdf_release(capi_sdf* s);
-void capi_sdf_retain(capi_sdf* s); /* adds a reference (for combinations that use a child) */
+void sdfccd__sdf_release(sdfccd__sdf* s);
+void sdfccd__sdf_retain(sdfccd__sdf* s); /* adds a reference (for combinations that use a child) */
 /* Registers a new object (takes over its one reference). On failure the object is released. */
-sdfccd_Status capi_sdf_register(capi_sdf* s, sdfccd_SdfId* out_id);
+sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id);
 /* Looks up a live handle; NULL (with an INVALID_HANDLE message set) when unknown. */
-capi_sdf* capi_sdf_lookup(sdfccd_SdfId id);
+sdfccd__sdf* sdfccd__sdf_lookup(sdfccd_SdfId id);
 
 /* ---- mesh objects ---- */
-typedef struct capi_mesh {
+typedef struct sdfccd__mesh {
     scc_mesh mesh;                   /* arrays point into `block` */
     void* block;
     size_t block_size;
@@ -67,18 +71,18 @@ typedef struct capi_mesh {
     uint32_t refs;
     struct scc_bsh* bsh;             /* broad-phase sphere hierarchy (core/bsh.h), built at creation and
                                         owned; mesh.bsh points to it (memory counted by the allocator) */
-} capi_mesh;
+} sdfccd__mesh;
 
 /* Creates a mesh object from arrays (validated). `what` names the source in messages. */
-sdfccd_Status capi_mesh_create(const double* vertices, uint32_t vertex_count, const uint32_t* indices,
-                               uint32_t triangle_count, int drop_degenerate, const char* what,
+sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count, const uint32_t* indices,
+                                  uint32_t triangle_count, int drop_degenerate, const char* what,
                                sdfccd_MeshId* out_mesh);
-capi_mesh* capi_mesh_lookup(sdfccd_MeshId id);
+sdfccd__mesh* sdfccd__mesh_lookup(sdfccd_MeshId id);
 
 /* Validates public query params and converts them to the core's (the only place this is done;
  * internal tools that call the core directly use it too). Declared with an incomplete type so
  * this header does not pull in core/ccd.h. */
 struct scc_params;
-sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, struct scc_params* out);
+sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* fn, struct scc_params* out);
 
 #endif

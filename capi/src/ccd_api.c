@@ -43,15 +43,15 @@ sdfccd_RigidMotion sdfccd_default_rigid_motion(void)
     return m;
 }
 
-sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, scc_params* out)
+sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* fn, scc_params* out)
 {
-    if (!in) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
+    if (!in) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
     if (in->internal_value != DEF_COOKIE)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params were not initialised with sdfccd_default_query_params()", fn);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params were not initialised with sdfccd_default_query_params()", fn);
     if ((int)in->method < 0 || in->method >= SDFCCD_METHOD_COUNT)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: unknown method %d", fn, (int)in->method);
-#define POS(f) if (!isfinite(in->f) || !(in->f > 0.0)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->" #f " must be finite and > 0 (got %g)", fn, in->f)
-#define NONNEG(f) if (!isfinite(in->f) || in->f < 0.0) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->" #f " must be finite and >= 0 (got %g)", fn, in->f)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: unknown method %d", fn, (int)in->method);
+#define POS(f) if (!isfinite(in->f) || !(in->f > 0.0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->" #f " must be finite and > 0 (got %g)", fn, in->f)
+#define NONNEG(f) if (!isfinite(in->f) || in->f < 0.0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->" #f " must be finite and >= 0 (got %g)", fn, in->f)
     POS(time_tolerance);
     POS(distance_tolerance);
     POS(max_rotation_per_segment);
@@ -61,15 +61,15 @@ sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, 
     NONNEG(toi_window);
 #undef POS
 #undef NONNEG
-    if (!isfinite(in->margin)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->margin is not finite", fn);
+    if (!isfinite(in->margin)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->margin is not finite", fn);
     if (in->max_iterations < 1 || in->max_line_search_iterations < 1 || in->certified_max_regions < 1)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: iteration caps must be >= 1", fn);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: iteration caps must be >= 1", fn);
     if (in->max_line_search_iterations > 4096)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->max_line_search_iterations must be <= 4096 (got %d)", fn,
-                          in->max_line_search_iterations);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->max_line_search_iterations must be <= 4096 (got %d)", fn,
+                             in->max_line_search_iterations);
     if (in->max_sdf_evaluations < 1)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->max_sdf_evaluations must be >= 1 (got %lld)", fn,
-                          (long long)in->max_sdf_evaluations);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->max_sdf_evaluations must be >= 1 (got %lld)", fn,
+                             (long long)in->max_sdf_evaluations);
     out->method = in->method == SDFCCD_METHOD_FWGSS ? SCC_METHOD_FWGSS
                 : in->method == SDFCCD_METHOD_FW ? SCC_METHOD_FW
                 : in->method == SDFCCD_METHOD_DCD ? SCC_METHOD_DCD : SCC_METHOD_CERTIFIED;
@@ -79,15 +79,15 @@ sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, 
     out->max_iter = in->max_iterations;
     out->max_ls_iter = in->max_line_search_iterations;
     if (in->fwgss_restarts < 0 || in->fwgss_restarts > 2)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_restarts must be 0, 1 or 2 (got %d)", fn, in->fwgss_restarts);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_restarts must be 0, 1 or 2 (got %d)", fn, in->fwgss_restarts);
     out->fwgss_restarts = in->fwgss_restarts;
     if (in->fwgss_vertex_trace < 0)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_vertex_trace must be >= 0 (got %d)", fn, in->fwgss_vertex_trace);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_vertex_trace must be >= 0 (got %d)", fn, in->fwgss_vertex_trace);
     out->fwgss_vertex_trace = in->fwgss_vertex_trace;
     out->subdivision = in->subdivision != 0;
     out->sub_min_area = in->subdivision_min_area;
     if (in->subdivision_max_depth < 1 || in->subdivision_max_depth > 32)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: params->subdivision_max_depth must be in [1, 32] (got %d)", fn, in->subdivision_max_depth);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->subdivision_max_depth must be in [1, 32] (got %d)", fn, in->subdivision_max_depth);
     out->sub_max_depth = in->subdivision_max_depth;
     out->contact_slop = in->contact_slop;
     out->toi_window = in->toi_window;
@@ -103,11 +103,11 @@ sdfccd_Status capi_convert_params(const sdfccd_QueryParams* in, const char* fn, 
 static sdfccd_Status check_magnitude(sdfccd_Vec3 v, const char* what)
 {
     sdfccd_Status st;
-    if ((st = capi_check_vec(v, what))) return st;
+    if ((st = sdfccd__check_vec(v, what))) return st;
     double m = fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
     if (m > SDFCCD_MAX_QUERY_MAGNITUDE)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s has a coordinate of magnitude %g, above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
-                          what, m, SDFCCD_MAX_QUERY_MAGNITUDE);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s has a coordinate of magnitude %g, above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
+                             what, m, SDFCCD_MAX_QUERY_MAGNITUDE);
     return SDFCCD_OK;
 }
 
@@ -115,25 +115,25 @@ static sdfccd_Status convert_motion(const sdfccd_RigidMotion* in, double t0, dou
 {
     sdfccd_Status st;
     scc_xform xf;
-    if ((st = capi_check_pose(in->pose, what, &xf))) return st;
+    if ((st = sdfccd__check_pose(in->pose, what, &xf))) return st;
     if ((st = check_magnitude(in->pose.position, what)) || (st = check_magnitude(in->local_center, what)) ||
         (st = check_magnitude(in->linear_velocity, what)) || (st = check_magnitude(in->angular_velocity, what)))
         return st;
     /* Lengths of vectors within the magnitude limit do not overflow; t1 - t0 is finite (check_interval). */
     double dt = t1 - t0;
-    double shift = scc_len(capi_v(in->linear_velocity)) * dt;
+    double shift = scc_len(sdfccd__v(in->linear_velocity)) * dt;
     if (!(shift <= SDFCCD_MAX_QUERY_MAGNITUDE))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the displacement |v| (t1 - t0) = %g is above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
-                          what, shift, SDFCCD_MAX_QUERY_MAGNITUDE);
-    double angle = scc_len(capi_v(in->angular_velocity)) * dt;
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the displacement |v| (t1 - t0) = %g is above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
+                             what, shift, SDFCCD_MAX_QUERY_MAGNITUDE);
+    double angle = scc_len(sdfccd__v(in->angular_velocity)) * dt;
     if (!(angle <= SDFCCD_MAX_ROTATION_ANGLE))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the rotation |w| (t1 - t0) = %g rad is above SDFCCD_MAX_ROTATION_ANGLE (%g rad), "
-                          "beyond which the motion model is not accurate", what, angle, SDFCCD_MAX_ROTATION_ANGLE);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the rotation |w| (t1 - t0) = %g rad is above SDFCCD_MAX_ROTATION_ANGLE (%g rad), "
+                             "beyond which the motion model is not accurate", what, angle, SDFCCD_MAX_ROTATION_ANGLE);
     out->p0 = xf.p;
     out->q0 = xf.q;
-    out->c_local = capi_v(in->local_center);
-    out->v = capi_v(in->linear_velocity);
-    out->w = capi_v(in->angular_velocity);
+    out->c_local = sdfccd__v(in->local_center);
+    out->v = sdfccd__v(in->linear_velocity);
+    out->w = sdfccd__v(in->angular_velocity);
     out->t0 = t0;
     return SDFCCD_OK;
 }
@@ -143,33 +143,33 @@ static sdfccd_Status check_total_rotation(const scc_rigid* body, const scc_rigid
 {
     double angle = (scc_len(body->w) + (sdf ? scc_len(sdf->w) : 0.0)) * dt;
     if (!(angle <= SDFCCD_MAX_ROTATION_ANGLE))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the relative rotation over the interval (%g rad) is above "
-                          "SDFCCD_MAX_ROTATION_ANGLE (%g rad), beyond which the motion model is not accurate",
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the relative rotation over the interval (%g rad) is above "
+                             "SDFCCD_MAX_ROTATION_ANGLE (%g rad), beyond which the motion model is not accurate",
                           fn, angle, SDFCCD_MAX_ROTATION_ANGLE);
     return SDFCCD_OK;
 }
 
-static sdfccd_Status check_mesh_bounds(const capi_mesh* m, const char* fn)
+static sdfccd_Status check_mesh_bounds(const sdfccd__mesh* m, const char* fn)
 {
     double b = fmax(scc_maxc(scc_vabs(m->mesh.bounds.lo)), scc_maxc(scc_vabs(m->mesh.bounds.hi)));
     if (!(b <= SDFCCD_MAX_QUERY_MAGNITUDE))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the mesh has a vertex coordinate of magnitude %g, above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
-                          fn, b, SDFCCD_MAX_QUERY_MAGNITUDE);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the mesh has a vertex coordinate of magnitude %g, above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
+                             fn, b, SDFCCD_MAX_QUERY_MAGNITUDE);
     return SDFCCD_OK;
 }
 
 static sdfccd_Status check_interval(double t0, double t1, const char* fn)
 {
-    if (!isfinite(t0) || !isfinite(t1)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: t0 and t1 must be finite (got %g, %g)", fn, t0, t1);
-    if (t1 < t0) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: t1 (%g) < t0 (%g)", fn, t1, t0);
-    if (!isfinite(t1 - t0)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: t1 - t0 overflows (t0 = %g, t1 = %g)", fn, t0, t1);
+    if (!isfinite(t0) || !isfinite(t1)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: t0 and t1 must be finite (got %g, %g)", fn, t0, t1);
+    if (t1 < t0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: t1 (%g) < t0 (%g)", fn, t1, t0);
+    if (!isfinite(t1 - t0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: t1 - t0 overflows (t0 = %g, t1 = %g)", fn, t0, t1);
     return SDFCCD_OK;
 }
 
 /* Common prologue: out_result, params, interval, SDF handle and SDF motion. */
 typedef struct query_setup {
     scc_params p;
-    capi_sdf* sdf;
+    sdfccd__sdf* sdf;
     scc_rigid sdf_motion;
     const scc_rigid* sdf_motion_ptr;
 } query_setup;
@@ -181,17 +181,17 @@ static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motio
     sdfccd_Status st;
     char what[96];
     snprintf(what, sizeof what, "%s: out_result", fn);
-    if ((st = capi_check_ptr(out_result, what))) return st;
+    if ((st = sdfccd__check_ptr(out_result, what))) return st;
     if (capacity < 0 || (capacity > 0 && !out_contacts))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: out_contacts is NULL or capacity (%d) < 0", fn, capacity);
-    if ((st = capi_convert_params(params, fn, &q->p)) || (st = check_interval(t0, t1, fn))) return st;
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_contacts is NULL or capacity (%d) < 0", fn, capacity);
+    if ((st = sdfccd__convert_params(params, fn, &q->p)) || (st = check_interval(t0, t1, fn))) return st;
     q->sdf_motion_ptr = NULL;
     if (sdf_motion) {
         snprintf(what, sizeof what, "%s: sdf_motion", fn);
         if ((st = convert_motion(sdf_motion, t0, t1, what, &q->sdf_motion))) return st;
         q->sdf_motion_ptr = &q->sdf_motion;
     }
-    q->sdf = capi_sdf_lookup(sdf);
+    q->sdf = sdfccd__sdf_lookup(sdf);
     if (!q->sdf) return SDFCCD_INVALID_HANDLE;
     return SDFCCD_OK;
 }
@@ -222,8 +222,8 @@ static void write_result(const query_setup* q, double t0, double t1, const scc_q
     r->triangles_tested = s->triangles_tested;
     for (int32_t i = 0; i < r->contact_count; ++i) {
         sdfccd_Contact* o = &out[i];
-        o->point = capi_pv(scc_world_point(q->sdf_motion_ptr, c[i].toi, c[i].point));
-        o->normal = capi_pv(scc_normalize_or(scc_world_vector(q->sdf_motion_ptr, c[i].toi, c[i].normal), scc_v3(0, 0, 1)));
+        o->point = sdfccd__pv(scc_world_point(q->sdf_motion_ptr, c[i].toi, c[i].point));
+        o->normal = sdfccd__pv(scc_normalize_or(scc_world_vector(q->sdf_motion_ptr, c[i].toi, c[i].normal), scc_v3(0, 0, 1)));
         o->distance = c[i].distance;
         o->gap_t0 = c[i].gap_t0;
         o->toi = c[i].toi;
@@ -244,8 +244,8 @@ static sdfccd_Status run_triangle(const query_setup* q, const scc_tri_motion* m,
 {
     scc_contact c[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     scc_query_summary s;
-    if (!scc_query_triangle(q->sdf->sdf, m, t0, t1, &q->p, capi_allocator(), 0, c, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s))
-        return capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory in the certified search", fn);
+    if (!scc_query_triangle(q->sdf->sdf, m, t0, t1, &q->p, sdfccd__allocator(), 0, c, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s))
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory in the certified search", fn);
     write_result(q, t0, t1, &s, c, out_contacts, capacity, out_result);
     return SDFCCD_OK;
 }
@@ -258,16 +258,16 @@ sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* 
     query_setup q;
     sdfccd_Status st;
     if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
-    if ((st = capi_check_ptr(triangle, "sdfccd_query_triangle: triangle")) || (st = capi_check_ptr(motion, "sdfccd_query_triangle: motion")))
+    if ((st = sdfccd__check_ptr(triangle, "sdfccd_query_triangle: triangle")) || (st = sdfccd__check_ptr(motion, "sdfccd_query_triangle: motion")))
         return st;
     scc_rigid body;
     scc_tri_motion m;
     memset(&m, 0, sizeof m);
     for (int i = 0; i < 3; ++i) {
         if ((st = check_magnitude(triangle[i], "sdfccd_query_triangle: triangle vertex"))) return st;
-        m.local[i] = capi_v(triangle[i]);
+        m.local[i] = sdfccd__v(triangle[i]);
     }
-    if (degenerate(m.local)) return capi_error(SDFCCD_DEGENERATE, "%s: the triangle has zero area", fn);
+    if (degenerate(m.local)) return sdfccd__error(SDFCCD_DEGENERATE, "%s: the triangle has zero area", fn);
     if ((st = convert_motion(motion, t0, t1, "sdfccd_query_triangle: motion", &body))) return st;
     if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
     m.kind = SCC_TRI_RIGID;
@@ -286,7 +286,7 @@ sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
     query_setup q;
     sdfccd_Status st;
     if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
-    if ((st = capi_check_ptr(start, "sdfccd_query_triangle_linear: start")) || (st = capi_check_ptr(end, "sdfccd_query_triangle_linear: end")))
+    if ((st = sdfccd__check_ptr(start, "sdfccd_query_triangle_linear: start")) || (st = sdfccd__check_ptr(end, "sdfccd_query_triangle_linear: end")))
         return st;
     scc_tri_motion m;
     memset(&m, 0, sizeof m);
@@ -294,10 +294,10 @@ sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
         if ((st = check_magnitude(start[i], "sdfccd_query_triangle_linear: start vertex")) ||
             (st = check_magnitude(end[i], "sdfccd_query_triangle_linear: end vertex")))
             return st;
-        m.start[i] = capi_v(start[i]);
-        m.end[i] = capi_v(end[i]);
+        m.start[i] = sdfccd__v(start[i]);
+        m.end[i] = sdfccd__v(end[i]);
     }
-    if (degenerate(m.start)) return capi_error(SDFCCD_DEGENERATE, "%s: the triangle has zero area at t0", fn);
+    if (degenerate(m.start)) return sdfccd__error(SDFCCD_DEGENERATE, "%s: the triangle has zero area at t0", fn);
     m.kind = SCC_TRI_LINEAR;
     m.sdf = q.sdf_motion_ptr;
     m.t0 = t0;
@@ -310,13 +310,13 @@ static sdfccd_Status run_mesh(const query_setup* q, const scc_mesh_motion* mm, s
 {
     const int32_t kCap = 1024;
     int32_t cap = capacity < kCap ? kCap : capacity;
-    scc_contact* c = capi_alloc((size_t)cap * sizeof *c);
-    if (!c) return capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    scc_contact* c = sdfccd__alloc((size_t)cap * sizeof *c);
+    if (!c) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
     scc_query_summary s;
-    int ok = scc_query_mesh(q->sdf->sdf, mm, &q->p, capi_allocator(), c, cap, &s);
+    int ok = scc_query_mesh(q->sdf->sdf, mm, &q->p, sdfccd__allocator(), c, cap, &s);
     if (ok) write_result(q, mm->t0, mm->t1, &s, c, out_contacts, capacity, out_result);
-    capi_free(c, (size_t)cap * sizeof *c);
-    return ok ? SDFCCD_OK : capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    sdfccd__free(c, (size_t)cap * sizeof *c);
+    return ok ? SDFCCD_OK : sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
 }
 
 sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
@@ -327,11 +327,11 @@ sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_
     query_setup q;
     sdfccd_Status st;
     if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
-    if ((st = capi_check_ptr(motion, "sdfccd_query_mesh: motion"))) return st;
+    if ((st = sdfccd__check_ptr(motion, "sdfccd_query_mesh: motion"))) return st;
     scc_rigid body;
     if ((st = convert_motion(motion, t0, t1, "sdfccd_query_mesh: motion", &body))) return st;
     if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
-    capi_mesh* m = capi_mesh_lookup(mesh);
+    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     if ((st = check_mesh_bounds(m, fn))) return st;
     scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1 };
@@ -347,23 +347,23 @@ sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotio
     query_setup q;
     sdfccd_Status st;
     if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
-    if ((st = capi_check_ptr(start, "sdfccd_query_mesh_linear: start")) || (st = capi_check_ptr(end, "sdfccd_query_mesh_linear: end")))
+    if ((st = sdfccd__check_ptr(start, "sdfccd_query_mesh_linear: start")) || (st = sdfccd__check_ptr(end, "sdfccd_query_mesh_linear: end")))
         return st;
-    capi_mesh* m = capi_mesh_lookup(mesh);
+    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     uint32_t nv = m->mesh.vertex_count;
     for (uint32_t i = 0; i < 3 * nv; ++i)
         if (!(fabs(start[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE) || !(fabs(end[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE))
-            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i / 3);
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i / 3);
     size_t bytes = 2 * (size_t)nv * sizeof(scc_vec3);
-    scc_vec3* v = capi_alloc(bytes);
-    if (!v) return capi_error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    scc_vec3* v = sdfccd__alloc(bytes);
+    if (!v) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
     for (uint32_t i = 0; i < nv; ++i) {
         v[i] = scc_v3(start[3 * i], start[3 * i + 1], start[3 * i + 2]);
         v[nv + i] = scc_v3(end[3 * i], end[3 * i + 1], end[3 * i + 2]);
     }
     scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1 };
     st = run_mesh(&q, &mm, out_contacts, capacity, out_result, fn);
-    capi_free(v, bytes);
+    sdfccd__free(v, bytes);
     return st;
 }

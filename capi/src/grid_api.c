@@ -14,34 +14,34 @@
 
 /* ---------------- handles ---------------- */
 
-static void grid_release(capi_sdf* s)
+static void grid_release(sdfccd__sdf* s)
 {
     scc_grid_destroy((scc_grid*)s->extra);
     s->extra = NULL;
 }
 
-sdfccd_Status capi_grid_register(scc_grid* g, sdfccd_SdfId* out_sdf)
+sdfccd_Status sdfccd__grid_register(scc_grid* g, sdfccd_SdfId* out_sdf)
 {
-    capi_sdf* s = capi_sdf_new(sizeof(scc_grid*));
+    sdfccd__sdf* s = sdfccd__sdf_new(sizeof(scc_grid*));
     if (!s) {
         scc_grid_destroy(g);
-        return capi_oom("a grid SDF handle");
+        return sdfccd__oom("a grid SDF handle");
     }
     *(scc_grid**)s->storage = g;
     s->sdf = &g->base;
     s->extra = g;
     s->release_extra = grid_release;
     s->memory_bytes = (int64_t)(s->storage_size + scc_grid_memory(g));
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
-sdfccd_Status capi_grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid)
+sdfccd_Status sdfccd__grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid)
 {
     *out_grid = NULL;
-    capi_sdf* s = capi_sdf_lookup(id);
-    if (!s) return capi_error(SDFCCD_INVALID_HANDLE, "%s: SDF handle {%u, %u} is not a live SDF", fn, id.index1, id.generation);
+    sdfccd__sdf* s = sdfccd__sdf_lookup(id);
+    if (!s) return sdfccd__error(SDFCCD_INVALID_HANDLE, "%s: SDF handle {%u, %u} is not a live SDF", fn, id.index1, id.generation);
     if (s->release_extra != grid_release)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: SDF handle {%u, %u} is not a grid", fn, id.index1, id.generation);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: SDF handle {%u, %u} is not a grid", fn, id.index1, id.generation);
     *out_grid = (scc_grid*)s->extra;
     return SDFCCD_OK;
 }
@@ -72,7 +72,7 @@ static void* pool_thread(void* arg)
     return NULL;
 }
 
-void capi_pool_init(capi_pool* p, int threads, sdfccd_ProgressFcn* progress, void* user)
+void sdfccd__pool_init(sdfccd__pool* p, int threads, sdfccd_ProgressFcn* progress, void* user)
 {
     memset(p, 0, sizeof *p);
     if (threads <= 0) {
@@ -91,7 +91,7 @@ void capi_pool_init(capi_pool* p, int threads, sdfccd_ProgressFcn* progress, voi
     p->last_reported = -1.0;
 }
 
-static void pool_report(capi_pool* p, double f)
+static void pool_report(sdfccd__pool* p, double f)
 {
     if (!p->progress || f < p->last_reported) return;
     if (f < 1.0 && f - p->last_reported < 0.005) return;
@@ -99,9 +99,9 @@ static void pool_report(capi_pool* p, double f)
     p->progress(f, p->progress_user);
 }
 
-int capi_pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx)
+int sdfccd__pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx)
 {
-    capi_pool* p = user;
+    sdfccd__pool* p = user;
     const int st = stage >= 0 && stage < 4 ? stage : 0;
     pool_run r;
     r.task = task;
@@ -146,27 +146,27 @@ sdfccd_GridDef sdfccd_default_grid_def(void)
 
 static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
 {
-    if (!def) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: def is NULL", fn);
+    if (!def) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: def is NULL", fn);
     if (def->internal_value != GRID_DEF_MAGIC)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: def was not initialised with sdfccd_default_grid_def()", fn);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: def was not initialised with sdfccd_default_grid_def()", fn);
     for (int i = 0; i < 3; ++i)
         if (def->resolution[i] < 1)
-            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: resolution[%d] = %d must be >= 1", fn, i, def->resolution[i]);
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: resolution[%d] = %d must be >= 1", fn, i, def->resolution[i]);
     const uint64_t n = (uint64_t)def->resolution[0] * (uint64_t)def->resolution[1] * (uint64_t)def->resolution[2];
     if (n > 0x7FFFFFFEull || scc_grid_dense_node_count((const uint32_t[3]){ (uint32_t)def->resolution[0], (uint32_t)def->resolution[1], (uint32_t)def->resolution[2] }) >= 0xFFFFFFFFull)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: resolution %d x %d x %d needs more than 2^32 nodes", fn,
-                          def->resolution[0], def->resolution[1], def->resolution[2]);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: resolution %d x %d x %d needs more than 2^32 nodes", fn,
+                             def->resolution[0], def->resolution[1], def->resolution[2]);
     if (!def->fit_domain) {
         sdfccd_Status st;
-        if ((st = capi_check_vec(def->domain.lo, "domain.lo")) || (st = capi_check_vec(def->domain.hi, "domain.hi"))) return st;
+        if ((st = sdfccd__check_vec(def->domain.lo, "domain.lo")) || (st = sdfccd__check_vec(def->domain.hi, "domain.hi"))) return st;
         if (!(def->domain.lo.x < def->domain.hi.x && def->domain.lo.y < def->domain.hi.y && def->domain.lo.z < def->domain.hi.z))
-            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: domain.lo must be below domain.hi on every axis", fn);
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: domain.lo must be below domain.hi on every axis", fn);
     }
     if (!(def->padding >= 0.0) || !isfinite(def->padding))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: padding = %g must be finite and >= 0", fn, def->padding);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: padding = %g must be finite and >= 0", fn, def->padding);
     if (!(def->band >= 0.0) || isnan(def->band))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: band = %g must be >= 0 (0 = dense)", fn, def->band);
-    if (def->threads < 0) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: threads = %d must be >= 0", fn, def->threads);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: band = %g must be >= 0 (0 = dense)", fn, def->band);
+    if (def->threads < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: threads = %d must be >= 0", fn, def->threads);
     return SDFCCD_OK;
 }
 
@@ -174,13 +174,13 @@ static sdfccd_Status build_status(scc_grid_build_status st, const char* fn)
 {
     switch (st) {
     case SCC_GRID_BUILD_OK: return SDFCCD_OK;
-    case SCC_GRID_BUILD_OUT_OF_MEMORY: return capi_oom("a grid");
-    case SCC_GRID_BUILD_TOO_LARGE: return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the grid needs more than 2^32 nodes", fn);
-    case SCC_GRID_BUILD_EMPTY_BAND: return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the band culled every cell (no surface inside the domain?)", fn);
-    case SCC_GRID_BUILD_BAD_VALUE: return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the source returned a non-finite value at a node", fn);
-    case SCC_GRID_BUILD_CANCELLED: return capi_error(SDFCCD_BAD_STATE, "%s: cancelled", fn);
+    case SCC_GRID_BUILD_OUT_OF_MEMORY: return sdfccd__oom("a grid");
+    case SCC_GRID_BUILD_TOO_LARGE: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the grid needs more than 2^32 nodes", fn);
+    case SCC_GRID_BUILD_EMPTY_BAND: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the band culled every cell (no surface inside the domain?)", fn);
+    case SCC_GRID_BUILD_BAD_VALUE: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the source returned a non-finite value at a node", fn);
+    case SCC_GRID_BUILD_CANCELLED: return sdfccd__error(SDFCCD_BAD_STATE, "%s: cancelled", fn);
     }
-    return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: unknown build failure", fn);
+    return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: unknown build failure", fn);
 }
 
 static scc_aabb padded(scc_aabb b, double pad)
@@ -192,14 +192,14 @@ static scc_aabb padded(scc_aabb b, double pad)
     return b;
 }
 
-static void fill_build_def(scc_grid_build_def* bd, const sdfccd_GridDef* def, scc_aabb domain, capi_pool* pool)
+static void fill_build_def(scc_grid_build_def* bd, const sdfccd_GridDef* def, scc_aabb domain, sdfccd__pool* pool)
 {
     memset(bd, 0, sizeof *bd);
     bd->lo = domain.lo;
     bd->hi = domain.hi;
     for (int i = 0; i < 3; ++i) bd->res[i] = (uint32_t)def->resolution[i];
     bd->band = def->band > 0.0 ? def->band : 0.0;
-    bd->parallel_for = capi_pool_parallel_for;
+    bd->parallel_for = sdfccd__pool_parallel_for;
     bd->parallel_user = pool;
 }
 
@@ -216,15 +216,15 @@ static double mesh_sample(void* user, scc_vec3 p, uint32_t* state, double cap)
     return c->sign * scc_mesh_sdf_distance_capped(c->ms, p, state, cap);
 }
 
-sdfccd_Status capi_mesh_topology_message(const scc_mesh_topology* t, const char* fn)
+sdfccd_Status sdfccd__mesh_topology_message(const scc_mesh_topology* t, const char* fn)
 {
     if (!t->closed)
-        return capi_error(SDFCCD_DEGENERATE,
-                          "%s: the mesh is not closed (%u boundary, %u non-manifold, %u inconsistently oriented edges); "
+        return sdfccd__error(SDFCCD_DEGENERATE,
+                             "%s: the mesh is not closed (%u boundary, %u non-manifold, %u inconsistently oriented edges); "
                           "signs would be wrong (set allow_open_mesh to build anyway)",
                           fn, t->boundary_edges, t->nonmanifold_edges, t->inconsistent_edges);
     if (!(t->volume > 0.0))
-        return capi_error(SDFCCD_DEGENERATE, "%s: the mesh is inside out (signed volume %g <= 0); flip its triangles", fn, t->volume);
+        return sdfccd__error(SDFCCD_DEGENERATE, "%s: the mesh is inside out (signed volume %g <= 0); flip its triangles", fn, t->volume);
     return SDFCCD_OK;
 }
 
@@ -232,18 +232,18 @@ sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_Grid
 {
     static const char* fn = "sdfccd_create_grid_from_mesh";
     sdfccd_Status st;
-    if ((st = check_grid_def(def, fn)) || (st = capi_check_ptr(out_grid, "sdfccd_create_grid_from_mesh: out_grid"))) return st;
-    capi_mesh* m = capi_mesh_lookup(mesh);
+    if ((st = check_grid_def(def, fn)) || (st = sdfccd__check_ptr(out_grid, "sdfccd_create_grid_from_mesh: out_grid"))) return st;
+    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_sdf ms;
-    if (scc_mesh_sdf_init(&ms, capi_allocator(), &m->mesh) != 0) return capi_oom("a mesh distance structure");
-    if (!def->allow_open_mesh && (st = capi_mesh_topology_message(&ms.topology, fn))) {
+    if (scc_mesh_sdf_init(&ms, sdfccd__allocator(), &m->mesh) != 0) return sdfccd__oom("a mesh distance structure");
+    if (!def->allow_open_mesh && (st = sdfccd__mesh_topology_message(&ms.topology, fn))) {
         scc_mesh_sdf_destroy(&ms);
         return st;
     }
-    const scc_aabb domain = def->fit_domain ? padded(scc_grid_fit_domain(m->mesh.bounds), def->padding) : capi_box(def->domain);
-    capi_pool pool;
-    capi_pool_init(&pool, def->threads, def->progress, def->progress_user);
+    const scc_aabb domain = def->fit_domain ? padded(scc_grid_fit_domain(m->mesh.bounds), def->padding) : sdfccd__box(def->domain);
+    sdfccd__pool pool;
+    sdfccd__pool_init(&pool, def->threads, def->progress, def->progress_user);
     scc_grid_build_def bd;
     fill_build_def(&bd, def, domain, &pool);
     mesh_sample_ctx ctx = { &ms, def->invert ? -1.0 : 1.0 };
@@ -251,10 +251,10 @@ sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_Grid
     bd.sample_user = &ctx;
     bd.sample_lipschitz = 1.0; /* exact distance */
     scc_grid* g = NULL;
-    st = build_status(scc_grid_build(capi_allocator(), &bd, &g), fn);
+    st = build_status(scc_grid_build(sdfccd__allocator(), &bd, &g), fn);
     scc_mesh_sdf_destroy(&ms);
     if (st) return st;
-    return capi_grid_register(g, out_grid);
+    return sdfccd__grid_register(g, out_grid);
 }
 
 /* ---------------- build from an SDF ---------------- */
@@ -273,20 +273,20 @@ sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef
 {
     static const char* fn = "sdfccd_create_grid_from_sdf";
     sdfccd_Status st;
-    if ((st = check_grid_def(def, fn)) || (st = capi_check_ptr(out_grid, "sdfccd_create_grid_from_sdf: out_grid"))) return st;
-    capi_sdf* s = capi_sdf_lookup(sdf);
+    if ((st = check_grid_def(def, fn)) || (st = sdfccd__check_ptr(out_grid, "sdfccd_create_grid_from_sdf: out_grid"))) return st;
+    sdfccd__sdf* s = sdfccd__sdf_lookup(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     scc_aabb domain;
     if (def->fit_domain) {
         if (!scc_vfinite(s->sdf->bounds.lo) || !scc_vfinite(s->sdf->bounds.hi))
-            return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: the SDF's bounds are infinite; set fit_domain = 0 and a domain", fn);
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the SDF's bounds are infinite; set fit_domain = 0 and a domain", fn);
         domain = padded(scc_grid_fit_domain(s->sdf->bounds), def->padding);
     } else {
-        domain = capi_box(def->domain);
+        domain = sdfccd__box(def->domain);
     }
-    capi_sdf_retain(s); /* keep the source alive during the build */
-    capi_pool pool;
-    capi_pool_init(&pool, def->threads, def->progress, def->progress_user);
+    sdfccd__sdf_retain(s); /* keep the source alive during the build */
+    sdfccd__pool pool;
+    sdfccd__pool_init(&pool, def->threads, def->progress, def->progress_user);
     scc_grid_build_def bd;
     fill_build_def(&bd, def, domain, &pool);
     sdf_sample_ctx ctx = { s->sdf, def->invert ? -1.0 : 1.0 };
@@ -294,15 +294,15 @@ sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef
     bd.sample_user = &ctx;
     bd.sample_lipschitz = isfinite(s->sdf->lipschitz) && s->sdf->lipschitz > 0.0 ? s->sdf->lipschitz : 0.0;
     scc_grid* g = NULL;
-    st = build_status(scc_grid_build(capi_allocator(), &bd, &g), fn);
-    capi_sdf_release(s);
+    st = build_status(scc_grid_build(sdfccd__allocator(), &bd, &g), fn);
+    sdfccd__sdf_release(s);
     if (st) return st;
-    return capi_grid_register(g, out_grid);
+    return sdfccd__grid_register(g, out_grid);
 }
 
 /* ---------------- inspection ---------------- */
 
-int64_t capi_grid_file_bytes(const scc_grid* g)
+int64_t sdfccd__grid_file_bytes(const scc_grid* g)
 {
     int64_t b = 124 + 3 * 8;
     for (uint32_t f = 0; f < g->field_count; ++f)
@@ -313,22 +313,22 @@ int64_t capi_grid_file_bytes(const scc_grid* g)
 sdfccd_Status sdfccd_grid_get_info(sdfccd_SdfId grid, sdfccd_GridInfo* out_info)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_info, "sdfccd_grid_get_info: out_info"))) return st;
+    if ((st = sdfccd__check_ptr(out_info, "sdfccd_grid_get_info: out_info"))) return st;
     scc_grid* g;
-    if ((st = capi_grid_lookup(grid, "sdfccd_grid_get_info", &g))) return st;
+    if ((st = sdfccd__grid_lookup(grid, "sdfccd_grid_get_info", &g))) return st;
     sdfccd_GridInfo* o = out_info;
     memset(o, 0, sizeof *o);
     for (int i = 0; i < 3; ++i) o->resolution[i] = (int32_t)g->res[i];
-    o->domain.lo = capi_pv(g->lo);
-    o->domain.hi = capi_pv(g->hi);
-    o->cell_size = capi_pv(g->h);
+    o->domain.lo = sdfccd__pv(g->lo);
+    o->domain.hi = sdfccd__pv(g->hi);
+    o->cell_size = sdfccd__pv(g->h);
     o->field_count = (int32_t)g->field_count;
     o->cell_count = (int64_t)g->n_cells;
     o->stored_cells = (int64_t)g->fields[0].cell_count;
     o->valued_cells = (int64_t)g->valued_cells;
     o->node_count = (int64_t)g->fields[0].node_count;
-    o->memory_bytes = (int64_t)(scc_grid_memory(g) + sizeof(capi_sdf) + sizeof(scc_grid*));
-    o->file_bytes = capi_grid_file_bytes(g);
+    o->memory_bytes = (int64_t)(scc_grid_memory(g) + sizeof(sdfccd__sdf) + sizeof(scc_grid*));
+    o->file_bytes = sdfccd__grid_file_bytes(g);
     o->max_lipschitz = g->lipschitz_max;
     o->band = g->band;
     return SDFCCD_OK;
@@ -338,30 +338,30 @@ sdfccd_Status sdfccd_grid_interpolate(sdfccd_SdfId grid, int32_t field, sdfccd_V
                                       sdfccd_Vec3* out_grad, int32_t* out_has_value)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_value, "sdfccd_grid_interpolate: out_value")) ||
-        (st = capi_check_ptr(out_has_value, "sdfccd_grid_interpolate: out_has_value")) ||
-        (st = capi_check_vec(p, "sdfccd_grid_interpolate: p")))
+    if ((st = sdfccd__check_ptr(out_value, "sdfccd_grid_interpolate: out_value")) ||
+        (st = sdfccd__check_ptr(out_has_value, "sdfccd_grid_interpolate: out_has_value")) ||
+        (st = sdfccd__check_vec(p, "sdfccd_grid_interpolate: p")))
         return st;
     scc_grid* g;
-    if ((st = capi_grid_lookup(grid, "sdfccd_grid_interpolate", &g))) return st;
+    if ((st = sdfccd__grid_lookup(grid, "sdfccd_grid_interpolate", &g))) return st;
     if (field < 0 || (uint32_t)field >= g->field_count)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_grid_interpolate: field %d is not in [0, %u)", field, g->field_count);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_grid_interpolate: field %d is not in [0, %u)", field, g->field_count);
     double v = 0.0;
     scc_vec3 gr = scc_v3(0, 0, 0);
-    const int ok = scc_grid_interpolate(g, (uint32_t)field, capi_v(p), &v, &gr);
+    const int ok = scc_grid_interpolate(g, (uint32_t)field, sdfccd__v(p), &v, &gr);
     *out_has_value = ok;
     *out_value = ok ? v : 0.0;
-    if (out_grad) *out_grad = ok ? capi_pv(gr) : capi_pv(scc_v3(0, 0, 0));
+    if (out_grad) *out_grad = ok ? sdfccd__pv(gr) : sdfccd__pv(scc_v3(0, 0, 0));
     return SDFCCD_OK;
 }
 
 sdfccd_Status sdfccd_grid_lipschitz_bound(sdfccd_SdfId grid, sdfccd_Aabb box, double* out_bound)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_bound, "sdfccd_grid_lipschitz_bound: out_bound"))) return st;
+    if ((st = sdfccd__check_ptr(out_bound, "sdfccd_grid_lipschitz_bound: out_bound"))) return st;
     scc_grid* g;
-    if ((st = capi_grid_lookup(grid, "sdfccd_grid_lipschitz_bound", &g))) return st;
-    scc_aabb b = capi_box(box);
+    if ((st = sdfccd__grid_lookup(grid, "sdfccd_grid_lipschitz_bound", &g))) return st;
+    scc_aabb b = sdfccd__box(box);
     *out_bound = scc_grid_lipschitz_in(&g->base, &b);
     return SDFCCD_OK;
 }

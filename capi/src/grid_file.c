@@ -27,7 +27,7 @@ typedef struct reader {
 
 static sdfccd_Status fmt(const reader* r, const char* what)
 {
-    return capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: %s (at byte %zu of %zu)", what, r->pos, r->size);
+    return sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: %s (at byte %zu of %zu)", what, r->pos, r->size);
 }
 
 static int rd(reader* r, void* out, size_t n)
@@ -62,9 +62,9 @@ static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId*
     if ((size - r.pos) / (24 + 4 * (n_cells ? n_cells : 1)) < n_fields) return fmt(&r, "file too short for the field count and cell maps");
 
     const scc_vec3 lo = scc_v3(dom[0], dom[1], dom[2]), hi = scc_v3(dom[3], dom[4], dom[5]);
-    scc_grid* g = scc_grid_create_raw(capi_allocator(), lo, hi, res, scc_v3(h[0], h[1], h[2]), scc_v3(ih[0], ih[1], ih[2]), (uint32_t)n_fields);
-    if (!g) return capi_oom("a grid");
-    const scc_allocator* a = capi_allocator();
+    scc_grid* g = scc_grid_create_raw(sdfccd__allocator(), lo, hi, res, scc_v3(h[0], h[1], h[2]), scc_v3(ih[0], ih[1], ih[2]), (uint32_t)n_fields);
+    if (!g) return sdfccd__oom("a grid");
+    const scc_allocator* a = sdfccd__allocator();
     sdfccd_Status st = SDFCCD_OK;
 
     /* node arrays */
@@ -78,7 +78,7 @@ static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId*
         scc_grid_field* fd = &g->fields[f];
         if (count) {
             fd->nodes = scc_alloc(a, (size_t)count * 8);
-            if (!fd->nodes) { st = capi_oom("grid nodes"); goto fail; }
+            if (!fd->nodes) { st = sdfccd__oom("grid nodes"); goto fail; }
         }
         fd->node_count = count;
         const size_t at = r.pos;
@@ -97,7 +97,7 @@ static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId*
         scc_grid_field* fd = &g->fields[f];
         if (count) {
             fd->cells = scc_alloc(a, (size_t)count * 128);
-            if (!fd->cells) { st = capi_oom("grid cells"); goto fail; }
+            if (!fd->cells) { st = sdfccd__oom("grid cells"); goto fail; }
         }
         fd->cell_count = count;
         const size_t at = r.pos;
@@ -115,7 +115,7 @@ static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId*
         if (count > (size - r.pos) / 4) { st = fmt(&r, "cell map larger than the rest of the file"); goto fail; }
         scc_grid_field* fd = &g->fields[f];
         fd->map = scc_alloc(a, (size_t)count * 4);
-        if (!fd->map) { st = capi_oom("grid cell map"); goto fail; }
+        if (!fd->map) { st = sdfccd__oom("grid cell map"); goto fail; }
         const size_t at = r.pos;
         rd(&r, fd->map, (size_t)count * 4);
         for (uint64_t i = 0; i < count; ++i)
@@ -123,15 +123,15 @@ static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId*
     }
     if (r.pos != size) { st = fmt(&r, "trailing bytes after the last cell map"); goto fail; }
 
-    capi_pool pool;
-    capi_pool_init(&pool, 0, NULL, NULL);
-    switch (scc_grid_finalize(g, 0.0, capi_pool_parallel_for, &pool)) {
+    sdfccd__pool pool;
+    sdfccd__pool_init(&pool, 0, NULL, NULL);
+    switch (scc_grid_finalize(g, 0.0, sdfccd__pool_parallel_for, &pool)) {
     case SCC_GRID_OK: break;
-    case SCC_GRID_EMPTY: st = capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: field 0 has no cell with values"); goto fail;
-    case SCC_GRID_TOO_LARGE: st = capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: too many cells"); goto fail;
-    default: st = capi_oom("grid bounds"); goto fail;
+    case SCC_GRID_EMPTY: st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: field 0 has no cell with values"); goto fail;
+    case SCC_GRID_TOO_LARGE: st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: too many cells"); goto fail;
+    default: st = sdfccd__oom("grid bounds"); goto fail;
     }
-    return capi_grid_register(g, out_grid);
+    return sdfccd__grid_register(g, out_grid);
 fail:
     scc_grid_destroy(g);
     return st;
@@ -140,44 +140,44 @@ fail:
 sdfccd_Status sdfccd_load_grid_memory(const void* data, size_t size, sdfccd_SdfId* out_grid)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(data, "sdfccd_load_grid_memory: data")) || (st = capi_check_ptr(out_grid, "sdfccd_load_grid_memory: out_grid"))) return st;
-    if (!host_is_little_endian()) return capi_error(SDFCCD_UNSUPPORTED, "sdfccd_load_grid: .cdf files are little-endian; this host is not");
+    if ((st = sdfccd__check_ptr(data, "sdfccd_load_grid_memory: data")) || (st = sdfccd__check_ptr(out_grid, "sdfccd_load_grid_memory: out_grid"))) return st;
+    if (!host_is_little_endian()) return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_load_grid: .cdf files are little-endian; this host is not");
     return parse(data, size, out_grid);
 }
 
 sdfccd_Status sdfccd_load_grid(const char* path, sdfccd_SdfId* out_grid)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(path, "sdfccd_load_grid: path")) || (st = capi_check_ptr(out_grid, "sdfccd_load_grid: out_grid"))) return st;
-    if (!host_is_little_endian()) return capi_error(SDFCCD_UNSUPPORTED, "sdfccd_load_grid: .cdf files are little-endian; this host is not");
+    if ((st = sdfccd__check_ptr(path, "sdfccd_load_grid: path")) || (st = sdfccd__check_ptr(out_grid, "sdfccd_load_grid: out_grid"))) return st;
+    if (!host_is_little_endian()) return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_load_grid: .cdf files are little-endian; this host is not");
     FILE* f = fopen(path, "rb");
-    if (!f) return capi_error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot open '%s': %s", path, strerror(errno));
+    if (!f) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot open '%s': %s", path, strerror(errno));
     long size = -1;
     if (fseek(f, 0, SEEK_END) == 0) size = ftell(f);
     if (size < 0 || fseek(f, 0, SEEK_SET) != 0) {
         fclose(f);
-        return capi_error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot determine the size of '%s'", path);
+        return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot determine the size of '%s'", path);
     }
     if (size == 0) {
         fclose(f);
-        return capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: '%s' is empty", path);
+        return sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: '%s' is empty", path);
     }
-    unsigned char* buf = capi_alloc((size_t)size);
-    if (!buf) { fclose(f); return capi_oom("a file buffer"); }
+    unsigned char* buf = sdfccd__alloc((size_t)size);
+    if (!buf) { fclose(f); return sdfccd__oom("a file buffer"); }
     const size_t got = fread(buf, 1, (size_t)size, f);
     const int err = ferror(f);
     fclose(f);
     if (got != (size_t)size || err) {
-        capi_free(buf, (size_t)size);
-        return capi_error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot read '%s'", path);
+        sdfccd__free(buf, (size_t)size);
+        return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot read '%s'", path);
     }
     st = parse(buf, (size_t)size, out_grid);
-    capi_free(buf, (size_t)size);
+    sdfccd__free(buf, (size_t)size);
     if (st) {
         /* prefix the path to the parser's message */
         char msg[400];
         snprintf(msg, sizeof msg, "%s", sdfccd_last_error());
-        capi_error(st, "%s ['%s']", msg, path);
+        sdfccd__error(st, "%s ['%s']", msg, path);
     }
     return st;
 }
@@ -189,12 +189,12 @@ static int wr(FILE* f, const void* p, size_t n) { return n == 0 || fwrite(p, 1, 
 sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(path, "sdfccd_save_grid: path"))) return st;
+    if ((st = sdfccd__check_ptr(path, "sdfccd_save_grid: path"))) return st;
     scc_grid* g;
-    if ((st = capi_grid_lookup(grid, "sdfccd_save_grid", &g))) return st;
-    if (!host_is_little_endian()) return capi_error(SDFCCD_UNSUPPORTED, "sdfccd_save_grid: .cdf files are little-endian; this host is not");
+    if ((st = sdfccd__grid_lookup(grid, "sdfccd_save_grid", &g))) return st;
+    if (!host_is_little_endian()) return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_save_grid: .cdf files are little-endian; this host is not");
     FILE* f = fopen(path, "wb");
-    if (!f) return capi_error(SDFCCD_IO_ERROR, "sdfccd_save_grid: cannot create '%s': %s", path, strerror(errno));
+    if (!f) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_save_grid: cannot create '%s': %s", path, strerror(errno));
     /* A band grid built in-tree keeps field 0 in vertex blocks: number its nodes (first use in
      * cell order) and build the id table the file needs. */
     double* band_nodes = NULL;
@@ -205,16 +205,16 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
         band_nodes_bytes = (size_t)fd->node_count * sizeof(double);
         band_cells_bytes = (size_t)fd->cell_count * 128;
         const size_t key_bytes = (size_t)g->block_count * sizeof(uint32_t);
-        band_nodes = capi_alloc(band_nodes_bytes);
-        band_cells = capi_alloc(band_cells_bytes);
-        uint32_t* id_of_key = capi_alloc(key_bytes);
+        band_nodes = sdfccd__alloc(band_nodes_bytes);
+        band_cells = sdfccd__alloc(band_cells_bytes);
+        uint32_t* id_of_key = sdfccd__alloc(key_bytes);
         if (!band_nodes || !band_cells || !id_of_key) {
-            capi_free(band_nodes, band_nodes_bytes);
-            capi_free(band_cells, band_cells_bytes);
-            capi_free(id_of_key, key_bytes);
+            sdfccd__free(band_nodes, band_nodes_bytes);
+            sdfccd__free(band_cells, band_cells_bytes);
+            sdfccd__free(id_of_key, key_bytes);
             fclose(f);
             remove(path);
-            return capi_oom("a band grid's node numbering");
+            return sdfccd__oom("a band grid's node numbering");
         }
         memset(id_of_key, 0xFF, key_bytes);
         uint64_t next = 0;
@@ -234,7 +234,7 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
                 band_cells[(size_t)c * 32 + a] = id_of_key[key];
             }
         }
-        capi_free(id_of_key, key_bytes);
+        sdfccd__free(id_of_key, key_bytes);
     }
 
     const double dom[6] = { g->lo.x, g->lo.y, g->lo.z, g->hi.x, g->hi.y, g->hi.z };
@@ -271,12 +271,12 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
     }
     ok = ok && wr(f, &n_fields, 8);
     for (uint32_t i = 0; ok && i < g->field_count; ++i) ok = wr(f, &n_cells, 8) && wr(f, g->fields[i].map, (size_t)n_cells * 4);
-    capi_free(band_nodes, band_nodes_bytes);
-    capi_free(band_cells, band_cells_bytes);
+    sdfccd__free(band_nodes, band_nodes_bytes);
+    sdfccd__free(band_cells, band_cells_bytes);
     if (fclose(f) != 0) ok = 0;
     if (!ok) {
         remove(path);
-        return capi_error(SDFCCD_IO_ERROR, "sdfccd_save_grid: writing '%s' failed", path);
+        return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_save_grid: writing '%s' failed", path);
     }
     return SDFCCD_OK;
 }

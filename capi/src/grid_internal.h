@@ -8,24 +8,24 @@
 #include "../../core/grid.h"
 
 /* Wraps a finished core grid in a new SDF handle (takes ownership; destroys it on failure). */
-sdfccd_Status capi_grid_register(scc_grid* g, sdfccd_SdfId* out_sdf);
+sdfccd_Status sdfccd__grid_register(scc_grid* g, sdfccd_SdfId* out_sdf);
 /* The grid behind a handle: INVALID_HANDLE, or INVALID_ARGUMENT when the SDF is not a grid. */
-sdfccd_Status capi_grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid);
+sdfccd_Status sdfccd__grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid);
 /* Size of the .cdf file of a grid. */
-int64_t capi_grid_file_bytes(const scc_grid* g);
+int64_t sdfccd__grid_file_bytes(const scc_grid* g);
 /* DEGENERATE with a message when the topology cannot give correct signs, else OK. */
 struct scc_mesh_topology;
-sdfccd_Status capi_mesh_topology_message(const struct scc_mesh_topology* t, const char* fn);
+sdfccd_Status sdfccd__mesh_topology_message(const struct scc_mesh_topology* t, const char* fn);
 
 /* Runs a parallel_for on `threads` threads (0 = online cores) and reports progress. */
-typedef struct capi_pool {
+typedef struct sdfccd__pool {
     int threads;
     sdfccd_ProgressFcn* progress;
     void* progress_user;
     double stage_base[4], stage_weight[4]; /* progress mapping per stage (SCC_GRID_STAGE_*) */
     double last_reported;
-} capi_pool;
-void capi_pool_init(capi_pool* p, int threads, sdfccd_ProgressFcn* progress, void* user);
-int capi_pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx);
+} sdfccd__pool;
+void sdfccd__pool_init(sdfccd__pool* p, int threads, sdfccd_ProgressFcn* progress, void* user);
+int sdfccd__pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx);
 
 #endif

@@ -57,18 +57,18 @@ static int same_pos(const double* a, const double* b) { return a[0] == b[0] && a
 static sdfccd_Status finish_mesh(double* verts, uint32_t nv, uint32_t* idx, uint32_t nt, const sdfccd_MeshLoadDef* d,
                                  const char* path, sdfccd_MeshId* out_mesh)
 {
-    if (nt == 0 || nv == 0) return capi_error(SDFCCD_DEGENERATE, "sdfccd_load_mesh: '%s' contains no triangles", path);
+    if (nt == 0 || nv == 0) return sdfccd__error(SDFCCD_DEGENERATE, "sdfccd_load_mesh: '%s' contains no triangles", path);
     for (uint32_t i = 0; i < 3 * nv; ++i) verts[i] *= d->scale;
     uint32_t out_v = nv;
     if (d->merge_vertices) {
         weld_table wt = { NULL, 16 };
         while (wt.cap < 2 * (size_t)nv) wt.cap *= 2;
-        wt.slots = capi_calloc(wt.cap * sizeof(uint32_t));
-        uint32_t* remap = capi_alloc((size_t)nv * sizeof(uint32_t));
+        wt.slots = sdfccd__calloc(wt.cap * sizeof(uint32_t));
+        uint32_t* remap = sdfccd__alloc((size_t)nv * sizeof(uint32_t));
         if (!wt.slots || !remap) {
-            capi_free(wt.slots, wt.cap * sizeof(uint32_t));
-            capi_free(remap, (size_t)nv * sizeof(uint32_t));
-            return capi_oom("an imported mesh");
+            sdfccd__free(wt.slots, wt.cap * sizeof(uint32_t));
+            sdfccd__free(remap, (size_t)nv * sizeof(uint32_t));
+            return sdfccd__oom("an imported mesh");
         }
         out_v = 0;
         for (uint32_t i = 0; i < nv; ++i) {
@@ -88,12 +88,12 @@ static sdfccd_Status finish_mesh(double* verts, uint32_t nv, uint32_t* idx, uint
             remap[i] = id;
         }
         for (size_t k = 0; k < 3 * (size_t)nt; ++k) idx[k] = remap[idx[k]];
-        capi_free(wt.slots, wt.cap * sizeof(uint32_t));
-        capi_free(remap, (size_t)nv * sizeof(uint32_t));
+        sdfccd__free(wt.slots, wt.cap * sizeof(uint32_t));
+        sdfccd__free(remap, (size_t)nv * sizeof(uint32_t));
     }
     char what[300];
     snprintf(what, sizeof what, "sdfccd_load_mesh('%s')", path);
-    return capi_mesh_create(verts, out_v, idx, nt, d->drop_degenerate, what, out_mesh);
+    return sdfccd__mesh_create(verts, out_v, idx, nt, d->drop_degenerate, what, out_mesh);
 }
 
 /* ---------------- Wavefront OBJ, read in double precision ----------------
@@ -108,10 +108,10 @@ static int grow_push(growbuf* b, const void* v)
 {
     if (b->used == b->cap) {
         size_t nc = b->cap ? 2 * b->cap : 1024;
-        void* np = capi_alloc(nc * b->elem);
+        void* np = sdfccd__alloc(nc * b->elem);
         if (!np) return 0;
         if (b->p) memcpy(np, b->p, b->used * b->elem);
-        capi_free(b->p, b->cap * b->elem);
+        sdfccd__free(b->p, b->cap * b->elem);
         b->p = np;
         b->cap = nc;
     }
@@ -123,7 +123,7 @@ static int grow_push(growbuf* b, const void* v)
 static sdfccd_Status load_obj(const char* path, const sdfccd_MeshLoadDef* d, sdfccd_MeshId* out_mesh)
 {
     FILE* f = fopen(path, "rb");
-    if (!f) return capi_error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot open '%s': %s", path, strerror(errno));
+    if (!f) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot open '%s': %s", path, strerror(errno));
     growbuf v = { NULL, 0, 0, 3 * sizeof(double) }, t = { NULL, 0, 0, 3 * sizeof(uint32_t) };
     sdfccd_Status st = SDFCCD_OK;
     char line[4096];
@@ -133,7 +133,7 @@ static sdfccd_Status load_obj(const char* path, const sdfccd_MeshLoadDef* d, sdf
         ++lineno;
         size_t len = strlen(line);
         if (len == sizeof line - 1 && line[len - 1] != '\n' && !feof(f)) {
-            st = capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu is longer than %zu characters", path, lineno, sizeof line - 2);
+            st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu is longer than %zu characters", path, lineno, sizeof line - 2);
             break;
         }
         char* s = line;
@@ -147,8 +147,8 @@ static sdfccd_Status load_obj(const char* path, const sdfccd_MeshLoadDef* d, sdf
                 if (next == e || !isfinite(p[k])) { bad_line = 1; break; }
                 e = next;
             }
-            if (bad_line) { st = capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu: bad vertex", path, lineno); break; }
-            if (!grow_push(&v, p)) { st = capi_oom("an imported mesh"); break; }
+            if (bad_line) { st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu: bad vertex", path, lineno); break; }
+            if (!grow_push(&v, p)) { st = sdfccd__oom("an imported mesh"); break; }
         } else if (s[0] == 'f' && (s[1] == ' ' || s[1] == '\t')) {
             uint32_t first = 0, prev = 0;
             int n = 0;
@@ -167,22 +167,22 @@ static sdfccd_Status load_obj(const char* path, const sdfccd_MeshLoadDef* d, sdf
                 if (n == 0) first = id;
                 else if (n >= 2) {
                     const uint32_t tri[3] = { first, prev, id };
-                    if (!grow_push(&t, tri)) { st = capi_oom("an imported mesh"); break; }
+                    if (!grow_push(&t, tri)) { st = sdfccd__oom("an imported mesh"); break; }
                 }
                 prev = id;
                 ++n;
             }
             if (st) break;
-            if (bad_line) { st = capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu: bad face (index out of range or malformed)", path, lineno); break; }
+            if (bad_line) { st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu: bad face (index out of range or malformed)", path, lineno); break; }
         }
     }
-    if (!st && ferror(f)) st = capi_error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot read '%s'", path);
+    if (!st && ferror(f)) st = sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot read '%s'", path);
     fclose(f);
     if (!st && (v.used > (1u << 30) || t.used > (1u << 30)))
-        st = capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: '%s' is too large", path);
+        st = sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: '%s' is too large", path);
     if (!st) st = finish_mesh(v.p, (uint32_t)v.used, t.p, (uint32_t)t.used, d, path, out_mesh);
-    capi_free(v.p, v.cap * v.elem);
-    capi_free(t.p, t.cap * t.elem);
+    sdfccd__free(v.p, v.cap * v.elem);
+    sdfccd__free(t.p, t.cap * t.elem);
     return st;
 }
 
@@ -197,22 +197,22 @@ static int has_obj_extension(const char* path)
 sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, sdfccd_MeshId* out_mesh)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(path, "sdfccd_load_mesh: path")) || (st = capi_check_ptr(out_mesh, "sdfccd_load_mesh: out_mesh"))) return st;
+    if ((st = sdfccd__check_ptr(path, "sdfccd_load_mesh: path")) || (st = sdfccd__check_ptr(out_mesh, "sdfccd_load_mesh: out_mesh"))) return st;
     sdfccd_MeshLoadDef d = def ? *def : sdfccd_default_mesh_load_def();
     if (d.internal_value != LOAD_DEF_MAGIC)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: def was not initialised with sdfccd_default_mesh_load_def()");
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: def was not initialised with sdfccd_default_mesh_load_def()");
     if (!isfinite(d.scale) || d.scale == 0.0)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: scale = %g must be finite and non-zero", d.scale);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: scale = %g must be finite and non-zero", d.scale);
     if (has_obj_extension(path)) return load_obj(path, &d, out_mesh);
 #if !SDFCCD_HAVE_ASSIMP
-    return capi_error(SDFCCD_UNSUPPORTED, "sdfccd_load_mesh: this build has no assimp (configure with SDFCCD_WITH_ASSIMP=ON); only .obj files load");
+    return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_load_mesh: this build has no assimp (configure with SDFCCD_WITH_ASSIMP=ON); only .obj files load");
 #else
     FILE* probe = fopen(path, "rb");
-    if (!probe) return capi_error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot open '%s': %s", path, strerror(errno));
+    if (!probe) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot open '%s': %s", path, strerror(errno));
     fclose(probe);
 
     const struct aiScene* scene = aiImportFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices);
-    if (!scene) return capi_error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: assimp cannot read '%s': %s", path, aiGetErrorString());
+    if (!scene) return sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: assimp cannot read '%s': %s", path, aiGetErrorString());
     uint64_t nv = 0, nt = 0;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const struct aiMesh* mesh = scene->mMeshes[m];
@@ -221,20 +221,20 @@ sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, 
     }
     if (nt == 0 || nv == 0) {
         aiReleaseImport(scene);
-        return capi_error(SDFCCD_DEGENERATE, "sdfccd_load_mesh: '%s' contains no triangles", path);
+        return sdfccd__error(SDFCCD_DEGENERATE, "sdfccd_load_mesh: '%s' contains no triangles", path);
     }
     if (nv > (1u << 30) || nt > (1u << 30)) {
         aiReleaseImport(scene);
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: '%s' is too large", path);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: '%s' is too large", path);
     }
     const size_t vbytes = (size_t)nv * 3 * sizeof(double), ibytes = (size_t)nt * 3 * sizeof(uint32_t);
-    double* verts = capi_alloc(vbytes);
-    uint32_t* idx = capi_alloc(ibytes);
+    double* verts = sdfccd__alloc(vbytes);
+    uint32_t* idx = sdfccd__alloc(ibytes);
     if (!verts || !idx) {
-        capi_free(verts, vbytes);
-        capi_free(idx, ibytes);
+        sdfccd__free(verts, vbytes);
+        sdfccd__free(idx, ibytes);
         aiReleaseImport(scene);
-        return capi_oom("an imported mesh");
+        return sdfccd__oom("an imported mesh");
     }
     uint32_t out_t = 0, base = 0;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
@@ -255,8 +255,8 @@ sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, 
     }
     aiReleaseImport(scene);
     st = finish_mesh(verts, (uint32_t)nv, idx, out_t, &d, path, out_mesh);
-    capi_free(verts, vbytes);
-    capi_free(idx, ibytes);
+    sdfccd__free(verts, vbytes);
+    sdfccd__free(idx, ibytes);
     return st;
 #endif
 }
@@ -266,11 +266,11 @@ sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, 
 sdfccd_Status sdfccd_mesh_get_topology(sdfccd_MeshId mesh, sdfccd_MeshTopology* out_topology)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_topology, "sdfccd_mesh_get_topology: out_topology"))) return st;
-    capi_mesh* m = capi_mesh_lookup(mesh);
+    if ((st = sdfccd__check_ptr(out_topology, "sdfccd_mesh_get_topology: out_topology"))) return st;
+    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_topology t;
-    if (scc_mesh_topology_check(capi_allocator(), &m->mesh, &t) != 0) return capi_oom("a topology check");
+    if (scc_mesh_topology_check(sdfccd__allocator(), &m->mesh, &t) != 0) return sdfccd__oom("a topology check");
     out_topology->boundary_edges = t.boundary_edges;
     out_topology->nonmanifold_edges = t.nonmanifold_edges;
     out_topology->inconsistent_edges = t.inconsistent_edges;
@@ -283,26 +283,26 @@ sdfccd_Status sdfccd_mesh_signed_distance(sdfccd_MeshId mesh, const sdfccd_Vec3*
                                           double* out_distances, sdfccd_Vec3* out_closest)
 {
     sdfccd_Status st;
-    if (count < 0) return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_mesh_signed_distance: count = %d < 0", count);
-    if (count > 0 && ((st = capi_check_ptr(points, "sdfccd_mesh_signed_distance: points")) ||
-                      (st = capi_check_ptr(out_distances, "sdfccd_mesh_signed_distance: out_distances"))))
+    if (count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_mesh_signed_distance: count = %d < 0", count);
+    if (count > 0 && ((st = sdfccd__check_ptr(points, "sdfccd_mesh_signed_distance: points")) ||
+                      (st = sdfccd__check_ptr(out_distances, "sdfccd_mesh_signed_distance: out_distances"))))
         return st;
     for (int32_t i = 0; i < count; ++i)
-        if ((st = capi_check_vec(points[i], "sdfccd_mesh_signed_distance: a point"))) return st;
-    capi_mesh* m = capi_mesh_lookup(mesh);
+        if ((st = sdfccd__check_vec(points[i], "sdfccd_mesh_signed_distance: a point"))) return st;
+    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_sdf ms;
-    if (scc_mesh_sdf_init(&ms, capi_allocator(), &m->mesh) != 0) return capi_oom("a mesh distance structure");
-    if (!allow_open && (st = capi_mesh_topology_message(&ms.topology, "sdfccd_mesh_signed_distance"))) {
+    if (scc_mesh_sdf_init(&ms, sdfccd__allocator(), &m->mesh) != 0) return sdfccd__oom("a mesh distance structure");
+    if (!allow_open && (st = sdfccd__mesh_topology_message(&ms.topology, "sdfccd_mesh_signed_distance"))) {
         scc_mesh_sdf_destroy(&ms);
         return st;
     }
     uint32_t hint = UINT32_MAX;
     for (int32_t i = 0; i < count; ++i) {
         scc_mesh_distance_result r;
-        scc_mesh_sdf_query_hint(&ms, capi_v(points[i]), &hint, &r);
+        scc_mesh_sdf_query_hint(&ms, sdfccd__v(points[i]), &hint, &r);
         out_distances[i] = r.distance;
-        if (out_closest) out_closest[i] = capi_pv(r.closest);
+        if (out_closest) out_closest[i] = sdfccd__pv(r.closest);
     }
     scc_mesh_sdf_destroy(&ms);
     return SDFCCD_OK;

@@ -10,33 +10,33 @@
 
 static sdfccd_Status positive(double v, const char* what)
 {
-    if (!isfinite(v) || !(v > 0.0)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s must be finite and > 0 (got %g)", what, v);
+    if (!isfinite(v) || !(v > 0.0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s must be finite and > 0 (got %g)", what, v);
     return SDFCCD_OK;
 }
 
 /* Allocates storage of `size` for a new shape; NULL with an OOM message. */
-static capi_sdf* new_shape(size_t size, const char* what)
+static sdfccd__sdf* new_shape(size_t size, const char* what)
 {
-    capi_sdf* s = capi_sdf_new(size);
-    if (!s) capi_oom(what);
+    sdfccd__sdf* s = sdfccd__sdf_new(size);
+    if (!s) sdfccd__oom(what);
     return s;
 }
 
 sdfccd_Status sdfccd_create_sphere(double radius, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_sdf, "sdfccd_create_sphere: out_sdf")) || (st = positive(radius, "sdfccd_create_sphere: radius"))) return st;
-    capi_sdf* s = new_shape(sizeof(scc_sdf_sphere), "a sphere");
+    if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_sphere: out_sdf")) || (st = positive(radius, "sdfccd_create_sphere: radius"))) return st;
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_sphere), "a sphere");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     scc_sdf_sphere_init(s->storage, radius);
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 static sdfccd_Status make_box(sdfccd_Vec3 half, double radius, const char* fn, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
     char what[96];
-    if ((st = capi_check_ptr(out_sdf, fn))) return st;
+    if ((st = sdfccd__check_ptr(out_sdf, fn))) return st;
     snprintf(what, sizeof what, "%s: half.x", fn);
     if ((st = positive(half.x, what))) return st;
     snprintf(what, sizeof what, "%s: half.y", fn);
@@ -45,11 +45,11 @@ static sdfccd_Status make_box(sdfccd_Vec3 half, double radius, const char* fn, s
     if ((st = positive(half.z, what))) return st;
     double m = fmin(half.x, fmin(half.y, half.z));
     if (!isfinite(radius) || radius < 0.0 || radius > m)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: radius must be in [0, %g] (got %g)", fn, m, radius);
-    capi_sdf* s = new_shape(sizeof(scc_sdf_box), "a box");
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: radius must be in [0, %g] (got %g)", fn, m, radius);
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_box), "a box");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
-    scc_sdf_box_init(s->storage, capi_v(half), radius);
-    return capi_sdf_register(s, out_sdf);
+    scc_sdf_box_init(s->storage, sdfccd__v(half), radius);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 sdfccd_Status sdfccd_create_box(sdfccd_Vec3 half, sdfccd_SdfId* out_sdf)
@@ -65,53 +65,53 @@ sdfccd_Status sdfccd_create_rounded_box(sdfccd_Vec3 half, double radius, sdfccd_
 sdfccd_Status sdfccd_create_torus(double major, double minor, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_sdf, "sdfccd_create_torus: out_sdf")) || (st = positive(major, "sdfccd_create_torus: major")) ||
+    if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_torus: out_sdf")) || (st = positive(major, "sdfccd_create_torus: major")) ||
         (st = positive(minor, "sdfccd_create_torus: minor")))
         return st;
-    if (!(minor < major)) return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_torus: minor (%g) must be < major (%g)", minor, major);
-    capi_sdf* s = new_shape(sizeof(scc_sdf_torus), "a torus");
+    if (!(minor < major)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_torus: minor (%g) must be < major (%g)", minor, major);
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_torus), "a torus");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     scc_sdf_torus_init(s->storage, major, minor);
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 sdfccd_Status sdfccd_create_capsule(double half_height, double radius, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_sdf, "sdfccd_create_capsule: out_sdf")) || (st = positive(radius, "sdfccd_create_capsule: radius")))
+    if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_capsule: out_sdf")) || (st = positive(radius, "sdfccd_create_capsule: radius")))
         return st;
     if (!isfinite(half_height) || half_height < 0.0)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_capsule: half_height must be finite and >= 0 (got %g)", half_height);
-    capi_sdf* s = new_shape(sizeof(scc_sdf_capsule), "a capsule");
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_capsule: half_height must be finite and >= 0 (got %g)", half_height);
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_capsule), "a capsule");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     scc_sdf_capsule_init(s->storage, half_height, radius);
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 sdfccd_Status sdfccd_create_cylinder(double half_height, double radius, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_sdf, "sdfccd_create_cylinder: out_sdf")) || (st = positive(radius, "sdfccd_create_cylinder: radius")) ||
+    if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_cylinder: out_sdf")) || (st = positive(radius, "sdfccd_create_cylinder: radius")) ||
         (st = positive(half_height, "sdfccd_create_cylinder: half_height")))
         return st;
-    capi_sdf* s = new_shape(sizeof(scc_sdf_cylinder), "a cylinder");
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_cylinder), "a cylinder");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     scc_sdf_cylinder_init(s->storage, half_height, radius);
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 sdfccd_Status sdfccd_create_half_space(sdfccd_Vec3 normal, double offset, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_sdf, "sdfccd_create_half_space: out_sdf")) || (st = capi_check_vec(normal, "sdfccd_create_half_space: normal")) ||
-        (st = capi_check_finite(offset, "sdfccd_create_half_space: offset")))
+    if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_half_space: out_sdf")) || (st = sdfccd__check_vec(normal, "sdfccd_create_half_space: normal")) ||
+        (st = sdfccd__check_finite(offset, "sdfccd_create_half_space: offset")))
         return st;
     double l = sqrt(normal.x * normal.x + normal.y * normal.y + normal.z * normal.z);
-    if (!(l > 1e-12)) return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_half_space: normal has zero length");
-    capi_sdf* s = new_shape(sizeof(scc_sdf_half_space), "a half-space");
+    if (!(l > 1e-12)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_half_space: normal has zero length");
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_half_space), "a half-space");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
-    scc_sdf_half_space_init(s->storage, scc_scale(capi_v(normal), 1.0 / l), offset / l);
-    return capi_sdf_register(s, out_sdf);
+    scc_sdf_half_space_init(s->storage, scc_scale(sdfccd__v(normal), 1.0 / l), offset / l);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 sdfccd_SpikeGridDef sdfccd_default_spike_grid_def(void)
@@ -129,56 +129,56 @@ sdfccd_SpikeGridDef sdfccd_default_spike_grid_def(void)
 sdfccd_Status sdfccd_create_spike_grid(const sdfccd_SpikeGridDef* def, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(def, "sdfccd_create_spike_grid: def")) || (st = capi_check_ptr(out_sdf, "sdfccd_create_spike_grid: out_sdf")))
+    if ((st = sdfccd__check_ptr(def, "sdfccd_create_spike_grid: def")) || (st = sdfccd__check_ptr(out_sdf, "sdfccd_create_spike_grid: out_sdf")))
         return st;
     if (def->internal_value != DEF_COOKIE)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_spike_grid: def was not initialised with sdfccd_default_spike_grid_def()");
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_spike_grid: def was not initialised with sdfccd_default_spike_grid_def()");
     if ((st = positive(def->spacing, "spike grid spacing")) || (st = positive(def->base_radius, "spike grid base_radius")) ||
         (st = positive(def->height, "spike grid height")))
         return st;
     if (def->base_radius > 0.5 * def->spacing)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_spike_grid: base_radius (%g) must be <= spacing / 2 (%g)", def->base_radius, 0.5 * def->spacing);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_spike_grid: base_radius (%g) must be <= spacing / 2 (%g)", def->base_radius, 0.5 * def->spacing);
     if (def->count_x < 1 || def->count_y < 1 || def->count_x > 100000 || def->count_y > 100000)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_spike_grid: counts must be in [1, 100000] (got %d x %d)", def->count_x, def->count_y);
-    capi_sdf* s = new_shape(sizeof(scc_sdf_spike_grid), "a spike grid");
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_spike_grid: counts must be in [1, 100000] (got %d x %d)", def->count_x, def->count_y);
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_spike_grid), "a spike grid");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     scc_sdf_spike_grid_init(s->storage, def->spacing, def->base_radius, def->height, def->count_x, def->count_y);
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 sdfccd_Status sdfccd_create_csg(sdfccd_CsgOp op, sdfccd_SdfId a, sdfccd_SdfId b, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_sdf, "sdfccd_create_csg: out_sdf"))) return st;
+    if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_csg: out_sdf"))) return st;
     if (op != SDFCCD_CSG_UNION && op != SDFCCD_CSG_INTERSECTION && op != SDFCCD_CSG_DIFFERENCE)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_csg: unknown operation %d", (int)op);
-    capi_sdf* sa = capi_sdf_lookup(a);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_csg: unknown operation %d", (int)op);
+    sdfccd__sdf* sa = sdfccd__sdf_lookup(a);
     if (!sa) return SDFCCD_INVALID_HANDLE;
-    capi_sdf* sb = capi_sdf_lookup(b);
+    sdfccd__sdf* sb = sdfccd__sdf_lookup(b);
     if (!sb) return SDFCCD_INVALID_HANDLE;
-    capi_sdf* s = new_shape(sizeof(scc_sdf_csg), "a CSG combination");
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_csg), "a CSG combination");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     scc_csg_op cop = op == SDFCCD_CSG_UNION ? SCC_CSG_UNION : op == SDFCCD_CSG_INTERSECTION ? SCC_CSG_INTERSECTION : SCC_CSG_DIFFERENCE;
     scc_sdf_csg_init(s->storage, cop, sa->sdf, sb->sdf);
-    capi_sdf_retain(sa);
-    capi_sdf_retain(sb);
+    sdfccd__sdf_retain(sa);
+    sdfccd__sdf_retain(sb);
     s->children[0] = sa;
     s->children[1] = sb;
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 /* Validates a pose and returns it as a core transform with a normalised rotation. */
-sdfccd_Status capi_check_pose(sdfccd_Pose pose, const char* what, scc_xform* out)
+sdfccd_Status sdfccd__check_pose(sdfccd_Pose pose, const char* what, scc_xform* out)
 {
     sdfccd_Status st;
-    if ((st = capi_check_vec(pose.position, what))) return st;
+    if ((st = sdfccd__check_vec(pose.position, what))) return st;
     sdfccd_Quat q = pose.orientation;
     if (!isfinite(q.w) || !isfinite(q.x) || !isfinite(q.y) || !isfinite(q.z))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: orientation is not finite", what);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: orientation is not finite", what);
     scc_quat cq = { q.w, q.x, q.y, q.z };
-    if (!(scc_quat_norm(cq) > 1e-12)) return capi_error(SDFCCD_INVALID_ARGUMENT, "%s: orientation is a zero quaternion", what);
+    if (!(scc_quat_norm(cq) > 1e-12)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: orientation is a zero quaternion", what);
     out->q = scc_quat_normalize(cq);
-    out->p = capi_v(pose.position);
+    out->p = sdfccd__v(pose.position);
     return SDFCCD_OK;
 }
 
@@ -186,17 +186,17 @@ sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, do
 {
     sdfccd_Status st;
     scc_xform xf;
-    if ((st = capi_check_ptr(out_sdf, "sdfccd_create_transformed: out_sdf")) || (st = positive(scale, "sdfccd_create_transformed: scale")) ||
-        (st = capi_check_pose(pose, "sdfccd_create_transformed: pose", &xf)))
+    if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_transformed: out_sdf")) || (st = positive(scale, "sdfccd_create_transformed: scale")) ||
+        (st = sdfccd__check_pose(pose, "sdfccd_create_transformed: pose", &xf)))
         return st;
-    capi_sdf* c = capi_sdf_lookup(child);
+    sdfccd__sdf* c = sdfccd__sdf_lookup(child);
     if (!c) return SDFCCD_INVALID_HANDLE;
-    capi_sdf* s = new_shape(sizeof(scc_sdf_transform), "a transformed SDF");
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_transform), "a transformed SDF");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     scc_sdf_transform_init(s->storage, c->sdf, xf, scale);
-    capi_sdf_retain(c);
+    sdfccd__sdf_retain(c);
     s->children[0] = c;
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 /* ---- user callbacks ---- */
@@ -210,9 +210,9 @@ static double callback_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
     const callback_sdf* c = (const callback_sdf*)self;
     sdfccd_Vec3 gp = { 0.0, 0.0, 1.0 };
-    double v = c->fn(capi_pv(p), g ? &gp : NULL, c->user);
+    double v = c->fn(sdfccd__pv(p), g ? &gp : NULL, c->user);
     if (g) {
-        *g = capi_v(gp);
+        *g = sdfccd__v(gp);
         if (!scc_vfinite(*g)) *g = scc_v3(0.0, 0.0, 1.0); /* never hand NaN to a solver */
     }
     return v;
@@ -232,53 +232,53 @@ sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void)
 sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(def, "sdfccd_create_callback_sdf: def")) || (st = capi_check_ptr(out_sdf, "sdfccd_create_callback_sdf: out_sdf")))
+    if ((st = sdfccd__check_ptr(def, "sdfccd_create_callback_sdf: def")) || (st = sdfccd__check_ptr(out_sdf, "sdfccd_create_callback_sdf: out_sdf")))
         return st;
     if (def->internal_value != DEF_COOKIE)
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def was not initialised with sdfccd_default_callback_sdf_def()");
-    if (!def->eval) return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def->eval is NULL");
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def was not initialised with sdfccd_default_callback_sdf_def()");
+    if (!def->eval) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def->eval is NULL");
     if ((st = positive(def->lipschitz, "sdfccd_create_callback_sdf: lipschitz"))) return st;
     if (isnan(def->bounds.lo.x) || isnan(def->bounds.lo.y) || isnan(def->bounds.lo.z) || isnan(def->bounds.hi.x) ||
         isnan(def->bounds.hi.y) || isnan(def->bounds.hi.z))
-        return capi_error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: bounds contain NaN");
-    capi_sdf* s = new_shape(sizeof(callback_sdf), "a callback SDF");
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: bounds contain NaN");
+    sdfccd__sdf* s = new_shape(sizeof(callback_sdf), "a callback SDF");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     callback_sdf* c = s->storage;
     c->base.eval = callback_eval;
     c->base.lipschitz_in = NULL;
     c->base.domain.lo = scc_v3(-INFINITY, -INFINITY, -INFINITY);
     c->base.domain.hi = scc_v3(INFINITY, INFINITY, INFINITY);
-    c->base.bounds = capi_box(def->bounds);
+    c->base.bounds = sdfccd__box(def->bounds);
     c->base.lipschitz = def->lipschitz;
     c->base.convex = 0;
     c->base.convex_in = NULL;
     c->base.kind = SCC_SDF_CALLBACK;
     c->fn = def->eval;
     c->user = def->user;
-    return capi_sdf_register(s, out_sdf);
+    return sdfccd__sdf_register(s, out_sdf);
 }
 
 sdfccd_Status sdfccd_sdf_eval(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_value, "sdfccd_sdf_eval: out_value")) || (st = capi_check_vec(p, "sdfccd_sdf_eval: p"))) return st;
-    capi_sdf* s = capi_sdf_lookup(sdf);
+    if ((st = sdfccd__check_ptr(out_value, "sdfccd_sdf_eval: out_value")) || (st = sdfccd__check_vec(p, "sdfccd_sdf_eval: p"))) return st;
+    sdfccd__sdf* s = sdfccd__sdf_lookup(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     scc_vec3 g;
-    *out_value = scc_sdf_eval(s->sdf, capi_v(p), out_grad ? &g : NULL);
-    if (out_grad) *out_grad = capi_pv(g);
+    *out_value = scc_sdf_eval(s->sdf, sdfccd__v(p), out_grad ? &g : NULL);
+    if (out_grad) *out_grad = sdfccd__pv(g);
     return SDFCCD_OK;
 }
 
 sdfccd_Status sdfccd_sdf_get_info(sdfccd_SdfId sdf, sdfccd_SdfInfo* out_info)
 {
     sdfccd_Status st;
-    if ((st = capi_check_ptr(out_info, "sdfccd_sdf_get_info: out_info"))) return st;
-    capi_sdf* s = capi_sdf_lookup(sdf);
+    if ((st = sdfccd__check_ptr(out_info, "sdfccd_sdf_get_info: out_info"))) return st;
+    sdfccd__sdf* s = sdfccd__sdf_lookup(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     out_info->kind = (sdfccd_SdfKind)s->sdf->kind;
-    out_info->domain = capi_pbox(s->sdf->domain);
-    out_info->bounds = capi_pbox(s->sdf->bounds);
+    out_info->domain = sdfccd__pbox(s->sdf->domain);
+    out_info->bounds = sdfccd__pbox(s->sdf->bounds);
     out_info->lipschitz = s->sdf->lipschitz;
     out_info->memory_bytes = s->memory_bytes + (int64_t)sizeof *s;
     return SDFCCD_OK;
