@@ -5,6 +5,7 @@ sdfccd_add_check_test(test_sweep test_sweep.c)
 sdfccd_add_check_test(test_sdf test_sdf.c)
 sdfccd_add_check_test(test_solvers test_solvers.c)
 sdfccd_add_check_test(test_api test_api.c)
+sdfccd_add_check_test(test_fall test_fall.c)
 
 # Packaging: cmake --install, then find_package(sdfccd) and pkg-config from a separate project.
 add_test(NAME install_consumer COMMAND ${CMAKE_COMMAND}
