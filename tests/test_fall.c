@@ -13,7 +13,7 @@
 #include "ccd.h"
 #include "sdf_analytic.h"
 #include "test_util.h"
-#include "capi_internal.h" /* capi_convert_params */
+#include "capi_internal.h" /* sdfccd__convert_params */
 
 #define DT (1.0 / 60.0)
 
@@ -64,7 +64,7 @@ static scc_params params_of(sdfccd_Method m)
     sdfccd_QueryParams pub = sdfccd_default_query_params();
     pub.method = m;
     scc_params p;
-    ck_assert_int_eq(capi_convert_params(&pub, "test_fall", &p), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd__convert_params(&pub, "test_fall", &p), SDFCCD_OK);
     return p;
 }
 
