@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT
- * sdfccd C ABI: allocator hooks and byte count, error messages, version queries and the
- * generation-checked handle registry shared by SDFs and meshes. */
+ * sdfccd C ABI: allocator hooks and byte count, error messages, version queries, the
+ * generation-checked handle registry shared by SDFs and meshes, and SDF objects (mesh objects
+ * are in mesh_api.c). */
 #include "capi_internal.h"
-#include "../../core/bsh.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -138,8 +138,6 @@ const char* sdfccd_configuration_string(void)
 
 /* ---------------- handle registry ---------------- */
 
-enum { KIND_FREE = 0, KIND_SDF = 1, KIND_MESH = 2 };
-
 typedef struct slot {
     void* obj;
     uint32_t generation;
@@ -156,11 +154,11 @@ static uint32_t s_free_head = UINT32_MAX;
 static void registry_maybe_shrink(void)
 {
     for (uint32_t i = 0; i < s_slot_count; ++i)
-        if (s_slots[i].kind != KIND_FREE) return;
+        if (s_slots[i].kind != SDFCCD__KIND_FREE) return;
     /* Keep the generations growing across a reset so stale ids never match again. */
 }
 
-static int registry_add(void* obj, uint32_t kind, uint32_t* out_index1, uint32_t* out_generation)
+int sdfccd__registry_add(void* obj, uint32_t kind, uint32_t* out_index1, uint32_t* out_generation)
 {
     pthread_mutex_lock(&s_lock);
     uint32_t i;
@@ -189,7 +187,7 @@ static int registry_add(void* obj, uint32_t kind, uint32_t* out_index1, uint32_t
     return 1;
 }
 
-static void* registry_get(uint32_t index1, uint32_t generation, uint32_t kind)
+void* sdfccd__registry_get(uint32_t index1, uint32_t generation, uint32_t kind)
 {
     void* obj = NULL;
     pthread_mutex_lock(&s_lock);
@@ -202,7 +200,7 @@ static void* registry_get(uint32_t index1, uint32_t generation, uint32_t kind)
 }
 
 /* Removes the entry and returns its object (NULL if the id is not live). */
-static void* registry_remove(uint32_t index1, uint32_t generation, uint32_t kind)
+void* sdfccd__registry_remove(uint32_t index1, uint32_t generation, uint32_t kind)
 {
     void* obj = NULL;
     pthread_mutex_lock(&s_lock);
@@ -211,7 +209,7 @@ static void* registry_remove(uint32_t index1, uint32_t generation, uint32_t kind
         if (s->kind == kind && s->generation == generation) {
             obj = s->obj;
             s->obj = NULL;
-            s->kind = KIND_FREE;
+            s->kind = SDFCCD__KIND_FREE;
             s->next_free = s_free_head;
             s_free_head = index1 - 1;
             registry_maybe_shrink();
@@ -260,7 +258,7 @@ void sdfccd__sdf_retain(sdfccd__sdf* s)
 sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id)
 {
     sdfccd_SdfId id = { 0, 0 };
-    if (!registry_add(s, KIND_SDF, &id.index1, &id.generation)) {
+    if (!sdfccd__registry_add(s, SDFCCD__KIND_SDF, &id.index1, &id.generation)) {
         sdfccd__sdf_release(s);
         return sdfccd__oom("an SDF handle");
     }
@@ -270,162 +268,16 @@ sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id)
 
 sdfccd__sdf* sdfccd__sdf_lookup(sdfccd_SdfId id)
 {
-    sdfccd__sdf* s = registry_get(id.index1, id.generation, KIND_SDF);
+    sdfccd__sdf* s = sdfccd__registry_get(id.index1, id.generation, SDFCCD__KIND_SDF);
     if (!s) sdfccd__error(SDFCCD_INVALID_HANDLE, "SDF handle {%u, %u} is not a live SDF", id.index1, id.generation);
     return s;
 }
 
 sdfccd_Status sdfccd_destroy_sdf(sdfccd_SdfId id)
 {
-    sdfccd__sdf* s = registry_remove(id.index1, id.generation, KIND_SDF);
+    sdfccd__sdf* s = sdfccd__registry_remove(id.index1, id.generation, SDFCCD__KIND_SDF);
     if (!s) return sdfccd__error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_sdf: handle {%u, %u} is not a live SDF", id.index1, id.generation);
     sdfccd__sdf_release(s);
-    return SDFCCD_OK;
-}
-
-/* ---------------- mesh objects ---------------- */
-
-sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count, const uint32_t* indices,
-                                  uint32_t triangle_count, int drop_degenerate, const char* what,
-                               sdfccd_MeshId* out_mesh)
-{
-    if (!vertices || !indices) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertices or indices is NULL", what);
-    if (vertex_count == 0 || triangle_count == 0)
-        return sdfccd__error(SDFCCD_DEGENERATE, "%s: the mesh is empty (%u vertices, %u triangles)", what, vertex_count, triangle_count);
-    if (vertex_count > (1u << 30) || triangle_count > (1u << 30))
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: too many vertices or triangles", what);
-    for (uint32_t i = 0; i < 3 * vertex_count; ++i)
-        if (!isfinite(vertices[i]))
-            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate", what, i / 3);
-    uint32_t kept = 0;
-    for (uint32_t t = 0; t < triangle_count; ++t) {
-        const uint32_t* f = indices + 3 * t;
-        if (f[0] >= vertex_count || f[1] >= vertex_count || f[2] >= vertex_count)
-            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: triangle %u has a vertex index out of range (%u vertices)", what, t, vertex_count);
-        scc_vec3 a = { vertices[3 * f[0]], vertices[3 * f[0] + 1], vertices[3 * f[0] + 2] };
-        scc_vec3 b = { vertices[3 * f[1]], vertices[3 * f[1] + 1], vertices[3 * f[1] + 2] };
-        scc_vec3 c = { vertices[3 * f[2]], vertices[3 * f[2] + 1], vertices[3 * f[2] + 2] };
-        double scale = fmax(scc_len2(scc_sub(b, a)), scc_len2(scc_sub(c, a)));
-        int degenerate = !(scc_triangle_area2(a, b, c) > 1e-12 * scale) || scale == 0.0;
-        if (degenerate && !drop_degenerate)
-            return sdfccd__error(SDFCCD_DEGENERATE, "%s: triangle %u (vertices %u %u %u) has zero area", what, t, f[0], f[1], f[2]);
-        kept += !degenerate;
-    }
-    if (kept == 0) return sdfccd__error(SDFCCD_DEGENERATE, "%s: every triangle has zero area", what);
-
-    size_t vbytes = (size_t)vertex_count * sizeof(scc_vec3);
-    size_t ibytes = (size_t)kept * 3 * sizeof(uint32_t);
-    sdfccd__mesh* m = sdfccd__calloc(sizeof *m);
-    void* block = sdfccd__alloc(vbytes + ibytes);
-    if (!m || !block) {
-        sdfccd__free(m, sizeof *m);
-        sdfccd__free(block, vbytes + ibytes);
-        return sdfccd__oom("a mesh");
-    }
-    scc_vec3* v = block;
-    uint32_t* idx = (uint32_t*)((char*)block + vbytes);
-    scc_aabb box = { { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY } };
-    for (uint32_t i = 0; i < vertex_count; ++i) {
-        v[i] = scc_v3(vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2]);
-        box.lo = scc_vmin(box.lo, v[i]);
-        box.hi = scc_vmax(box.hi, v[i]);
-    }
-    uint32_t k = 0;
-    for (uint32_t t = 0; t < triangle_count; ++t) {
-        const uint32_t* f = indices + 3 * t;
-        double scale = fmax(scc_len2(scc_sub(v[f[1]], v[f[0]])), scc_len2(scc_sub(v[f[2]], v[f[0]])));
-        if (!(scc_triangle_area2(v[f[0]], v[f[1]], v[f[2]]) > 1e-12 * scale) || scale == 0.0) continue;
-        idx[3 * k] = f[0]; idx[3 * k + 1] = f[1]; idx[3 * k + 2] = f[2];
-        ++k;
-    }
-    m->block = block;
-    m->block_size = vbytes + ibytes;
-    m->mesh.vertices = v;
-    m->mesh.indices = idx;
-    m->mesh.vertex_count = vertex_count;
-    m->mesh.triangle_count = kept;
-    m->mesh.bounds = box;
-    m->dropped_triangles = triangle_count - kept;
-    m->refs = 1;
-    m->bsh = scc_bsh_build(&m->mesh, sdfccd__allocator()); /* broad phase of the mesh query */
-    if (!m->bsh) {
-        sdfccd__free(block, m->block_size);
-        sdfccd__free(m, sizeof *m);
-        return sdfccd__oom("a mesh's bounding-sphere hierarchy");
-    }
-    m->mesh.bsh = m->bsh;
-    sdfccd_MeshId id = { 0, 0 };
-    if (!registry_add(m, KIND_MESH, &id.index1, &id.generation)) {
-        scc_bsh_destroy(m->bsh, sdfccd__allocator());
-        sdfccd__free(block, m->block_size);
-        sdfccd__free(m, sizeof *m);
-        return sdfccd__oom("a mesh handle");
-    }
-    *out_mesh = id;
-    return SDFCCD_OK;
-}
-
-sdfccd__mesh* sdfccd__mesh_lookup(sdfccd_MeshId id)
-{
-    sdfccd__mesh* m = registry_get(id.index1, id.generation, KIND_MESH);
-    if (!m) sdfccd__error(SDFCCD_INVALID_HANDLE, "mesh handle {%u, %u} is not a live mesh", id.index1, id.generation);
-    return m;
-}
-
-sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId id)
-{
-    sdfccd__mesh* m = registry_remove(id.index1, id.generation, KIND_MESH);
-    if (!m) return sdfccd__error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_mesh: handle {%u, %u} is not a live mesh", id.index1, id.generation);
-    scc_bsh_destroy(m->bsh, sdfccd__allocator());
-    sdfccd__free(m->block, m->block_size);
-    sdfccd__free(m, sizeof *m);
-    return SDFCCD_OK;
-}
-
-sdfccd_MeshDef sdfccd_default_mesh_def(void)
-{
-    sdfccd_MeshDef d;
-    memset(&d, 0, sizeof d);
-    d.internal_value = 0x5DFCCD01;
-    return d;
-}
-
-sdfccd_Status sdfccd_create_mesh(const sdfccd_MeshDef* def, sdfccd_MeshId* out_mesh)
-{
-    sdfccd_Status st;
-    if ((st = sdfccd__check_ptr(def, "sdfccd_create_mesh: def")) || (st = sdfccd__check_ptr(out_mesh, "sdfccd_create_mesh: out_mesh")))
-        return st;
-    if (def->internal_value != 0x5DFCCD01)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_mesh: def was not initialised with sdfccd_default_mesh_def()");
-    return sdfccd__mesh_create(def->vertices, def->vertex_count, def->indices, def->triangle_count,
-                               def->drop_degenerate, "sdfccd_create_mesh", out_mesh);
-}
-
-sdfccd_Status sdfccd_mesh_get_info(sdfccd_MeshId id, sdfccd_MeshInfo* out_info)
-{
-    sdfccd_Status st;
-    if ((st = sdfccd__check_ptr(out_info, "sdfccd_mesh_get_info: out_info"))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(id);
-    if (!m) return SDFCCD_INVALID_HANDLE;
-    out_info->vertex_count = m->mesh.vertex_count;
-    out_info->triangle_count = m->mesh.triangle_count;
-    out_info->dropped_triangles = m->dropped_triangles;
-    out_info->bounds = sdfccd__pbox(m->mesh.bounds);
-    out_info->memory_bytes = (int64_t)(m->block_size + sizeof *m + (m->bsh ? m->bsh->bytes : 0));
-    return SDFCCD_OK;
-}
-
-sdfccd_Status sdfccd_mesh_get_data(sdfccd_MeshId id, double* out_vertices, uint32_t* out_indices)
-{
-    sdfccd__mesh* m = sdfccd__mesh_lookup(id);
-    if (!m) return SDFCCD_INVALID_HANDLE;
-    if (out_vertices)
-        for (uint32_t i = 0; i < m->mesh.vertex_count; ++i) {
-            out_vertices[3 * i] = m->mesh.vertices[i].x;
-            out_vertices[3 * i + 1] = m->mesh.vertices[i].y;
-            out_vertices[3 * i + 2] = m->mesh.vertices[i].z;
-        }
-    if (out_indices) memcpy(out_indices, m->mesh.indices, (size_t)m->mesh.triangle_count * 3 * sizeof(uint32_t));
     return SDFCCD_OK;
 }
 

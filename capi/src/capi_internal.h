@@ -38,6 +38,15 @@ static inline sdfccd_Vec3 sdfccd__pv(scc_vec3 v) { sdfccd_Vec3 r = { v.x, v.y, v
 static inline scc_aabb sdfccd__box(sdfccd_Aabb b) { scc_aabb r = { sdfccd__v(b.lo), sdfccd__v(b.hi) }; return r; }
 static inline sdfccd_Aabb sdfccd__pbox(scc_aabb b) { sdfccd_Aabb r = { sdfccd__pv(b.lo), sdfccd__pv(b.hi) }; return r; }
 
+/* ---- the handle registry (base.c), shared by SDF and mesh objects ---- */
+enum { SDFCCD__KIND_FREE = 0, SDFCCD__KIND_SDF = 1, SDFCCD__KIND_MESH = 2 };
+/* Adds `obj` under a new generation-checked id; 0 when the table cannot grow. */
+int sdfccd__registry_add(void* obj, uint32_t kind, uint32_t* out_index1, uint32_t* out_generation);
+/* The live object of that id and kind, or NULL. */
+void* sdfccd__registry_get(uint32_t index1, uint32_t generation, uint32_t kind);
+/* Removes the entry and returns its object (NULL if the id is not live). */
+void* sdfccd__registry_remove(uint32_t index1, uint32_t generation, uint32_t kind);
+
 /* ---- SDF objects ----
  * A sdfccd__sdf owns one block `storage` (the concrete core SDF, which embeds scc_sdf first),
  * optional extra memory freed by `release_extra`, and references to up to two children. */
@@ -62,7 +71,7 @@ sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id);
 /* Looks up a live handle; NULL (with an INVALID_HANDLE message set) when unknown. */
 sdfccd__sdf* sdfccd__sdf_lookup(sdfccd_SdfId id);
 
-/* ---- mesh objects ---- */
+/* ---- mesh objects (mesh_api.c) ---- */
 typedef struct sdfccd__mesh {
     scc_mesh mesh;                   /* arrays point into `block` */
     void* block;
@@ -78,6 +87,9 @@ sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count,
                                   uint32_t triangle_count, int drop_degenerate, const char* what,
                                sdfccd_MeshId* out_mesh);
 sdfccd__mesh* sdfccd__mesh_lookup(sdfccd_MeshId id);
+/* DEGENERATE with a message when the topology cannot give correct signs, else OK. */
+struct scc_mesh_topology;
+sdfccd_Status sdfccd__mesh_topology_message(const struct scc_mesh_topology* t, const char* fn);
 
 /* Validates public query params and converts them to the core's (the only place this is done;
  * internal tools that call the core directly use it too). Declared with an incomplete type so

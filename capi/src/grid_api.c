@@ -216,18 +216,6 @@ static double mesh_sample(void* user, scc_vec3 p, uint32_t* state, double cap)
     return c->sign * scc_mesh_sdf_distance_capped(c->ms, p, state, cap);
 }
 
-sdfccd_Status sdfccd__mesh_topology_message(const scc_mesh_topology* t, const char* fn)
-{
-    if (!t->closed)
-        return sdfccd__error(SDFCCD_DEGENERATE,
-                             "%s: the mesh is not closed (%u boundary, %u non-manifold, %u inconsistently oriented edges); "
-                          "signs would be wrong (set allow_open_mesh to build anyway)",
-                          fn, t->boundary_edges, t->nonmanifold_edges, t->inconsistent_edges);
-    if (!(t->volume > 0.0))
-        return sdfccd__error(SDFCCD_DEGENERATE, "%s: the mesh is inside out (signed volume %g <= 0); flip its triangles", fn, t->volume);
-    return SDFCCD_OK;
-}
-
 sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
 {
     static const char* fn = "sdfccd_create_grid_from_mesh";

@@ -13,9 +13,6 @@ sdfccd_Status sdfccd__grid_register(scc_grid* g, sdfccd_SdfId* out_sdf);
 sdfccd_Status sdfccd__grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid);
 /* Size of the .cdf file of a grid. */
 int64_t sdfccd__grid_file_bytes(const scc_grid* g);
-/* DEGENERATE with a message when the topology cannot give correct signs, else OK. */
-struct scc_mesh_topology;
-sdfccd_Status sdfccd__mesh_topology_message(const struct scc_mesh_topology* t, const char* fn);
 
 /* Runs a parallel_for on `threads` threads (0 = online cores) and reports progress. */
 typedef struct sdfccd__pool {

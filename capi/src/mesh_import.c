@@ -1,14 +1,13 @@
 /* SPDX-License-Identifier: MIT
- * sdfccd C ABI: triangle mesh import through assimp's C API (triangulation, node transforms,
- * exact-position vertex welding), the mesh topology report and exact signed distance queries. */
-#include "grid_internal.h"
+ * sdfccd C ABI: sdfccd_load_mesh, triangle mesh import from files: `.obj` through our own reader
+ * in double precision (obj_reader.c), every other format through assimp's C API (triangulation,
+ * node transforms; float positions), then exact-position vertex welding shared by both. */
+#include "mesh_import.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "../../core/mesh_distance.h"
 
 #if SDFCCD_HAVE_ASSIMP
 #include <assimp/cimport.h>
@@ -53,9 +52,8 @@ static uint64_t hash_pos(const double* p)
 
 static int same_pos(const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
 
-/* Welds `verts` in place (when merge is set), rewrites `idx`, and creates the mesh handle. */
-static sdfccd_Status finish_mesh(double* verts, uint32_t nv, uint32_t* idx, uint32_t nt, const sdfccd_MeshLoadDef* d,
-                                 const char* path, sdfccd_MeshId* out_mesh)
+sdfccd_Status sdfccd__finish_imported_mesh(double* verts, uint32_t nv, uint32_t* idx, uint32_t nt, const sdfccd_MeshLoadDef* d,
+                                          const char* path, sdfccd_MeshId* out_mesh)
 {
     if (nt == 0 || nv == 0) return sdfccd__error(SDFCCD_DEGENERATE, "sdfccd_load_mesh: '%s' contains no triangles", path);
     for (uint32_t i = 0; i < 3 * nv; ++i) verts[i] *= d->scale;
@@ -96,96 +94,6 @@ static sdfccd_Status finish_mesh(double* verts, uint32_t nv, uint32_t* idx, uint
     return sdfccd__mesh_create(verts, out_v, idx, nt, d->drop_degenerate, what, out_mesh);
 }
 
-/* ---------------- Wavefront OBJ, read in double precision ----------------
- * Debian's assimp stores positions as 32-bit floats, which would round every coordinate of an
- * OBJ file written with more digits and break agreement with Discregrid (which parses doubles),
- * so OBJ files are read here: `v x y z` and `f` records (polygons fan-triangulated, `i/t/n`
- * forms, negative relative indices); every other record is ignored. */
-
-typedef struct growbuf { void* p; size_t used, cap, elem; } growbuf;
-
-static int grow_push(growbuf* b, const void* v)
-{
-    if (b->used == b->cap) {
-        size_t nc = b->cap ? 2 * b->cap : 1024;
-        void* np = sdfccd__alloc(nc * b->elem);
-        if (!np) return 0;
-        if (b->p) memcpy(np, b->p, b->used * b->elem);
-        sdfccd__free(b->p, b->cap * b->elem);
-        b->p = np;
-        b->cap = nc;
-    }
-    memcpy((char*)b->p + b->used * b->elem, v, b->elem);
-    b->used++;
-    return 1;
-}
-
-static sdfccd_Status load_obj(const char* path, const sdfccd_MeshLoadDef* d, sdfccd_MeshId* out_mesh)
-{
-    FILE* f = fopen(path, "rb");
-    if (!f) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot open '%s': %s", path, strerror(errno));
-    growbuf v = { NULL, 0, 0, 3 * sizeof(double) }, t = { NULL, 0, 0, 3 * sizeof(uint32_t) };
-    sdfccd_Status st = SDFCCD_OK;
-    char line[4096];
-    unsigned long lineno = 0;
-    int bad_line = 0;
-    while (fgets(line, sizeof line, f)) {
-        ++lineno;
-        size_t len = strlen(line);
-        if (len == sizeof line - 1 && line[len - 1] != '\n' && !feof(f)) {
-            st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu is longer than %zu characters", path, lineno, sizeof line - 2);
-            break;
-        }
-        char* s = line;
-        while (*s == ' ' || *s == '\t') ++s;
-        if (s[0] == 'v' && (s[1] == ' ' || s[1] == '\t')) {
-            double p[3];
-            char* e = s + 1;
-            for (int k = 0; k < 3; ++k) {
-                char* next;
-                p[k] = strtod(e, &next);
-                if (next == e || !isfinite(p[k])) { bad_line = 1; break; }
-                e = next;
-            }
-            if (bad_line) { st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu: bad vertex", path, lineno); break; }
-            if (!grow_push(&v, p)) { st = sdfccd__oom("an imported mesh"); break; }
-        } else if (s[0] == 'f' && (s[1] == ' ' || s[1] == '\t')) {
-            uint32_t first = 0, prev = 0;
-            int n = 0;
-            char* e = s + 1;
-            for (;;) {
-                while (*e == ' ' || *e == '\t') ++e;
-                if (*e == '\0' || *e == '\n' || *e == '\r' || *e == '#') break;
-                char* next;
-                long long k = strtoll(e, &next, 10);
-                if (next == e) { bad_line = 1; break; }
-                while (*next && *next != ' ' && *next != '\t' && *next != '\n' && *next != '\r') ++next; /* skip /t/n */
-                e = next;
-                long long vi = k > 0 ? k - 1 : (long long)v.used + k;
-                if (k == 0 || vi < 0 || vi >= (long long)v.used) { bad_line = 1; break; }
-                const uint32_t id = (uint32_t)vi;
-                if (n == 0) first = id;
-                else if (n >= 2) {
-                    const uint32_t tri[3] = { first, prev, id };
-                    if (!grow_push(&t, tri)) { st = sdfccd__oom("an imported mesh"); break; }
-                }
-                prev = id;
-                ++n;
-            }
-            if (st) break;
-            if (bad_line) { st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: '%s' line %lu: bad face (index out of range or malformed)", path, lineno); break; }
-        }
-    }
-    if (!st && ferror(f)) st = sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot read '%s'", path);
-    fclose(f);
-    if (!st && (v.used > (1u << 30) || t.used > (1u << 30)))
-        st = sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: '%s' is too large", path);
-    if (!st) st = finish_mesh(v.p, (uint32_t)v.used, t.p, (uint32_t)t.used, d, path, out_mesh);
-    sdfccd__free(v.p, v.cap * v.elem);
-    sdfccd__free(t.p, t.cap * t.elem);
-    return st;
-}
-
 static int has_obj_extension(const char* path)
 {
     size_t n = strlen(path);
@@ -203,7 +111,7 @@ sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, 
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: def was not initialised with sdfccd_default_mesh_load_def()");
     if (!isfinite(d.scale) || d.scale == 0.0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: scale = %g must be finite and non-zero", d.scale);
-    if (has_obj_extension(path)) return load_obj(path, &d, out_mesh);
+    if (has_obj_extension(path)) return sdfccd__load_obj(path, &d, out_mesh);
 #if !SDFCCD_HAVE_ASSIMP
     return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_load_mesh: this build has no assimp (configure with SDFCCD_WITH_ASSIMP=ON); only .obj files load");
 #else
@@ -254,56 +162,9 @@ sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, 
         base += mesh->mNumVertices;
     }
     aiReleaseImport(scene);
-    st = finish_mesh(verts, (uint32_t)nv, idx, out_t, &d, path, out_mesh);
+    st = sdfccd__finish_imported_mesh(verts, (uint32_t)nv, idx, out_t, &d, path, out_mesh);
     sdfccd__free(verts, vbytes);
     sdfccd__free(idx, ibytes);
     return st;
 #endif
-}
-
-/* ---------------- topology and distance ---------------- */
-
-sdfccd_Status sdfccd_mesh_get_topology(sdfccd_MeshId mesh, sdfccd_MeshTopology* out_topology)
-{
-    sdfccd_Status st;
-    if ((st = sdfccd__check_ptr(out_topology, "sdfccd_mesh_get_topology: out_topology"))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
-    if (!m) return SDFCCD_INVALID_HANDLE;
-    scc_mesh_topology t;
-    if (scc_mesh_topology_check(sdfccd__allocator(), &m->mesh, &t) != 0) return sdfccd__oom("a topology check");
-    out_topology->boundary_edges = t.boundary_edges;
-    out_topology->nonmanifold_edges = t.nonmanifold_edges;
-    out_topology->inconsistent_edges = t.inconsistent_edges;
-    out_topology->volume = t.volume;
-    out_topology->closed = t.closed;
-    return SDFCCD_OK;
-}
-
-sdfccd_Status sdfccd_mesh_signed_distance(sdfccd_MeshId mesh, const sdfccd_Vec3* points, int32_t count, int32_t allow_open,
-                                          double* out_distances, sdfccd_Vec3* out_closest)
-{
-    sdfccd_Status st;
-    if (count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_mesh_signed_distance: count = %d < 0", count);
-    if (count > 0 && ((st = sdfccd__check_ptr(points, "sdfccd_mesh_signed_distance: points")) ||
-                      (st = sdfccd__check_ptr(out_distances, "sdfccd_mesh_signed_distance: out_distances"))))
-        return st;
-    for (int32_t i = 0; i < count; ++i)
-        if ((st = sdfccd__check_vec(points[i], "sdfccd_mesh_signed_distance: a point"))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
-    if (!m) return SDFCCD_INVALID_HANDLE;
-    scc_mesh_sdf ms;
-    if (scc_mesh_sdf_init(&ms, sdfccd__allocator(), &m->mesh) != 0) return sdfccd__oom("a mesh distance structure");
-    if (!allow_open && (st = sdfccd__mesh_topology_message(&ms.topology, "sdfccd_mesh_signed_distance"))) {
-        scc_mesh_sdf_destroy(&ms);
-        return st;
-    }
-    uint32_t hint = UINT32_MAX;
-    for (int32_t i = 0; i < count; ++i) {
-        scc_mesh_distance_result r;
-        scc_mesh_sdf_query_hint(&ms, sdfccd__v(points[i]), &hint, &r);
-        out_distances[i] = r.distance;
-        if (out_closest) out_closest[i] = sdfccd__pv(r.closest);
-    }
-    scc_mesh_sdf_destroy(&ms);
-    return SDFCCD_OK;
 }
