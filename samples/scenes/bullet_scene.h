@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: MIT
+/** @file bullet_scene.h  Base of the rigid scenes: a btDiscreteDynamicsWorld stepped with the
+ * sdfccd bridge registered (GImpact meshes against SdfShape / btSdfCollisionShape), or, with
+ * Options::stock, the same SDF surfaces as btBvhTriangleMeshShape triangle meshes (their
+ * isosurface from sdfccd_extract_isosurface) against Bullet's own GImpact algorithm: what users
+ * do today. Both variants build the same bodies from the same code.
+ */
+#ifndef SDFCCD_SCENES_BULLET_SCENE_H
+#define SDFCCD_SCENES_BULLET_SCENE_H
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletCollision/CollisionShapes/btSdfCollisionShape.h>
+#include <BulletCollision/Gimpact/btGImpactShape.h>
+
+#include "sdfccd_bullet/sdfccd_bullet.h"
+#include "scene.h"
+
+namespace scenes {
+
+class BulletScene : public Scene {
+public:
+    BulletScene(const Options& opt, const btVector3& gravity, int up_axis);
+    ~BulletScene() override;
+
+    void step(int i, double dt) override;
+    StepCost cost() const override;
+    double energy() const override;
+    const char* precision() const override { return SDFCCD_BULLET_PRECISION_NAME; }
+    std::string describe() const override;
+
+    /** Called before step i (fire shots, move kinematic bodies). */
+    virtual void beforeStep(int i) {}
+
+    /** A dynamic (mass > 0) or static GImpact body of `mesh` at `pos` with orientation `rot`. */
+    btRigidBody* addMeshBody(const std::shared_ptr<MeshData>& mesh, double mass, const btVector3& pos,
+                             const btQuaternion& rot = btQuaternion::getIdentity());
+    /** A static SDF surface at `pos`/`rot`: SdfShape of `sdf` through the bridge, or (stock) the
+     * isosurface of `sdf` inside `bounds` (local frame) at `stock_resolution` cells along the longest
+     * axis as a btBvhTriangleMeshShape. `exact`/`exact_mesh` is the measuring reference. The scene
+     * takes ownership of `sdf`, `exact` and `exact_mesh` (destroyed with the scene; `exact` may equal `sdf`). */
+    Collider& addStaticSdf(const std::string& name, sdfccd_SdfId sdf, const btVector3& pos, const btQuaternion& rot,
+                           sdfccd_Aabb bounds, int stock_resolution, sdfccd_SdfId exact, sdfccd_MeshId exact_mesh = sdfccd_MeshId());
+    /** A static btSdfCollisionShape read from a .cdf file (bridge variant; stock: the isosurface of
+     * `grid`, the same file loaded by sdfccd). `grid` (owned) is also the measuring reference. */
+    Collider& addStaticBtSdf(const std::string& name, const std::string& cdf_path, sdfccd_SdfId grid, const btVector3& pos,
+                             int stock_resolution);
+    /** Owns an SDF handle (destroyed with the scene). */
+    sdfccd_SdfId own(sdfccd_SdfId id);
+
+    btDiscreteDynamicsWorld* world() { return m_world.get(); }
+    sdfccd_bullet::Bridge* bridge() { return m_bridge.get(); }
+    const Options& options() const { return m_opt; }
+
+protected:
+    void syncBodies();
+    std::string m_description;
+
+private:
+    struct GImpactAsset;
+    struct StockMesh;
+    GImpactAsset* assetFor(const std::shared_ptr<MeshData>& mesh);
+
+    Options m_opt;
+    btVector3 m_gravity;
+    std::unique_ptr<sdfccd_bullet::Bridge> m_bridge;
+    std::unique_ptr<btDefaultCollisionConfiguration> m_config;
+    std::unique_ptr<btCollisionDispatcher> m_dispatcher;
+    std::unique_ptr<btDbvtBroadphase> m_broadphase;
+    std::unique_ptr<btSequentialImpulseConstraintSolver> m_solver;
+    std::unique_ptr<btDiscreteDynamicsWorld> m_world;
+    std::vector<std::unique_ptr<GImpactAsset>> m_assets;
+    std::vector<std::unique_ptr<StockMesh>> m_stock;
+    std::vector<std::unique_ptr<btCollisionShape>> m_shapes;
+    std::vector<std::unique_ptr<btDefaultMotionState>> m_motions;
+    std::vector<std::unique_ptr<btRigidBody>> m_rigid;
+    std::vector<int> m_bodyIndex; // m_rigid[i] -> bodies index or -1 (statics)
+    std::vector<std::vector<char>> m_files;
+    std::vector<sdfccd_SdfId> m_sdfs;
+    std::vector<sdfccd_MeshId> m_meshes;
+    int m_up;
+};
+
+/** Rotation of `angle` radians about `axis`. */
+btQuaternion axisAngle(double ax, double ay, double az, double angle);
+/** A deterministic pseudo-random orientation (index i). */
+btQuaternion tumble(int i);
+
+} // namespace scenes
+
+#endif

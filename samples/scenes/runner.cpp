@@ -1,0 +1,319 @@
+// SPDX-License-Identifier: MIT
+// The measuring loop shared by the runner, the stability tests and the benchmark.
+#include "runner.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "snapshot.h"
+
+namespace scenes {
+
+namespace {
+
+const double kContactPhi = 1e-3; // a sample this close counts as touching (first contact)
+const double kDeepPhi = -1e-3;   // deeper than the 1 mm collision margin
+
+double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// World positions of a body's samples, its centre last.
+void worldSamples(const Body& b, std::vector<double>& out)
+{
+    int n = b.mesh->sampleCount();
+    out.resize(3 * (size_t)n + 3);
+    double c[3] = { 0, 0, 0 };
+    if (b.deformable) {
+        std::copy(b.world.begin(), b.world.begin() + 3 * (size_t)n, out.begin());
+        int nv = b.mesh->vertexCount();
+        for (int i = 0; i < nv; ++i)
+            for (int k = 0; k < 3; ++k) c[k] += b.world[3 * (size_t)i + k] / nv;
+    } else {
+        for (int i = 0; i < n; ++i) b.frame.apply(&b.mesh->samples[3 * (size_t)i], &out[3 * (size_t)i]);
+        for (int k = 0; k < 3; ++k) c[k] = b.frame.p[k];
+    }
+    for (int k = 0; k < 3; ++k) out[3 * (size_t)n + k] = c[k];
+}
+
+// Distance from p to a box (0 inside).
+double boxDistance(const sdfccd_Aabb& b, const double* p)
+{
+    double lo[3] = { b.lo.x, b.lo.y, b.lo.z }, hi[3] = { b.hi.x, b.hi.y, b.hi.z }, d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+        double e = std::max(std::max(lo[k] - p[k], p[k] - hi[k]), 0.0);
+        d2 += e * e;
+    }
+    return std::sqrt(d2);
+}
+
+struct Measure {
+    double min_phi = 1e300;
+    int min_body = -1, min_collider = -1;
+    int64_t deep = 0;
+    std::vector<double> body_min;                // per body
+    std::vector<std::vector<double>> sample_phi; // per body, per sample (for snapshots)
+    std::vector<char> tunnelled;                 // per body, this step
+};
+
+void measure(Scene& scene, Measure& m)
+{
+    size_t nb = scene.bodies.size();
+    m.min_phi = 1e300;
+    m.min_body = m.min_collider = -1;
+    m.deep = 0;
+    m.body_min.assign(nb, 1e300);
+    m.sample_phi.resize(nb);
+    m.tunnelled.assign(nb, 0);
+    for (size_t bi = 0; bi < nb; ++bi) m.sample_phi[bi].assign((size_t)scene.bodies[bi].mesh->sampleCount(), 1e300);
+    std::vector<double> pts;
+    for (size_t ci = 0; ci < scene.colliders.size(); ++ci) {
+        const Collider& c = scene.colliders[ci];
+        // Gather the samples of the bodies near this collider (mesh distances run as one batch).
+        std::vector<sdfccd_Vec3> batch;
+        std::vector<std::pair<size_t, size_t>> owner; // (body, first index in batch)
+        for (size_t bi = 0; bi < nb; ++bi) {
+            const Body& b = scene.bodies[bi];
+            if (!b.active) continue;
+            worldSamples(b, pts);
+            size_t n = pts.size() / 3;
+            double lc[3];
+            c.frame.applyInverse(&pts[3 * (n - 1)], lc);
+            double up_h = dot3(&pts[3 * (n - 1)], scene.up);
+            if (up_h < c.kill_below) m.tunnelled[bi] = 1;
+            double reach = b.deformable ? 1e300 : b.mesh->radius;
+            if (boxDistance(c.bounds, lc) > reach + 0.05) continue;
+            owner.push_back(std::make_pair(bi, batch.size()));
+            for (size_t i = 0; i < n; ++i) {
+                double l[3];
+                c.frame.applyInverse(&pts[3 * i], l);
+                batch.push_back(sdfccd_Vec3{ l[0], l[1], l[2] });
+            }
+        }
+        if (batch.empty()) continue;
+        std::vector<double> phi(batch.size(), 1e300);
+        if (c.exact_mesh.index1) {
+            sdfccd_mesh_signed_distance(c.exact_mesh, batch.data(), (int32_t)batch.size(), 0, phi.data(), nullptr);
+        } else {
+            for (size_t i = 0; i < batch.size(); ++i) sdfccd_sdf_eval(c.exact, batch[i], &phi[i], nullptr);
+        }
+        for (size_t k = 0; k < owner.size(); ++k) {
+            size_t bi = owner[k].first, first = owner[k].second;
+            size_t end = k + 1 < owner.size() ? owner[k + 1].second : batch.size();
+            size_t n = end - first - 1; // samples; the centre is last
+            std::vector<double>& sp = m.sample_phi[bi];
+            for (size_t i = 0; i < n; ++i) {
+                double p = phi[first + i];
+                sp[i] = std::min(sp[i], p);
+                if (p < m.body_min[bi]) m.body_min[bi] = p;
+                if (p < m.min_phi) {
+                    m.min_phi = p;
+                    m.min_body = (int)bi;
+                    m.min_collider = (int)ci;
+                }
+            }
+            if (phi[end - 1] < -scene.bodies[bi].mesh->half_thickness) m.tunnelled[bi] = 1;
+        }
+    }
+    for (size_t bi = 0; bi < nb; ++bi)
+        for (double p : m.sample_phi[bi])
+            if (p < kDeepPhi) ++m.deep;
+}
+
+double speedBound(const Body& b, const std::vector<double>& prev_world, double dt)
+{
+    if (b.deformable) {
+        double s = 0;
+        for (size_t i = 0; i + 2 < b.world.size() && i + 2 < prev_world.size(); i += 3) {
+            double d[3] = { b.world[i] - prev_world[i], b.world[i + 1] - prev_world[i + 1], b.world[i + 2] - prev_world[i + 2] };
+            s = std::max(s, std::sqrt(dot3(d, d)) / dt);
+        }
+        return s;
+    }
+    return std::sqrt(dot3(b.v, b.v)) + std::sqrt(dot3(b.w, b.w)) * b.mesh->radius;
+}
+
+} // namespace
+
+Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
+{
+    Summary s;
+    s.steps = cfg.steps;
+    s.dt = cfg.dt;
+    s.precision = scene.precision();
+    s.description = scene.describe();
+    s.body_count = (int)scene.bodies.size();
+    if (csv)
+        std::fprintf(csv, "step,time,min_phi,deep_samples,contacts,ccd_ms,step_ms,ccd_queries,hits,energy,max_speed,tunnelled\n");
+    Measure m;
+    std::vector<char> tunnelled(scene.bodies.size(), 0);
+    int window = std::max(1, (int)std::lround(1.0 / cfg.dt));
+    int window_start = std::max(0, cfg.steps - window);
+    std::vector<std::array<double, 3>> ref;
+    std::vector<std::vector<double>> prev_world(scene.bodies.size());
+    double total_step = 0, prev_energy = scene.energy();
+    s.energy_start = prev_energy;
+    StepCost prev_cost = scene.cost();
+    StepCost start_cost = prev_cost;
+    double contacts_sum = 0;
+    auto wall0 = std::chrono::steady_clock::now();
+    auto last_progress = wall0;
+    Snapshotter snap(cfg.snapshot);
+    for (int i = 0; i < cfg.steps; ++i) {
+        for (size_t bi = 0; bi < scene.bodies.size(); ++bi)
+            if (scene.bodies[bi].deformable) prev_world[bi] = scene.bodies[bi].world;
+        auto t0 = std::chrono::steady_clock::now();
+        scene.step(i, cfg.dt);
+        double step_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        total_step += step_s;
+        StepCost c = scene.cost();
+        double ccd_s = c.ccd_seconds - prev_cost.ccd_seconds;
+        contacts_sum += c.contacts;
+        measure(scene, m);
+        if (m.min_phi < 1e299) {
+            double pen = std::max(0.0, -m.min_phi);
+            if (pen > s.max_penetration) {
+                s.max_penetration = pen;
+                s.max_penetration_step = i;
+                s.max_penetration_where = scene.bodies[(size_t)m.min_body].name + "#" + std::to_string(m.min_body) + " in " +
+                                          scene.colliders[(size_t)m.min_collider].name;
+            }
+            if (i == cfg.steps - 1) s.end_penetration = pen;
+        }
+        s.deep_samples += m.deep;
+        bool first_contact_now = false;
+        if (s.first_contact_step < 0 && m.min_phi <= kContactPhi) {
+            s.first_contact_step = i;
+            first_contact_now = true;
+        }
+        if (s.first_hit_step < 0) {
+            s.ccd_ms_to_first_hit += 1e3 * ccd_s;
+            s.step_ms_to_first_hit += 1e3 * step_s;
+            if (c.hits > prev_cost.hits) s.first_hit_step = i;
+        }
+        int tun_now = 0;
+        for (size_t bi = 0; bi < scene.bodies.size(); ++bi) {
+            if (m.tunnelled[bi]) ++tun_now;
+            if (m.tunnelled[bi] && !tunnelled[bi]) {
+                tunnelled[bi] = 1;
+                ++s.tunnelled;
+                if (!s.tunnelled_names.empty()) s.tunnelled_names += ",";
+                s.tunnelled_names += scene.bodies[bi].name + "#" + std::to_string(bi) + "@" + std::to_string(i);
+            }
+        }
+        double e = scene.energy();
+        if (!scene.injects(i) && std::isfinite(e) && std::isfinite(prev_energy)) s.energy_max_gain = std::max(s.energy_max_gain, e - prev_energy);
+        prev_energy = e;
+        double max_speed = 0;
+        for (size_t bi = 0; bi < scene.bodies.size(); ++bi)
+            if (scene.bodies[bi].active) max_speed = std::max(max_speed, speedBound(scene.bodies[bi], prev_world[bi], cfg.dt));
+        if (i == window_start) {
+            ref.resize(scene.bodies.size());
+            for (size_t bi = 0; bi < scene.bodies.size(); ++bi) {
+                const Body& b = scene.bodies[bi];
+                std::vector<double> w;
+                worldSamples(b, w);
+                ref[bi] = { w[w.size() - 3], w[w.size() - 2], w[w.size() - 1] };
+            }
+        }
+        if (i >= window_start) {
+            s.rest_speed = std::max(s.rest_speed, max_speed);
+            for (size_t bi = 0; bi < scene.bodies.size(); ++bi) {
+                std::vector<double> w;
+                worldSamples(scene.bodies[bi], w);
+                double d[3] = { w[w.size() - 3] - ref[bi][0], w[w.size() - 2] - ref[bi][1], w[w.size() - 1] - ref[bi][2] };
+                s.rest_drift = std::max(s.rest_drift, std::sqrt(dot3(d, d)));
+            }
+        }
+        if (i == cfg.steps - 1) {
+            for (size_t bi = 0; bi < scene.bodies.size(); ++bi)
+                if (scene.bodies[bi].active && speedBound(scene.bodies[bi], prev_world[bi], cfg.dt) > 0.05) ++s.moving_at_end;
+        }
+        if (csv)
+            std::fprintf(csv, "%d,%.6f,%.6g,%lld,%d,%.4f,%.4f,%lld,%lld,%.6g,%.4g,%d\n", i, (i + 1) * cfg.dt,
+                         m.min_phi < 1e299 ? m.min_phi : NAN, (long long)m.deep, c.contacts, 1e3 * ccd_s, 1e3 * step_s,
+                         (long long)c.ccd_queries, (long long)c.hits, e, max_speed, tun_now);
+        if (snap.enabled() && (first_contact_now || i == cfg.steps - 1))
+            snap.write(scene, m.sample_phi, first_contact_now ? "first_contact" : "end", i);
+        prev_cost = c;
+        auto now = std::chrono::steady_clock::now();
+        if (cfg.progress && std::chrono::duration<double>(now - last_progress).count() > 2.0) {
+            last_progress = now;
+            std::fprintf(stderr, "\r  step %d/%d  max pen %.4g m  %.2f ms/step   ", i + 1, cfg.steps, s.max_penetration,
+                         1e3 * total_step / (i + 1));
+        }
+    }
+    if (cfg.progress && std::chrono::duration<double>(last_progress - wall0).count() > 0) std::fprintf(stderr, "\n");
+    StepCost end = scene.cost();
+    s.energy_end = prev_energy;
+    s.contacts_per_step = cfg.steps ? contacts_sum / cfg.steps : 0;
+    s.step_ms = cfg.steps ? 1e3 * total_step / cfg.steps : 0;
+    s.ccd_ms = cfg.steps ? 1e3 * (end.ccd_seconds - start_cost.ccd_seconds) / cfg.steps : 0;
+    s.ccd_queries = end.ccd_queries - start_cost.ccd_queries;
+    return s;
+}
+
+void printSummary(const Summary& s, std::FILE* out)
+{
+    std::fprintf(out, "scene %s  (%s, btScalar %s, %d steps of %.4g s)\n", s.scene.c_str(), s.description.c_str(),
+                 s.precision.c_str(), s.steps, s.dt);
+    std::fprintf(out, "  max_penetration_m   %.6f  (step %d%s%s)\n", s.max_penetration, s.max_penetration_step,
+                 s.max_penetration_where.empty() ? "" : ", ", s.max_penetration_where.c_str());
+    std::fprintf(out, "  end_penetration_m   %.6f\n", s.end_penetration);
+    std::fprintf(out, "  deep_sample_steps   %lld  (samples deeper than 1 mm, summed over steps)\n", (long long)s.deep_samples);
+    std::fprintf(out, "  first_contact_step  %d  (first sample within 1 mm)\n", s.first_contact_step);
+    std::fprintf(out, "  first_hit_step      %d  (first CCD contact; ccd %.3f ms, steps %.3f ms up to it)\n", s.first_hit_step,
+                 s.ccd_ms_to_first_hit, s.step_ms_to_first_hit);
+    std::fprintf(out, "  tunnelled           %d%s%s\n", s.tunnelled, s.tunnelled_names.empty() ? "" : "  ", s.tunnelled_names.c_str());
+    std::fprintf(out, "  rest_drift_m        %.6f  (max centre displacement over the last second)\n", s.rest_drift);
+    std::fprintf(out, "  rest_speed_mps      %.6f  (max |v| + |w| r over the last second)\n", s.rest_speed);
+    std::fprintf(out, "  moving_at_end       %d of %d\n", s.moving_at_end, s.body_count);
+    std::fprintf(out, "  energy_J            start %.6g  end %.6g  max gain in one step %.6g\n", s.energy_start, s.energy_end,
+                 s.energy_max_gain);
+    std::fprintf(out, "  contacts_per_step   %.2f\n", s.contacts_per_step);
+    std::fprintf(out, "  step_ms             %.4f\n", s.step_ms);
+    std::fprintf(out, "  ccd_ms              %.4f  (%.1f%% of the step, %lld queries)\n", s.ccd_ms,
+                 s.step_ms > 0 ? 100 * s.ccd_ms / s.step_ms : 0.0, (long long)s.ccd_queries);
+}
+
+bool checkSummary(const Summary& s, const std::string& spec, std::string* why)
+{
+    std::stringstream in(spec);
+    std::string item;
+    bool ok = true;
+    std::ostringstream msg;
+    while (std::getline(in, item, ',')) {
+        if (item.empty()) continue;
+        size_t eq = item.find('=');
+        std::string key = item.substr(0, eq);
+        double lim = eq == std::string::npos ? 0 : std::atof(item.c_str() + eq + 1);
+        bool pass;
+        double val;
+        if (key == "max_pen") { val = s.max_penetration; pass = val <= lim; }
+        else if (key == "min_max_pen") { val = s.max_penetration; pass = val >= lim; }
+        else if (key == "tunnelled") { val = s.tunnelled; pass = val <= lim; }
+        else if (key == "min_tunnelled") { val = s.tunnelled; pass = val >= lim; }
+        else if (key == "fails") { val = s.max_penetration; pass = s.max_penetration > lim || s.tunnelled > 0; }
+        else if (key == "rest_speed") { val = s.rest_speed; pass = val <= lim; }
+        else if (key == "rest_drift") { val = s.rest_drift; pass = val <= lim; }
+        else if (key == "moving") { val = s.moving_at_end; pass = val <= lim; }
+        else if (key == "energy_gain") { val = s.energy_max_gain; pass = val <= lim; }
+        else if (key == "contact") { val = s.first_contact_step; pass = val >= 0; }
+        else if (key == "hit") { val = s.first_hit_step; pass = val >= 0; }
+        else {
+            msg << "unknown check key '" << key << "'; ";
+            ok = false;
+            continue;
+        }
+        if (!pass) {
+            ok = false;
+            msg << key << ": measured " << val << ", limit " << lim << "; ";
+        }
+    }
+    if (why) *why = msg.str();
+    return ok;
+}
+
+} // namespace scenes

@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: MIT
+/** @file runner.h  Steps a scene and measures it against the exact SDFs.
+ *
+ * After every step, phi of every collider's exact reference is evaluated at every sample point
+ * (vertices, and lattice points on coarse meshes) of every active body near it. From that:
+ *  - max penetration over the run (-min phi, m) and where;
+ *  - first contact: the first step with some sample at phi <= 1 mm; first CCD hit (bridge/queries);
+ *  - tunnelled bodies: a body whose centre got deeper inside a collider than its own half-thickness,
+ *    or fell below a collider's kill height (through the floor);
+ *  - rest over the last second of simulated time: the largest displacement of any body centre from
+ *    its position one second before the end, and the largest vertex-speed bound |v| + |w| radius;
+ *  - energy (kinetic + potential): the largest gain in one step (shots excluded);
+ *  - cost: wall time per step, CCD time per step and its share, contacts per step.
+ */
+#ifndef SDFCCD_SCENES_RUNNER_H
+#define SDFCCD_SCENES_RUNNER_H
+
+#include <cstdio>
+#include <string>
+
+#include "scene.h"
+
+namespace scenes {
+
+struct RunConfig {
+    int steps = 0;
+    double dt = 0;
+    std::string csv;      /**< Per-step CSV file ("" = none). */
+    std::string snapshot; /**< Folder of PNG snapshots ("" = none). */
+    bool progress = true; /**< Progress line on stderr (about once per second of wall time). */
+};
+
+struct Summary {
+    std::string scene, method, precision, description;
+    bool stock = false, subdivision = true;
+    int steps = 0;
+    double dt = 0;
+    double max_penetration = 0;    /**< m, >= 0. */
+    int max_penetration_step = -1;
+    std::string max_penetration_where;
+    double end_penetration = 0;    /**< At the last step. */
+    int first_contact_step = -1;   /**< First step with a sample at phi <= 1 mm. */
+    int first_hit_step = -1;       /**< First step whose CCD found contact. */
+    double ccd_ms_to_first_hit = 0;/**< CCD time summed over steps up to and including first_hit_step. */
+    double step_ms_to_first_hit = 0;
+    int tunnelled = 0;             /**< Bodies that tunnelled at some step. */
+    std::string tunnelled_names;
+    double rest_drift = 0;         /**< m, max centre displacement over the last second. */
+    double rest_speed = 0;         /**< m/s, max over bodies and the last second of |v| + |w| radius. */
+    int moving_at_end = 0;         /**< Bodies with vertex-speed bound > 0.05 m/s at the end. */
+    double energy_start = 0, energy_end = 0, energy_max_gain = 0;
+    double contacts_per_step = 0;
+    double step_ms = 0;            /**< Mean wall time per step. */
+    double ccd_ms = 0;             /**< Mean CCD time per step. */
+    int64_t ccd_queries = 0;
+    int body_count = 0;
+    int64_t deep_samples = 0;      /**< Sample-steps with phi < -1 mm. */
+};
+
+/** Runs `scene` for cfg.steps steps of cfg.dt. `csv` (may be NULL) receives per-step rows. */
+Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv);
+void printSummary(const Summary& s, std::FILE* out);
+/** Checks "key=value,key=value" limits (see the runner's --help); false with the violations in *why. */
+bool checkSummary(const Summary& s, const std::string& spec, std::string* why);
+
+} // namespace scenes
+
+#endif

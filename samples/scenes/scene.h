@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: MIT
+/** @file scene.h  The scene library: named scenes shared by the runner (sdfccd_scenes), the
+ * stability tests (ctest runs the runner with --check) and the Table 4 benchmark.
+ *
+ * Model: Box2D's benchmark table. Each scene is written once as a class deriving from Scene and
+ * listed in the table of registry.cpp as {name, summary, create, steps, dt}. A scene owns its
+ * world (a Bullet btDiscreteDynamicsWorld with the sdfccd bridge, or a kinematic replay through
+ * the C ABI) and exposes what the runner measures:
+ *  - bodies: moving triangle meshes (vertices plus extra sample points in the body frame, the
+ *    body pose after each step, or world positions for deformable meshes);
+ *  - colliders: the SDF surfaces, each with an EXACT reference for measuring (the analytic SDF
+ *    itself, the grid a .cdf holds, or the exact distance to the mesh a grid was baked from).
+ * The runner (runner.cpp) evaluates phi of every collider at every sample point of every body
+ * after every step, and reports the measured quantities (see Summary).
+ *
+ * Units: metres, seconds, kilograms. Every scene states its up axis and gravity.
+ */
+#ifndef SDFCCD_SCENES_SCENE_H
+#define SDFCCD_SCENES_SCENE_H
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sdfccd/sdfccd.h"
+
+namespace scenes {
+
+/** Options of a run (the runner's command line). */
+struct Options {
+    sdfccd_Method method = SDFCCD_METHOD_FWGSS; /**< CCD method of the bridge / kinematic queries. */
+    bool subdivision = true;                    /**< Adaptive subdivision (Section 4.5). */
+    bool stock = false;   /**< Bullet scenes: the SDF surfaces as btBvhTriangleMeshShape (no bridge). */
+    bool quick = false;   /**< Fewer bodies where a scene is large (the ctest variants; documented per scene). */
+    double margin = -1;   /**< Contact margin (m) of the bridge / queries; < 0: the scene's default. */
+    std::string data_dir; /**< The project's data/ folder. */
+};
+
+/** A triangle mesh in its body frame, with the points the runner measures: every vertex, plus
+ * (when `sample_density` > 1) a barycentric lattice on every triangle, so a coarse mesh whose
+ * faces are pierced between vertices (the spikes scene) shows its penetration. */
+struct MeshData {
+    std::string name;
+    std::vector<double> v;       /**< 3 * vertex count, body frame. */
+    std::vector<uint32_t> f;     /**< 3 * triangle count, counter-clockwise. */
+    std::vector<double> samples; /**< 3 * sample count: the vertices first, then lattice points. */
+    double radius = 0;           /**< max |vertex| (body frame origin to farthest vertex). */
+    double half_thickness = 0;   /**< Half the smallest extent of the local box. */
+    sdfccd_Aabb bounds{};
+    int vertexCount() const { return (int)(v.size() / 3); }
+    int triangleCount() const { return (int)(f.size() / 3); }
+    int sampleCount() const { return (int)(samples.size() / 3); }
+    /** Recomputes samples, radius, bounds, half_thickness. `density` lattice points per edge (1: vertices only). */
+    void finish(int density = 1);
+};
+
+/** Loads an OBJ through sdfccd_load_mesh, scaled; returns null (message on stderr) on failure. */
+std::shared_ptr<MeshData> loadMesh(const std::string& path, double scale);
+/** A mesh from arrays. */
+std::shared_ptr<MeshData> makeMesh(const std::string& name, std::vector<double> v, std::vector<uint32_t> f);
+
+/** A rigid transform in double: x_world = R x_local + p (R row-major). */
+struct Frame {
+    double R[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+    double p[3] = { 0, 0, 0 };
+    void apply(const double* x, double* out) const;
+    void applyInverse(const double* x, double* out) const;
+    static Frame fromPose(const sdfccd_Pose& pose);
+    sdfccd_Pose toPose() const;
+};
+
+/** A moving mesh the runner measures. The scene updates `frame`, `v`, `w` (or `world` for a
+ * deformable mesh) after every step. */
+struct Body {
+    std::string name;
+    std::shared_ptr<MeshData> mesh;
+    Frame frame;
+    double v[3] = { 0, 0, 0 }, w[3] = { 0, 0, 0 }; /**< Linear (m/s) and angular (rad/s) velocity, world. */
+    bool deformable = false;
+    std::vector<double> world; /**< Deformable: world positions of the samples (3 per sample). */
+    bool active = true;        /**< False before a body enters the scene (a shot fired later). */
+};
+
+/** An SDF surface and its exact reference for measuring. Exactly one of `exact` (evaluated in
+ * the collider's local frame: analytic, CSG, callback or a grid) or `exact_mesh` (the exact
+ * signed distance to that mesh, in the local frame) is set. */
+struct Collider {
+    std::string name;
+    Frame frame;             /**< World from local; updated by kinematic scenes. */
+    sdfccd_SdfId exact{};    /**< Not owned (the scene owns its handles). */
+    sdfccd_MeshId exact_mesh{};
+    sdfccd_SdfId render{};   /**< Drawn in snapshots when `exact` is not set (e.g. the grid of a mesh). */
+    sdfccd_Aabb bounds{};    /**< Local box containing the surface (for culling far bodies). */
+    double kill_below = -1e300; /**< A body centre below this world height (up axis) has fallen through. */
+};
+
+/** Per-step figures a scene reports about its own collision pipeline. */
+struct StepCost {
+    double ccd_seconds = 0;  /**< Time inside CCD queries (bridge or direct), cumulative. */
+    int64_t ccd_queries = 0; /**< Cumulative. */
+    int64_t hits = 0;        /**< Cumulative queries that found contact. */
+    int64_t triangles_tested = 0; /**< Cumulative (direct queries only; -1 when unknown). */
+    int contacts = 0;        /**< Contact points alive after this step (manifolds or query contacts). */
+};
+
+class Scene {
+public:
+    virtual ~Scene() {}
+    /** Advances one step of `dt` seconds (step index i, from 0) and updates bodies/colliders. */
+    virtual void step(int i, double dt) = 0;
+    /** Cumulative collision costs and the current contact count. */
+    virtual StepCost cost() const = 0;
+    /** Total mechanical energy (kinetic + potential, J); NaN when the scene does not define it. */
+    virtual double energy() const = 0;
+    /** True when energy is injected at step i (a shot fired): energy gain is not counted there. */
+    virtual bool injects(int i) const { return false; }
+    /** "float" or "double": the btScalar of the Bullet build (kinematic scenes: "double"). */
+    virtual const char* precision() const;
+    /** One-line description of the configuration actually built (bodies, variants). */
+    virtual std::string describe() const = 0;
+
+    std::vector<Body> bodies;
+    std::vector<Collider> colliders;
+    double up[3] = { 0, 0, 1 };  /**< Up axis (for kill planes and potential energy). */
+    sdfccd_Aabb view{};          /**< Snapshot view box (world); empty (lo = hi) frames the bodies. */
+};
+
+/** Table entry: Box2D's benchmark model. */
+struct SceneEntry {
+    const char* name;
+    const char* summary;
+    Scene* (*create)(const Options&); /**< Null (message on stderr) when the scene cannot be built. */
+    int steps;                        /**< Default number of steps. */
+    double dt;                        /**< Default step (s). */
+};
+
+/** The table (registry.cpp). */
+const std::vector<SceneEntry>& sceneTable();
+const SceneEntry* findScene(const std::string& name);
+
+/** The method's command-line name: fwgss, fw, dcd, certified. */
+const char* methodName(sdfccd_Method m);
+bool parseMethod(const std::string& s, sdfccd_Method* out);
+
+} // namespace scenes
+
+#endif

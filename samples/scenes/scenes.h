@@ -1,0 +1,17 @@
+// SPDX-License-Identifier: MIT
+/** @file scenes.h  The parts of the scene table, one function per file of scenes. */
+#ifndef SDFCCD_SCENES_SCENES_H
+#define SDFCCD_SCENES_SCENES_H
+
+#include <vector>
+
+#include "scene.h"
+
+namespace scenes {
+
+/** gimpact-demo, gimpact-shot-*, sdf-box*, landscape (bullet_recreations.cpp). */
+void appendBulletRecreations(std::vector<SceneEntry>& table);
+
+} // namespace scenes
+
+#endif
