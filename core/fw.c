@@ -16,12 +16,31 @@ void scc_fw_begin(scc_fw_state* s, const scc_sdf* sdf, const scc_tri_motion* m, 
     s->hit_t = tb;
     s->evals = 0;
     s->b[0] = 1.0; s->b[1] = 0.0; s->b[2] = 0.0;
+    s->dist_tol = p->dist_tol;
+    scc_fw_prepare_motion(s);
+}
+
+void scc_fw_prepare_motion(scc_fw_state* s)
+{
+    const scc_tri_motion* m = s->m;
+    s->fast = m->kind == SCC_TRI_RIGID && m->sdf == NULL;
+    s->cache_t = NAN;
+    s->wlen = 0.0;
+    if (!s->fast) return;
+    const scc_rigid* r = m->body;
+    s->t0 = r->t0;
+    s->g0 = scc_rigid_center_at(r, r->t0);
+    s->v = r->v;
+    s->w = r->w;
+    s->wlen = scc_len(r->w);
+    s->axis = s->wlen > 0.0 ? scc_scale(r->w, 1.0 / s->wlen) : scc_v3(0, 0, 1);
+    for (int i = 0; i < 3; ++i) s->r0[i] = scc_quat_rotate(r->q0, scc_sub(m->local[i], r->c_local));
 }
 
 void scc_fw_start_order(scc_fw_state* s, int order[3])
 {
     scc_tri_state st;
-    scc_tri_state_at(s->m, s->ts, &st);
+    scc_fw_tri_state(s, s->ts, &st);
     double score[3];
     for (int i = 0; i < 3; ++i) {
         double b[3] = { i == 0, i == 1, i == 2 };
@@ -65,7 +84,7 @@ void scc_fw_finish(scc_fw_state* s, int converged, int64_t iterations, scc_tri_h
     if (s->hit) {
         out->toi = s->hit_t;
         for (int j = 0; j < 3; ++j) out->bary[j] = s->hit_b[j];
-        out->point = scc_tri_point_at(s->m, s->hit_b, s->hit_t, NULL);
+        out->point = scc_fw_point(s, s->hit_b, s->hit_t, NULL);
         out->distance = scc_sdf_eval(s->sdf, out->point, &out->normal);
         s->evals++;
         out->state = !converged ? SCC_NOT_CONVERGED : (s->hit_t <= s->ts ? SCC_PENETRATING : SCC_HIT);
@@ -96,12 +115,12 @@ void scc_fw(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, c
         double phi = scc_fw_eval(&s, s.b, t, &x, &g, &v);
         double d = phi <= p->margin ? -1.0 : (scc_dot(g, v) > 0.0 ? -1.0 : 1.0); /* Eq. 17 */
         scc_tri_state st;
-        scc_tri_state_at(m, t, &st);
+        scc_fw_tri_state(&s, t, &st);
         int sv = scc_fw_support(&st, g);
         double tn = scc_clamp(t + alpha * (s.te - s.ts) * d, s.ts, s.te); /* Eq. 18-19 */
         double bn[3];
         for (int j = 0; j < 3; ++j) bn[j] = (1.0 - alpha) * s.b[j] + alpha * (j == sv); /* Eq. 20 */
-        scc_vec3 xn = scc_tri_point_at(m, bn, tn, NULL);
+        scc_vec3 xn = scc_fw_point(&s, bn, tn, NULL);
         int small = fabs(tn - t) <= p->time_tol && scc_dist(xn, x) <= p->dist_tol;
         t = tn;
         for (int j = 0; j < 3; ++j) s.b[j] = bn[j];

@@ -11,7 +11,7 @@
 static double phi_at_time(double t, void* c)
 {
     scc_fw_state* s = c;
-    scc_vec3 x = scc_tri_point_at(s->m, s->b, t, NULL);
+    scc_vec3 x = scc_fw_point(s, s->b, t, NULL);
     double phi = scc_sdf_eval(s->sdf, x, NULL);
     s->evals++;
     scc_fw_witness(s, t, s->b, phi);
@@ -46,6 +46,55 @@ static scc_gss_result crossing_by_bisection(scc_fw_state* s, double lo, double h
     r.converged = hi - lo <= p->time_tol;
     r.l = hi;
     r.f = fabs(phi_at_time(hi, s));
+    return r;
+}
+
+/* The same entry search by regula falsi with the Illinois modification (ours): phi is
+ * smooth along a path away from the field's ridges, so the secant through the bracket's ends
+ * converges superlinearly, and halving the retained end's value when one end repeats keeps it
+ * from stalling on a convex stretch. Every few steps that did not halve the bracket, a
+ * bisection step bounds the worst case by the bisection's. `fhi` (<= 0) is phi - margin at hi. */
+static scc_gss_result crossing_by_secant(scc_fw_state* s, double lo, double hi, double fhi, const scc_params* p)
+{
+    scc_gss_result r;
+    r.evals = 0;
+    r.converged = 1;
+    double flo = phi_at_time(lo, s);
+    if (flo <= 0.0) {
+        r.l = lo;
+        r.f = fabs(flo);
+        return r;
+    }
+    int it = 0, side = 0, slow = 0;
+    while (hi - lo > p->time_tol && it++ < p->max_ls_iter) {
+        double width = hi - lo, t;
+        if (slow >= 2) {
+            t = 0.5 * (lo + hi);
+            slow = 0;
+        } else {
+            t = hi - fhi * (hi - lo) / (fhi - flo);
+            /* keep the sample strictly inside, at least a quarter tolerance from either end */
+            double m = 0.25 * p->time_tol;
+            if (!(t > lo + m)) t = lo + m;
+            if (!(t < hi - m)) t = hi - m;
+        }
+        double f = phi_at_time(t, s);
+        if (f > 0.0) {
+            lo = t;
+            flo = f;
+            if (side == -1) fhi *= 0.5;
+            side = -1;
+        } else {
+            hi = t;
+            fhi = f;
+            if (side == 1) flo *= 0.5;
+            side = 1;
+        }
+        slow = hi - lo > 0.5 * width ? slow + 1 : 0;
+    }
+    r.converged = hi - lo <= p->time_tol;
+    r.l = hi;
+    r.f = fabs(fhi);
     return r;
 }
 
@@ -98,9 +147,9 @@ static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 
     const scc_params* p = s->p;
     scc_vec3 end = scc_add(scc_add(scc_scale(st->x[0], bb[0]), scc_scale(st->x[1], bb[1])), scc_scale(st->x[2], bb[2]));
     double len = scc_dist(end, xn);
-    if (!(len > p->dist_tol)) return 0.0;
+    if (!(len > s->dist_tol)) return 0.0;
     space_ctx k = { s, xn, end, { s->b[0], s->b[1], s->b[2] }, { bb[0], bb[1], bb[2] }, t };
-    scc_gss_result sp = scc_gss_minimize(0.0, 1.0, p->dist_tol / len, p->max_ls_iter, phi_on_segment, &k);
+    scc_gss_result sp = scc_gss_minimize(0.0, 1.0, s->dist_tol / len, p->max_ls_iter, phi_on_segment, &k);
     for (int j = 0; j < 3; ++j) s->b[j] = fmax((1.0 - sp.l) * s->b[j] + sp.l * bb[j], 0.0);
     return sp.l * len;
 }
@@ -117,9 +166,11 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
         scc_vec3 x, g, v;
         double phi = scc_fw_eval(s, s->b, t, &x, &g, &v);
         scc_gss_result ls;
-        if (phi <= p->margin) {
+        if (phi <= p->margin && p->fwgss_secant && t > s->ts) {
+            ls = crossing_by_secant(s, s->ts, t, phi - p->margin, p);
+        } else if (phi <= p->margin) {
             ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, unsigned_phi_at_time, s);
-            if (ls.f > p->dist_tol) ls = crossing_by_bisection(s, s->ts, fmin(t, s->te), p);
+            if (ls.f > s->dist_tol) ls = crossing_by_bisection(s, s->ts, fmin(t, s->te), p);
         } else if (scc_dot(g, v) > 0.0) { /* d = -1: moving away, look back in time */
             ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, phi_at_time, s);
         } else {
@@ -137,7 +188,7 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
         scc_vec3 xn, gn;
         scc_fw_eval(s, s->b, tn, &xn, &gn, &v);
         scc_tri_state st;
-        scc_tri_state_at(s->m, tn, &st);
+        scc_fw_tri_state(s, tn, &st);
         double bb[3];
         int have_dir = 0;
         if (s->b[0] > 0.0 && s->b[1] > 0.0 && s->b[2] > 0.0) have_dir = interior_direction(&st, gn, s->b, bb);
@@ -157,7 +208,7 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
             }
         }
         double step = have_dir ? spatial_search(s, &st, xn, bb, tn) : 0.0;
-        int small = fabs(tn - t) <= p->time_tol && step <= p->dist_tol; /* line 32 */
+        int small = fabs(tn - t) <= p->time_tol && step <= s->dist_tol; /* line 32 */
         t = tn;
         if (small) { *io_iterations += it; return 1; }
     }
@@ -174,7 +225,7 @@ static void trace_vertex(scc_fw_state* s, int i, double speed, int cap)
     const double b[3] = { i == 0, i == 1, i == 2 };
     double t = s->ts;
     for (int k = 0; k < cap && t < s->te && s->evals < s->p->max_evals; ++k) {
-        scc_vec3 x = scc_tri_point_at(s->m, b, t, NULL);
+        scc_vec3 x = scc_fw_point(s, b, t, NULL);
         double phi = scc_sdf_eval(s->sdf, x, NULL);
         s->evals++;
         if (phi <= s->p->margin) {
@@ -193,8 +244,10 @@ void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb
 {
     scc_fw_state s;
     scc_fw_begin(&s, sdf, m, p, ta, tb);
+    double speed = scc_tri_speed_bound(m);
+    /* A spatial error of speed x time_tol moves the entry time by about time_tol. */
+    if (p->fwgss_speed_tol && speed > 0.0) s.dist_tol = speed * p->time_tol;
     if (p->fwgss_vertex_trace > 0) {
-        double speed = scc_tri_speed_bound(m);
         if (speed > 0.0)
             for (int i = 0; i < 3; ++i) trace_vertex(&s, i, speed, p->fwgss_vertex_trace);
     }

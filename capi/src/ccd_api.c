@@ -32,6 +32,8 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.broad_phase = 1;
     p.internal_value = DEF_COOKIE;
     p.max_sdf_evaluations = SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS;
+    p.fwgss_secant_entry = 1;
+    p.fwgss_speed_tolerance = 1;
     return p;
 }
 
@@ -96,6 +98,8 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     out->cert_max_regions = in->certified_max_regions;
     out->broad_phase = in->broad_phase != 0;
     out->max_evals = in->max_sdf_evaluations;
+    out->fwgss_secant = in->fwgss_secant_entry != 0;
+    out->fwgss_speed_tol = in->fwgss_speed_tolerance != 0;
     return SDFCCD_OK;
 }
 

@@ -71,6 +71,14 @@ typedef struct sdfccd_QueryParams {
                                         may exceed it by about one iteration (a few line searches). Default
                                         SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS (about 0.5 s with an analytic SDF on a
                                         2-core 2020s machine; slower SDFs take proportionally longer). */
+    int32_t fwgss_secant_entry;    /**< FWGSS: once the current point is in contact at the iterate's time and not at the
+                                        interval start, its entry time is found by regula falsi with the Illinois
+                                        modification on that sign change (a handful of evaluations) instead of the
+                                        paper's golden-section search of |phi| (Algorithm 2 line 13). 0 = the paper's
+                                        search. Default 1. */
+    int32_t fwgss_speed_tolerance; /**< FWGSS: the spatial tolerance is the distance the fastest point of the triangle
+                                        travels in time_tolerance (speed bound x time_tolerance), so a spatial error
+                                        costs at most about time_tolerance; 0 = distance_tolerance. Default 1. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
