@@ -329,7 +329,7 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
 {
     const scc_grid* g = (const scc_grid*)self;
     const double global = fmax(g->lipschitz_max, g->hole_source ? 1.0 : 0.0);
-    const double outside_global = sqrt(1.0 + global * global);
+    const double outside_global = scc_hypot2(1.0, global);
     if (!box || !scc_vfinite(box->lo) || !scc_vfinite(box->hi) || box->lo.x > box->hi.x || box->lo.y > box->hi.y || box->lo.z > box->hi.z)
         return outside_global;
     const int leaves = box->lo.x < g->lo.x || box->lo.y < g->lo.y || box->lo.z < g->lo.z ||

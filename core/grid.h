@@ -32,6 +32,10 @@
 #define SCC_GRID_NO_CELL 0xFFFFFFFFu
 /* Discregrid's "not sampled" node value (DBL_MAX). */
 #define SCC_GRID_NO_VALUE 1.7976931348623157e308
+/* Limits of loaded and built grids: domain coordinates and node values within +-1e100, cells at
+ * least 1e-50 wide, so distances, squares and gradients (value / cell size) stay finite. */
+#define SCC_GRID_MAX_COORDINATE 1e100
+#define SCC_GRID_MIN_CELL 1e-50
 
 /* ---- grid data ---- */
 

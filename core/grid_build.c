@@ -111,7 +111,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
         }
         if (!cancelled)
             for (uint64_t l = 0; l < nv; ++l)
-                if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
+                if (!(fabs(nodes[l]) <= SCC_GRID_MAX_COORDINATE)) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
     } else {
         node_ctx nc = { def, g, nodes, !banded, NULL, INFINITY, n_nodes, 1024 };
         cancelled = sample_nodes(def, &nc, SCC_GRID_STAGE_NODES);
@@ -119,7 +119,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
     if (cancelled) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED; }
     if (!banded)
         for (uint64_t l = 0; l < nodes_len; ++l)
-            if (!isfinite(nodes[l])) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
+            if (!(fabs(nodes[l]) <= SCC_GRID_MAX_COORDINATE)) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE; }
 
     fd->map = scc_alloc(a, (size_t)n_cells * sizeof(uint32_t));
     if (!fd->map) { scc_free(a, nodes, (size_t)nodes_len * sizeof(double)); scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY; }
@@ -151,7 +151,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
                     for (int s = 0; s < 32 && !keep; ++s) keep = fabs(nodes[ids[s]]) < keep_below;
                     if (!keep) { fd->map[l] = SCC_GRID_NO_CELL; continue; }
                     int bad = 0;
-                    for (int s = 0; s < 32; ++s) bad |= !isfinite(nodes[ids[s]]);
+                    for (int s = 0; s < 32; ++s) bad |= !(fabs(nodes[ids[s]]) <= SCC_GRID_MAX_COORDINATE);
                     if (bad) { /* a sample returned NaN/inf (a skipped node cannot be here) */
                         scc_free(a, renumber, (size_t)n_nodes * sizeof(uint32_t));
                         scc_free(a, nodes, (size_t)nodes_len * sizeof(double));

@@ -27,6 +27,21 @@ static inline scc_vec3 scc_cross(scc_vec3 a, scc_vec3 b)
 static inline double scc_len2(scc_vec3 a) { return scc_dot(a, a); }
 static inline double scc_len(scc_vec3 a) { return sqrt(scc_dot(a, a)); }
 static inline double scc_dist(scc_vec3 a, scc_vec3 b) { return scc_len(scc_sub(a, b)); }
+/* Lengths that neither overflow nor underflow in the squares (hypot-style): the plain formula
+ * when every coordinate is in [1e-150, 1e150] or zero, else the coordinates scaled by the largest. */
+static inline double scc_hypot3(double x, double y, double z)
+{
+    double m = fmax(fabs(x), fmax(fabs(y), fabs(z)));
+    if (m <= 1e150 && m >= 1e-150) {
+        double s = x * x + y * y + z * z;
+        if (s >= 1e-300) return sqrt(s);
+    }
+    if (!(m > 0.0) || isinf(m)) return m; /* 0, inf or NaN */
+    x /= m; y /= m; z /= m;
+    return m * sqrt(x * x + y * y + z * z);
+}
+static inline double scc_hypot2(double x, double y) { return scc_hypot3(x, y, 0.0); }
+static inline double scc_len_safe(scc_vec3 a) { return scc_hypot3(a.x, a.y, a.z); }
 static inline scc_vec3 scc_lerp(scc_vec3 a, scc_vec3 b, double t) { return scc_madd(a, scc_sub(b, a), t); }
 static inline scc_vec3 scc_mul(scc_vec3 a, scc_vec3 b) { return scc_v3(a.x * b.x, a.y * b.y, a.z * b.z); }
 static inline scc_vec3 scc_vabs(scc_vec3 a) { return scc_v3(fabs(a.x), fabs(a.y), fabs(a.z)); }

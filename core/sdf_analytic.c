@@ -39,8 +39,8 @@ static double sign_of(double x) { return x < 0.0 ? -1.0 : 1.0; }
 static double sphere_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
     const scc_sdf_sphere* s = (const scc_sdf_sphere*)self;
-    double l = scc_len(p);
-    if (g) *g = l > 0.0 ? scc_scale(p, 1.0 / l) : k_up;
+    double l = scc_len_safe(p);
+    if (g) *g = l > 0.0 ? scc_v3(p.x / l, p.y / l, p.z / l) : k_up;
     return l - s->radius;
 }
 void scc_sdf_sphere_init(scc_sdf_sphere* s, double r)
@@ -56,11 +56,11 @@ static double box_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
     scc_vec3 inner = scc_sub(s->half, scc_v3(s->radius, s->radius, s->radius));
     scc_vec3 q = scc_sub(scc_vabs(p), inner);
     scc_vec3 qp = scc_vmax(q, scc_v3(0, 0, 0));
-    double outside = scc_len(qp);
+    double outside = scc_len_safe(qp);
     double inside = fmin(scc_maxc(q), 0.0);
     if (g) {
         if (outside > 0.0) {
-            *g = scc_scale(scc_v3(qp.x * sign_of(p.x), qp.y * sign_of(p.y), qp.z * sign_of(p.z)), 1.0 / outside);
+            *g = scc_v3(qp.x / outside * sign_of(p.x), qp.y / outside * sign_of(p.y), qp.z / outside * sign_of(p.z));
         } else if (q.x >= q.y && q.x >= q.z) {
             *g = scc_v3(sign_of(p.x), 0, 0);
         } else if (q.y >= q.z) {
@@ -82,10 +82,10 @@ void scc_sdf_box_init(scc_sdf_box* s, scc_vec3 half, double radius)
 static double torus_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
     const scc_sdf_torus* s = (const scc_sdf_torus*)self;
-    double rho = sqrt(p.x * p.x + p.y * p.y);
+    double rho = scc_hypot2(p.x, p.y);
     double ex = rho > 0.0 ? p.x / rho : 1.0, ey = rho > 0.0 ? p.y / rho : 0.0;
     double qx = rho - s->major, qz = p.z;
-    double l = sqrt(qx * qx + qz * qz);
+    double l = scc_hypot2(qx, qz);
     if (g) *g = l > 0.0 ? scc_v3(qx / l * ex, qx / l * ey, qz / l) : scc_v3(ex, ey, 0.0);
     return l - s->minor;
 }
@@ -113,8 +113,8 @@ static double capsule_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
     const scc_sdf_capsule* s = (const scc_sdf_capsule*)self;
     scc_vec3 d = scc_v3(p.x, p.y, p.z - scc_clamp(p.z, -s->half_height, s->half_height));
-    double l = scc_len(d);
-    if (g) *g = l > 0.0 ? scc_scale(d, 1.0 / l) : scc_v3(1.0, 0.0, 0.0);
+    double l = scc_len_safe(d);
+    if (g) *g = l > 0.0 ? scc_v3(d.x / l, d.y / l, d.z / l) : scc_v3(1.0, 0.0, 0.0);
     return l - s->radius;
 }
 void scc_sdf_capsule_init(scc_sdf_capsule* s, double hh, double r)
@@ -128,11 +128,11 @@ void scc_sdf_capsule_init(scc_sdf_capsule* s, double hh, double r)
 static double cylinder_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
     const scc_sdf_cylinder* s = (const scc_sdf_cylinder*)self;
-    double rho = sqrt(p.x * p.x + p.y * p.y);
+    double rho = scc_hypot2(p.x, p.y);
     double ex = rho > 0.0 ? p.x / rho : 1.0, ey = rho > 0.0 ? p.y / rho : 0.0;
     double dr = rho - s->radius, dz = fabs(p.z) - s->half_height;
     double or_ = fmax(dr, 0.0), oz = fmax(dz, 0.0);
-    double outside = sqrt(or_ * or_ + oz * oz);
+    double outside = scc_hypot2(or_, oz);
     if (g) {
         if (outside > 0.0)
             *g = scc_v3(or_ / outside * ex, or_ / outside * ey, oz / outside * sign_of(p.z));
@@ -218,8 +218,9 @@ static double spike_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
     double best = p.z; /* ground slab z <= 0 */
     scc_vec3 bg = k_up;
     {
-        int ci = (int)lround((p.x - s->x0) / s->spacing);
-        int cj = (int)lround((p.y - s->y0) / s->spacing);
+        /* Clamped before rounding: a far point's cell index must not overflow an int. */
+        int ci = (int)lround(scc_clamp((p.x - s->x0) / s->spacing, -1.0, (double)s->count_x));
+        int cj = (int)lround(scc_clamp((p.y - s->y0) / s->spacing, -1.0, (double)s->count_y));
         ci = ci < 0 ? 0 : (ci >= s->count_x ? s->count_x - 1 : ci);
         cj = cj < 0 ? 0 : (cj >= s->count_y ? s->count_y - 1 : cj);
         for (int j = cj - 1; j <= cj + 1; ++j) {
@@ -227,7 +228,7 @@ static double spike_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
             for (int i = ci - 1; i <= ci + 1; ++i) {
                 if (i < 0 || i >= s->count_x) continue;
                 double dx = p.x - (s->x0 + i * s->spacing), dy = p.y - (s->y0 + j * s->spacing);
-                double rho = sqrt(dx * dx + dy * dy);
+                double rho = scc_hypot2(dx, dy);
                 double grho, gz;
                 double d = cone_distance2(rho, p.z, s->base_radius, s->height, &grho, &gz);
                 if (d < best) {
@@ -263,6 +264,10 @@ static double csg_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
     scc_vec3 ga, gb;
     double a = scc_sdf_eval(s->a, p, g ? &ga : NULL);
     double b = scc_sdf_eval(s->b, p, g ? &gb : NULL);
+    if (isnan(a) || isnan(b)) { /* fmin/fmax would drop the NaN and let a NaN point touch */
+        if (g) *g = scc_v3(NAN, NAN, NAN);
+        return NAN;
+    }
     switch (s->op) {
     case SCC_CSG_UNION:
         if (g) *g = a <= b ? ga : gb;
@@ -297,6 +302,10 @@ static double transform_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
     const scc_sdf_transform* s = (const scc_sdf_transform*)self;
     scc_vec3 local = scc_scale(scc_xform_apply_inv(s->xf, p), 1.0 / s->scale);
+    /* A point so far that dividing by a small scale overflows: clamped, which underestimates the
+     * distance (conservative) and keeps value and gradient finite. */
+    if (!scc_vfinite(local) && !isnan(local.x + local.y + local.z))
+        local = scc_vmax(scc_vmin(local, scc_v3(1e300, 1e300, 1e300)), scc_v3(-1e300, -1e300, -1e300));
     scc_vec3 gl;
     double v = scc_sdf_eval(s->child, local, g ? &gl : NULL);
     if (g) *g = scc_quat_rotate(s->xf.q, gl);

@@ -4,6 +4,7 @@
  * no NaN behind SDFCCD_OK (magnitude checks, overflow-safe SDFs). */
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 #include "test_util.h"
 
@@ -173,6 +174,192 @@ START_TEST(test_overflowing_query_inputs_rejected)
 }
 END_TEST
 
+/* Finding "NaN behind OK": |p| >~ 1.3e154 overflowed sqrt(x^2 + y^2) on the torus and the
+ * cylinder. Every analytic SDF now gives the exact, finite distance far away. */
+START_TEST(test_analytic_far_points_finite)
+{
+    sdfccd_SdfId shapes[6];
+    ck_assert_int_eq(sdfccd_create_torus(1.0, 0.25, &shapes[0]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_cylinder(1.0, 0.5, &shapes[1]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_sphere(1.0, &shapes[2]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 1, 2, 3 }, &shapes[3]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_capsule(1.0, 0.5, &shapes[4]), SDFCCD_OK);
+    sdfccd_SpikeGridDef sg = sdfccd_default_spike_grid_def();
+    ck_assert_int_eq(sdfccd_create_spike_grid(&sg, &shapes[5]), SDFCCD_OK);
+    const double mags[3] = { 1e154, 1e200, 1e300 };
+    for (int k = 0; k < 6; ++k)
+        for (int m = 0; m < 3; ++m) {
+            /* along the diagonal (x, x, x): the distance is |p| sqrt(3) to within the shape's size */
+            double x = mags[m];
+            sdfccd_Vec3 p = { x, x, x * (k == 5 ? 1.0 : 1.0) }, g;
+            double v;
+            ck_assert_int_eq(sdfccd_sdf_eval(shapes[k], p, &v, &g), SDFCCD_OK);
+            ck_assert_msg(isfinite(v) && isfinite(g.x) && isfinite(g.y) && isfinite(g.z), "shape %d at %g: %g", k, x, v);
+            if (k < 5) ck_assert_double_near(v / (x * sqrt(3.0)), 1.0, 1e-12);
+            else ck_assert_double_near(v / x, 1.0, 1e-12); /* the ground plane z = 0 is nearest */
+            ck_assert_double_near(sqrt(g.x * g.x + g.y * g.y + g.z * g.z), 1.0, 1e-12);
+        }
+    /* and tiny offsets (squares underflowing) still give a unit gradient */
+    sdfccd_Vec3 g;
+    double v;
+    ck_assert_int_eq(sdfccd_sdf_eval(shapes[2], (sdfccd_Vec3){ 1e-200, 0, 0 }, &v, &g), SDFCCD_OK);
+    ck_assert_double_near(v, -1.0, 0.0);
+    ck_assert_double_near(g.x, 1.0, 1e-15);
+    for (int k = 0; k < 6; ++k) sdfccd_destroy_sdf(shapes[k]);
+}
+END_TEST
+
+/* Finding "NaN behind OK": a transformed SDF with scale 1e-200 gave NaN at every point. Scales
+ * are limited to [1e-100, 1e100]; at the limits evaluations are finite and exact. */
+START_TEST(test_transform_scale_limits)
+{
+    sdfccd_SdfId s, t;
+    ck_assert_int_eq(sdfccd_create_sphere(1.0, &s), SDFCCD_OK);
+    sdfccd_Pose id = sdfccd_pose_identity();
+    ck_assert_int_eq(sdfccd_create_transformed(s, id, 1e-200, &t), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_create_transformed(s, id, 1e200, &t), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_Pose far = id;
+    far.position.x = 1e200;
+    ck_assert_int_eq(sdfccd_create_transformed(s, far, 1.0, &t), SDFCCD_INVALID_ARGUMENT);
+    const double scales[2] = { 1e-100, 1e100 };
+    for (int k = 0; k < 2; ++k) {
+        ck_assert_int_eq(sdfccd_create_transformed(s, id, scales[k], &t), SDFCCD_OK);
+        const double pts[4] = { 1.0, 1e100, 1e200, 1e300 };
+        for (int i = 0; i < 4; ++i) {
+            double v;
+            sdfccd_Vec3 g;
+            ck_assert_int_eq(sdfccd_sdf_eval(t, (sdfccd_Vec3){ 0, pts[i], 0 }, &v, &g), SDFCCD_OK);
+            ck_assert_msg(isfinite(v) && isfinite(g.y), "scale %g at %g: %g", scales[k], pts[i], v);
+            ck_assert_double_near(g.y, 1.0, 1e-12);
+            if (pts[i] / scales[k] > 1e300) { /* clamped in the child's frame: a finite underestimate */
+                ck_assert(v > 0.0 && v <= pts[i]);
+                continue;
+            }
+            ck_assert_double_near(v, pts[i] - scales[k], 1e-12 * fmax(pts[i], scales[k])); /* |p| - scale * radius */
+        }
+        sdfccd_destroy_sdf(t);
+    }
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
+static double nan_field(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
+{
+    (void)user;
+    if (g) *g = (sdfccd_Vec3){ 0, 0, 1 };
+    return p.z > 0.05 ? p.z : NAN;
+}
+
+/* Finding "NaN behind OK": CSG's fmin/fmax dropped a NaN operand, so a NaN point "touched"
+ * (hit = 1 with NaN contacts). A NaN operand now makes the combination NaN, which never touches,
+ * and an OK result has only finite contacts. */
+START_TEST(test_csg_nan_operand)
+{
+    sdfccd_SdfId plane, cb, u;
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, -5.0, &plane), SDFCCD_OK);
+    sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
+    d.eval = nan_field;
+    ck_assert_int_eq(sdfccd_create_callback_sdf(&d, &cb), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_UNION, plane, cb, &u), SDFCCD_OK);
+    double v;
+    ck_assert_int_eq(sdfccd_sdf_eval(u, (sdfccd_Vec3){ 0, 0, 0 }, &v, NULL), SDFCCD_OK);
+    ck_assert(isnan(v));
+    sdfccd_Vec3 tri[3] = { { 0, 0, 0.5 }, { 0.1, 0, 0.5 }, { 0, 0.1, 0.5 } };
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.linear_velocity.z = -1.0;
+    sdfccd_QueryParams p = sdfccd_default_query_params();
+    sdfccd_Contact c[8];
+    sdfccd_QueryResult r;
+    for (int method = 0; method < SDFCCD_METHOD_COUNT; ++method) {
+        p.method = (sdfccd_Method)method;
+        ck_assert_int_eq(sdfccd_query_triangle(u, NULL, tri, &m, 0, 1, &p, c, 8, &r), SDFCCD_OK);
+        ck_assert(isfinite(r.toi) && isfinite(r.fraction));
+        for (int i = 0; i < r.contact_count; ++i)
+            ck_assert(isfinite(c[i].point.x) && isfinite(c[i].normal.z) && isfinite(c[i].distance));
+    }
+    sdfccd_destroy_sdf(u);
+    sdfccd_destroy_sdf(cb);
+    sdfccd_destroy_sdf(plane);
+}
+END_TEST
+
+static unsigned char* read_all(const char* path, size_t* out_size)
+{
+    FILE* f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    unsigned char* b = malloc((size_t)n);
+    ck_assert_int_eq(fread(b, 1, (size_t)n, f), (size_t)n);
+    fclose(f);
+    *out_size = (size_t)n;
+    return b;
+}
+
+/* Findings on .cdf files: a domain of +-1e308 loaded (every evaluation NaN); node values of
+ * 1e154 loaded (infinite value, NaN gradient, infinite Lipschitz bound); a directory reported
+ * out of memory (a 9.2e18-byte request); an empty node array called memcpy(NULL, src, 0). */
+START_TEST(test_cdf_overflow_and_files)
+{
+    size_t n;
+    unsigned char* b = read_all(SDFCCD_DATA_DIR "/sdf/upstream/box.cdf", &n);
+    sdfccd_SdfId g;
+    ck_assert_int_eq(sdfccd_load_grid_memory(b, n, &g), SDFCCD_OK);
+    sdfccd_destroy_sdf(g);
+    unsigned char* m = malloc(n);
+    /* domain -1e308 .. 1e308 on every axis (cell size and its inverse follow) */
+    memcpy(m, b, n);
+    uint32_t res[3];
+    memcpy(res, m + 48, 12);
+    for (int i = 0; i < 3; ++i) {
+        double lo = -1e308, hi = 1e308, h = hi / res[i] * 2.0, ih = 1.0 / h;
+        memcpy(m + 8 * i, &lo, 8);
+        memcpy(m + 24 + 8 * i, &hi, 8);
+        memcpy(m + 60 + 8 * i, &h, 8);
+        memcpy(m + 84 + 8 * i, &ih, 8);
+    }
+    ck_assert_int_eq(sdfccd_load_grid_memory(m, n, &g), SDFCCD_FORMAT_ERROR);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "domain"));
+    /* node 0 of field 0 (after the 124-byte header, the array count and the node count) = 1e154 */
+    memcpy(m, b, n);
+    const double huge = 1e154;
+    memcpy(m + 140, &huge, 8);
+    ck_assert_int_eq(sdfccd_load_grid_memory(m, n, &g), SDFCCD_FORMAT_ERROR);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "node value"));
+    /* a field with empty node and cell arrays */
+    unsigned char e[124 + 8 + 8 + 8 + 8 + 8 + 8 + 4];
+    memcpy(e, b, 124);
+    const uint64_t one = 1, zero = 0, cells = 1;
+    const uint32_t r1[3] = { 1, 1, 1 };
+    memcpy(e + 48, r1, 12);
+    for (int i = 0; i < 3; ++i) { /* one cell: h = extent */
+        double lo, hi;
+        memcpy(&lo, e + 8 * i, 8);
+        memcpy(&hi, e + 24 + 8 * i, 8);
+        double h = hi - lo, ih = 1.0 / h;
+        memcpy(e + 60 + 8 * i, &h, 8);
+        memcpy(e + 84 + 8 * i, &ih, 8);
+    }
+    memcpy(e + 108, &cells, 8);
+    memcpy(e + 116, &one, 8);
+    memcpy(e + 124, &one, 8);  /* node arrays: 1 */
+    memcpy(e + 132, &zero, 8); /*   count 0 */
+    memcpy(e + 140, &one, 8);  /* cell arrays: 1 */
+    memcpy(e + 148, &zero, 8); /*   count 0 */
+    memcpy(e + 156, &one, 8);  /* cell maps: 1 */
+    memcpy(e + 164, &cells, 8);
+    const uint32_t none = 0xFFFFFFFFu;
+    memcpy(e + 172, &none, 4);
+    ck_assert_int_eq(sdfccd_load_grid_memory(e, sizeof e, &g), SDFCCD_FORMAT_ERROR);
+    /* a directory */
+    ck_assert_int_eq(sdfccd_load_grid(SDFCCD_DATA_DIR, &g), SDFCCD_IO_ERROR);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "not a regular file"));
+    free(m);
+    free(b);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("hardening");
@@ -182,6 +369,10 @@ int main(void)
     tcase_add_test(tc, test_budget_shared_by_segments);
     tcase_add_test(tc, test_budget_shared_by_triangles);
     tcase_add_test(tc, test_overflowing_query_inputs_rejected);
+    tcase_add_test(tc, test_analytic_far_points_finite);
+    tcase_add_test(tc, test_transform_scale_limits);
+    tcase_add_test(tc, test_csg_nan_operand);
+    tcase_add_test(tc, test_cdf_overflow_and_files);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -170,6 +170,21 @@ static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
     return SDFCCD_OK;
 }
 
+/* The grid box as built: coordinates within SCC_GRID_MAX_COORDINATE and cells at least
+ * SCC_GRID_MIN_CELL wide, so no distance or gradient of the grid overflows. */
+static sdfccd_Status check_domain(scc_aabb d, const sdfccd_GridDef* def, const char* fn)
+{
+    const double lo[3] = { d.lo.x, d.lo.y, d.lo.z }, hi[3] = { d.hi.x, d.hi.y, d.hi.z };
+    for (int i = 0; i < 3; ++i) {
+        if (!(fabs(lo[i]) <= SCC_GRID_MAX_COORDINATE && fabs(hi[i]) <= SCC_GRID_MAX_COORDINATE))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the domain [%g, %g] on axis %d exceeds +-%g", fn, lo[i], hi[i], i,
+                                 SCC_GRID_MAX_COORDINATE);
+        if (!((hi[i] - lo[i]) / def->resolution[i] >= SCC_GRID_MIN_CELL))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: cells narrower than %g on axis %d", fn, SCC_GRID_MIN_CELL, i);
+    }
+    return SDFCCD_OK;
+}
+
 static sdfccd_Status build_status(scc_grid_build_status st, const char* fn)
 {
     switch (st) {
@@ -177,7 +192,7 @@ static sdfccd_Status build_status(scc_grid_build_status st, const char* fn)
     case SCC_GRID_BUILD_OUT_OF_MEMORY: return sdfccd__oom("a grid");
     case SCC_GRID_BUILD_TOO_LARGE: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the grid needs more than 2^32 nodes", fn);
     case SCC_GRID_BUILD_EMPTY_BAND: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the band culled every cell (no surface inside the domain?)", fn);
-    case SCC_GRID_BUILD_BAD_VALUE: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the source returned a non-finite value at a node", fn);
+    case SCC_GRID_BUILD_BAD_VALUE: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the source returned a non-finite value or one above 1e100 in magnitude at a node", fn);
     case SCC_GRID_BUILD_CANCELLED: return sdfccd__error(SDFCCD_BAD_STATE, "%s: cancelled", fn);
     }
     return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: unknown build failure", fn);
@@ -230,6 +245,10 @@ sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_Grid
         return st;
     }
     const scc_aabb domain = def->fit_domain ? padded(scc_grid_fit_domain(m->mesh.bounds), def->padding) : sdfccd__box(def->domain);
+    if ((st = check_domain(domain, def, fn))) {
+        scc_mesh_sdf_destroy(&ms);
+        return st;
+    }
     sdfccd__pool pool;
     sdfccd__pool_init(&pool, def->threads, def->progress, def->progress_user);
     scc_grid_build_def bd;
@@ -272,6 +291,7 @@ sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef
     } else {
         domain = sdfccd__box(def->domain);
     }
+    if ((st = check_domain(domain, def, fn))) return st;
     sdfccd__sdf_retain(s); /* keep the source alive during the build */
     sdfccd__pool pool;
     sdfccd__pool_init(&pool, def->threads, def->progress, def->progress_user);

@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static int host_is_little_endian(void)
 {
@@ -33,7 +34,7 @@ static sdfccd_Status fmt(const reader* r, const char* what)
 static int rd(reader* r, void* out, size_t n)
 {
     if (r->size - r->pos < n) return 0;
-    memcpy(out, r->data + r->pos, n);
+    if (n) memcpy(out, r->data + r->pos, n); /* out is NULL for an empty array */
     r->pos += n;
     return 1;
 }
@@ -49,8 +50,12 @@ static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId*
         return fmt(&r, "file too short for the header");
     for (int i = 0; i < 3; ++i) {
         if (!isfinite(dom[i]) || !isfinite(dom[3 + i]) || !(dom[i] < dom[3 + i])) { r.pos = 0; return fmt(&r, "domain is not finite or min >= max"); }
+        /* Beyond these, distances between domain points overflow (a domain of +-1e308 loaded and
+         * every evaluation was NaN) or gradients (value / cell size) do. */
+        if (fabs(dom[i]) > SCC_GRID_MAX_COORDINATE || fabs(dom[3 + i]) > SCC_GRID_MAX_COORDINATE) { r.pos = 0; return fmt(&r, "domain coordinate above 1e100 in magnitude"); }
         if (res[i] == 0) { r.pos = 48; return fmt(&r, "a resolution is 0"); }
         const double ext = dom[3 + i] - dom[i];
+        if (!(ext / res[i] >= SCC_GRID_MIN_CELL)) { r.pos = 48; return fmt(&r, "cell size below 1e-50"); }
         if (!isfinite(h[i]) || !(h[i] > 0.0) || fabs(h[i] * res[i] - ext) > 1e-9 * ext) { r.pos = 60; return fmt(&r, "cell size does not match domain / resolution"); }
         if (!isfinite(ih[i]) || fabs(h[i] * ih[i] - 1.0) > 1e-9) { r.pos = 84; return fmt(&r, "inverse cell size does not match the cell size"); }
     }
@@ -84,7 +89,11 @@ static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId*
         const size_t at = r.pos;
         rd(&r, fd->nodes, (size_t)count * 8);
         for (uint64_t i = 0; i < count; ++i)
-            if (!isfinite(fd->nodes[i])) { r.pos = at + 8 * i; st = fmt(&r, "node value is NaN or infinite"); goto fail; }
+            if (!(fabs(fd->nodes[i]) <= SCC_GRID_MAX_COORDINATE) && fd->nodes[i] != SCC_GRID_NO_VALUE) {
+                r.pos = at + 8 * i;
+                st = fmt(&r, "node value is NaN, infinite or above 1e100 in magnitude (other than the not-sampled marker)");
+                goto fail;
+            }
     }
     /* cell arrays */
     if (!rd(&r, &outer, 8)) { st = fmt(&r, "file ends before the cell arrays"); goto fail; }
@@ -152,6 +161,12 @@ sdfccd_Status sdfccd_load_grid(const char* path, sdfccd_SdfId* out_grid)
     if (!host_is_little_endian()) return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_load_grid: .cdf files are little-endian; this host is not");
     FILE* f = fopen(path, "rb");
     if (!f) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_grid: cannot open '%s': %s", path, strerror(errno));
+    /* A directory opens for reading on Linux and reports an absurd size (it asked for 9.2e18 bytes). */
+    struct stat sb;
+    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        fclose(f);
+        return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_grid: '%s' is not a regular file", path);
+    }
     long size = -1;
     if (fseek(f, 0, SEEK_END) == 0) size = ftell(f);
     if (size < 0 || fseek(f, 0, SEEK_SET) != 0) {

@@ -189,6 +189,12 @@ sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, do
     if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_transformed: out_sdf")) || (st = positive(scale, "sdfccd_create_transformed: scale")) ||
         (st = sdfccd__check_pose(pose, "sdfccd_create_transformed: pose", &xf)))
         return st;
+    /* Beyond these, x / scale or scale * phi overflows for ordinary points (a scale of 1e-200 made
+     * every evaluation NaN). */
+    if (scale < 1e-100 || scale > 1e100)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_transformed: scale must be in [1e-100, 1e100] (got %g)", scale);
+    if (fmax(fabs(pose.position.x), fmax(fabs(pose.position.y), fabs(pose.position.z))) > 1e150)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_transformed: pose position has a coordinate above 1e150");
     sdfccd__sdf* c = sdfccd__sdf_lookup(child);
     if (!c) return SDFCCD_INVALID_HANDLE;
     sdfccd__sdf* s = new_shape(sizeof(scc_sdf_transform), "a transformed SDF");

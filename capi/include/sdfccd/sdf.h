@@ -68,7 +68,9 @@ typedef enum sdfccd_CsgOp { SDFCCD_CSG_UNION, SDFCCD_CSG_INTERSECTION, SDFCCD_CS
 SDFCCD_API sdfccd_Status sdfccd_create_csg(sdfccd_CsgOp op, sdfccd_SdfId a, sdfccd_SdfId b, sdfccd_SdfId* out_sdf);
 
 /** `child` placed with `pose` and uniformly scaled by `scale` > 0:
- * phi(x) = scale * phi_child(inverse(pose)(x) / scale). Rigid motion and uniform scale keep distances exact. */
+ * phi(x) = scale * phi_child(inverse(pose)(x) / scale). Rigid motion and uniform scale keep distances exact.
+ * `scale` must be in [1e-100, 1e100] and the pose's position within 1e150 per coordinate (beyond,
+ * the division or the product overflows); else ::SDFCCD_INVALID_ARGUMENT. */
 SDFCCD_API sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, double scale, sdfccd_SdfId* out_sdf);
 
 /** A user SDF. `eval` returns phi at p (local frame) and writes the gradient to *out_grad when
