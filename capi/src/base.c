@@ -114,7 +114,7 @@ const char* sdfccd_status_string(sdfccd_Status status)
 /* ---------------- version ---------------- */
 
 int32_t sdfccd_version(void) { return SDFCCD_VERSION_ID; }
-const char* sdfccd_version_string(void) { return "0.1.0"; }
+const char* sdfccd_version_string(void) { return SDFCCD_VERSION_STRING; }
 int sdfccd_is_double_precision(void) { return 1; }
 
 #ifndef SDFCCD_HAVE_ASSIMP
@@ -124,7 +124,7 @@ int sdfccd_is_double_precision(void) { return 1; }
 #define SDFCCD_STR(x) SDFCCD_STR2(x)
 const char* sdfccd_configuration_string(void)
 {
-    return "sdfccd 0.1.0; scalar=double; assimp=" SDFCCD_STR(SDFCCD_HAVE_ASSIMP)
+    return "sdfccd " SDFCCD_VERSION_STRING "; scalar=double; assimp=" SDFCCD_STR(SDFCCD_HAVE_ASSIMP)
 #if defined(__clang__)
         "; compiler=clang " __clang_version__
 #elif defined(__GNUC__)
