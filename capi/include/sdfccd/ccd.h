@@ -79,6 +79,11 @@ typedef struct sdfccd_QueryParams {
     int32_t fwgss_speed_tolerance; /**< FWGSS: the spatial tolerance is the distance the fastest point of the triangle
                                         travels in time_tolerance (speed bound x time_tolerance), so a spatial error
                                         costs at most about time_tolerance; 0 = distance_tolerance. Default 1. */
+    int32_t fwgss_clear_proof;     /**< FWGSS: before the descents, at most this many SDF evaluations try to prove that the
+                                        triangle stays clear of the field (conservative advancement of sub-triangles with
+                                        the field's Lipschitz bound, split when stalled); when it succeeds the triangle
+                                        has no contact and the descents are skipped. A proof, so it never loses a contact.
+                                        0 = off. Default 64. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
