@@ -4,15 +4,17 @@
 // btBvhTriangleMeshShape against Bullet's GImpact algorithm).
 //
 //  gimpact-demo   Bullet 2.x GimpactTestDemo: Y up, g = -10, 1/60 s. GImpact tori (bullet3
-//                 torus_textured x2: R 1 m, r 0.5 m, mass 1) and bunnies (bunny x4, mass 4)
+//                 torus_textured x2: R 1 m, r 0.5 m, mass 1) and bunnies (bunny.obj, 2 m, mass 4)
 //                 tumbling onto an SDF floor box (top at y = -9), a lying analytic torus
-//                 (R 2, r 0.5) and a grid SDF bunny (bunny x4, 32^3 grid; measured against the
-//                 exact mesh distance). 12 bodies (quick: 4).
+//                 (R 2, r 0.5) and a grid SDF bunny (32^3 grid; measured against the exact mesh
+//                 distance). bullet3's bunny.obj is already 2 m long (the demo's own bunny data
+//                 scaled x4 is about that size), so it is used at scale 1 (mass 4).
+//                 12 bodies (quick: 4).
 //  gimpact-shot-50/200/500   the same, plus a torus mesh shot at the lying torus at 50, 200 or
 //                 500 m/s at step 60 (the demo's "shoot" key).
 //  sdf-box        pybullet's signedDistanceField.py: Z up, g = -10, 1/240 s, concave_box.cdf
 //                 (data/sdf/concave_box_r32.cdf) static at the origin through our SdfShape, with a
-//                 9 cm torus (torus x0.06, mass 0.1) and small GImpact meshes (bunny x0.2,
+//                 9 cm torus (torus x0.06, mass 0.1) and small GImpact meshes (bunny x0.05 = 10 cm,
 //                 cube x0.08, torus x0.06; 9 bodies, quick: 3) dropped in.
 //  sdf-box-btsdf  the same through Bullet's own btSdfCollisionShape read from the same file.
 //  sdf-box-torus  the 9 cm torus dropped alone (the bridge issue's 5 mm limit).
@@ -54,7 +56,7 @@ public:
     {
         const Options& o = options();
         std::shared_ptr<MeshData> torus = loadMesh(o.data_dir + "/bullet3/torus_textured.obj", 2.0);
-        std::shared_ptr<MeshData> bunny = loadMesh(o.data_dir + "/bullet3/bunny.obj", 4.0);
+        std::shared_ptr<MeshData> bunny = loadMesh(o.data_dir + "/bullet3/bunny.obj", 1.0);
         if (!torus || !bunny) return false;
         torus->name = "torus";
         bunny->name = "bunny";
@@ -64,13 +66,13 @@ public:
         sdfccd_create_box(sdfccd_Vec3{ 30, 1, 30 }, &floor);
         Collider& f = addStaticSdf("floor", floor, btVector3(0, -10, 0), btQuaternion::getIdentity(),
                                    sdfccd_Aabb{ { -30.5, -1.5, -30.5 }, { 30.5, 1.5, 30.5 } }, 60, floor);
-        f.kill_below = -11;
+        f.killBelow(up, -11);
         // A torus lying on the floor (axis = y): analytic.
         sdfccd_SdfId ring;
         sdfccd_create_torus(2, 0.5, &ring);
         addStaticSdf("lying_torus", ring, btVector3(-6, -8.5, 0), axisAngle(1, 0, 0, -kPi / 2),
                      sdfccd_Aabb{ { -2.6, -2.6, -0.6 }, { 2.6, 2.6, 0.6 } }, 64, ring);
-        // The bunny x4 as a grid SDF, sitting on the floor; measured against the exact mesh distance.
+        // The bunny as a grid SDF, sitting on the floor; measured against the exact mesh distance.
         sdfccd_MeshId bunny_mesh = createMesh(*bunny);
         sdfccd_GridDef gd = sdfccd_default_grid_def();
         gd.resolution[0] = gd.resolution[1] = gd.resolution[2] = 32;
@@ -160,9 +162,9 @@ public:
             sdfccd_grid_get_info(grid, &gi);
             c = &addStaticSdf("concave_box", grid, btVector3(0, 0, 0), btQuaternion::getIdentity(), gi.domain, 96, grid);
         }
-        c->kill_below = -0.2; // the tray is |z| <= 0.1
+        c->killBelow(up, -0.2); // the tray is |z| <= 0.1
         std::shared_ptr<MeshData> torus = loadMesh(o.data_dir + "/bullet3/torus_textured.obj", 0.06);
-        std::shared_ptr<MeshData> bunny = loadMesh(o.data_dir + "/bullet3/bunny.obj", 0.2);
+        std::shared_ptr<MeshData> bunny = loadMesh(o.data_dir + "/bullet3/bunny.obj", 0.05);
         std::shared_ptr<MeshData> cube = loadMesh(o.data_dir + "/bullet3/cube.obj", 0.08);
         if (!torus || !bunny || !cube) return false;
         torus->name = "torus9cm";
@@ -247,7 +249,7 @@ public:
         if (sdfccd_create_callback_sdf(&def, &land) != SDFCCD_OK) return false;
         Collider& c = addStaticSdf("landscape", land, btVector3(0, 0, 0), btQuaternion::getIdentity(),
                                    sdfccd_Aabb{ { -kHalf - 0.5, -12.5, -kHalf - 0.5 }, { kHalf + 0.5, kAmp + 1, kHalf + 0.5 } }, 128, land);
-        c.kill_below = -12;
+        c.killBelow(up, -12);
         for (auto& b : rigidStatics()) b->setFriction(0.9f);
         std::shared_ptr<MeshData> cube = loadMesh(o.data_dir + "/bullet3/cube.obj", 2.0);
         std::shared_ptr<MeshData> torus = loadMesh(o.data_dir + "/bullet3/torus_textured.obj", 2.0);

@@ -46,6 +46,7 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
 {
     up[0] = up[1] = up[2] = 0;
     up[up_axis] = 1;
+    for (int k = 0; k < 3; ++k) this->gravity[k] = (double)gravity[k];
     sdfccd_bullet::Config cfg;
     cfg.query.method = opt.method;
     cfg.query.subdivision = opt.subdivision ? 1 : 0;
@@ -193,6 +194,7 @@ Collider& BulletScene::addStaticSdf(const std::string& name, sdfccd_SdfId sdf, c
     c.frame = frameOf(t);
     c.exact = exact;
     c.exact_mesh = exact_mesh;
+    c.ccd = sdf;
     c.bounds = bounds;
     colliders.push_back(c);
     return colliders.back();
@@ -221,6 +223,7 @@ Collider& BulletScene::addStaticBtSdf(const std::string& name, const std::string
     c.name = name;
     c.frame = frameOf(t);
     c.exact = grid;
+    c.ccd = grid;
     c.bounds = gi.domain;
     colliders.push_back(c);
     m_description += " [btSdfCollisionShape]";

@@ -81,8 +81,7 @@ void measure(Scene& scene, Measure& m)
             size_t n = pts.size() / 3;
             double lc[3];
             c.frame.applyInverse(&pts[3 * (n - 1)], lc);
-            double up_h = dot3(&pts[3 * (n - 1)], scene.up);
-            if (up_h < c.kill_below) m.tunnelled[bi] = 1;
+            if (dot3(&pts[3 * (n - 1)], c.kill_normal) > c.kill_offset) m.tunnelled[bi] = 1;
             double reach = b.deformable ? 1e300 : b.mesh->radius;
             if (boxDistance(c.bounds, lc) > reach + 0.05) continue;
             owner.push_back(std::make_pair(bi, batch.size()));

@@ -11,8 +11,23 @@ namespace scenes {
 
 const char* Scene::precision() const { return "double"; }
 
+MeshData::~MeshData()
+{
+    if (handle.index1) sdfccd_destroy_mesh(handle);
+}
+
 void MeshData::finish(int density)
 {
+    if (!handle.index1 && !f.empty()) {
+        sdfccd_MeshDef def = sdfccd_default_mesh_def();
+        def.vertices = v.data();
+        def.vertex_count = (uint32_t)vertexCount();
+        def.indices = f.data();
+        def.triangle_count = (uint32_t)triangleCount();
+        def.drop_degenerate = 1;
+        if (sdfccd_create_mesh(&def, &handle) != SDFCCD_OK)
+            std::fprintf(stderr, "sdfccd_scenes: mesh %s: %s\n", name.c_str(), sdfccd_last_error());
+    }
     int nv = vertexCount();
     samples = v;
     if (density > 1) {

@@ -48,6 +48,11 @@ struct MeshData {
     double radius = 0;           /**< max |vertex| (body frame origin to farthest vertex). */
     double half_thickness = 0;   /**< Half the smallest extent of the local box. */
     sdfccd_Aabb bounds{};
+    sdfccd_MeshId handle{};      /**< The mesh as an sdfccd handle (created by finish(); destroyed with the data). */
+    MeshData() = default;
+    MeshData(const MeshData&) = delete;
+    MeshData& operator=(const MeshData&) = delete;
+    ~MeshData();
     int vertexCount() const { return (int)(v.size() / 3); }
     int triangleCount() const { return (int)(f.size() / 3); }
     int sampleCount() const { return (int)(samples.size() / 3); }
@@ -92,7 +97,18 @@ struct Collider {
     sdfccd_MeshId exact_mesh{};
     sdfccd_SdfId render{};   /**< Drawn in snapshots when `exact` is not set (e.g. the grid of a mesh). */
     sdfccd_Aabb bounds{};    /**< Local box containing the surface (for culling far bodies). */
-    double kill_below = -1e300; /**< A body centre below this world height (up axis) has fallen through. */
+    /** A body centre c with dot(kill_normal, c) > kill_offset has passed through (tunnelled): e.g.
+     * below a floor, or beyond a plate it was thrown at. Default: never. */
+    double kill_normal[3] = { 0, 0, 0 };
+    double kill_offset = 1e300;
+    /** The SDF the CCD queries use (what the bridge's shape wraps); for Table 4's probe queries. */
+    sdfccd_SdfId ccd{};
+    /** Sets the kill plane to "centre below height h along up". */
+    void killBelow(const double* up, double h)
+    {
+        for (int k = 0; k < 3; ++k) kill_normal[k] = -up[k];
+        kill_offset = -h;
+    }
 };
 
 /** Per-step figures a scene reports about its own collision pipeline. */
@@ -115,6 +131,9 @@ public:
     virtual double energy() const = 0;
     /** True when energy is injected at step i (a shot fired): energy gain is not counted there. */
     virtual bool injects(int i) const { return false; }
+    /** Largest penetration (m, >= 0) seen INSIDE steps along the motion the scene executed, for
+     * kinematic scenes that know it (sampled along the executed path); 0 otherwise. */
+    virtual double sweptPenetration() const { return 0; }
     /** "float" or "double": the btScalar of the Bullet build (kinematic scenes: "double"). */
     virtual const char* precision() const;
     /** One-line description of the configuration actually built (bodies, variants). */
@@ -123,6 +142,7 @@ public:
     std::vector<Body> bodies;
     std::vector<Collider> colliders;
     double up[3] = { 0, 0, 1 };  /**< Up axis (for kill planes and potential energy). */
+    double gravity[3] = { 0, 0, 0 }; /**< m/s^2 (Table 4's probe predicts the motion with it). */
     sdfccd_Aabb view{};          /**< Snapshot view box (world); empty (lo = hi) frames the bodies. */
 };
 
