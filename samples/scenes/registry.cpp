@@ -9,6 +9,7 @@ const std::vector<SceneEntry>& sceneTable()
 {
     static const std::vector<SceneEntry> table = [] {
         std::vector<SceneEntry> t;
+        appendPaperScenes(t);
         appendBulletRecreations(t);
         return t;
     }();

@@ -171,6 +171,11 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
         double ccd_s = c.ccd_seconds - prev_cost.ccd_seconds;
         contacts_sum += c.contacts;
         measure(scene, m);
+        if (scene.sweptPenetration() > s.max_penetration) {
+            s.max_penetration = scene.sweptPenetration();
+            s.max_penetration_step = i;
+            s.max_penetration_where = "inside the step (executed motion)";
+        }
         if (m.min_phi < 1e299) {
             double pen = std::max(0.0, -m.min_phi);
             if (pen > s.max_penetration) {

@@ -11,6 +11,9 @@ namespace scenes {
 
 /** gimpact-demo, gimpact-shot-*, sdf-box*, landscape (bullet_recreations.cpp). */
 void appendBulletRecreations(std::vector<SceneEntry>& table);
+/** The paper's scenes: shuriken, torus-crossings, skateboard, pyramids, bunny, hoop, spikes,
+ * triangle-flat, spin360 (paper_scenes.cpp); cloth (cloth.cpp). */
+void appendPaperScenes(std::vector<SceneEntry>& table);
 
 } // namespace scenes
 
