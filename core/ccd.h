@@ -115,6 +115,8 @@ typedef struct scc_mesh_motion {
 } scc_mesh_motion;
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum);
+/* The motion of triangle t of the mesh motion `mm` (what the mesh query tests per triangle). */
+void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_motion* out);
 
 /* scc_query_mesh with instrumentation for benchmarks (mesh_query.c): `probe` (may be NULL) is
  * called with begin = 1 right before and begin = 0 right after each narrow-phase triangle test,

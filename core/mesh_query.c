@@ -42,7 +42,7 @@ static void buf_prune(contact_buf* b, double limit)
     b->n = k;
 }
 
-static void fill_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_motion* m)
+void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_motion* m)
 {
     const uint32_t* f = mm->mesh->indices + 3 * t;
     m->sdf = mm->sdf;
@@ -99,7 +99,7 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
     scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     double tb = fmin(c->mm->t1, c->best + p->toi_window);
     scc_tri_motion m;
-    fill_triangle_motion(c->mm, t, &m);
+    scc_mesh_triangle_motion(c->mm, t, &m);
     scc_query_summary s;
     if (c->probe) c->probe(c->probe_user, t, 1);
     if (!(ta < tb)) ta = c->mm->t0;

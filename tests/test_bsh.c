@@ -239,23 +239,6 @@ static int record_visit(void* user, uint32_t tri, double t_candidate, double* io
     return 1;
 }
 
-static void fill_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_motion* m)
-{
-    memset(m, 0, sizeof *m);
-    const uint32_t* f = mm->mesh->indices + 3 * t;
-    m->sdf = mm->sdf;
-    m->t0 = mm->t0;
-    m->t1 = mm->t1;
-    if (mm->body) {
-        m->kind = SCC_TRI_RIGID;
-        m->body = mm->body;
-        for (int i = 0; i < 3; ++i) m->local[i] = mm->mesh->vertices[f[i]];
-    } else {
-        m->kind = SCC_TRI_LINEAR;
-        for (int i = 0; i < 3; ++i) { m->start[i] = mm->start[f[i]]; m->end[i] = mm->end[f[i]]; }
-    }
-}
-
 typedef struct sweep_stats {
     int cases, hit_cases, tri_hits, culled_hits, cert_nc;
     int fwgss_later_than_plain, fwgss_cases;
@@ -321,7 +304,8 @@ static void run_case(test_rng* rng, const fields* fl, int kind, sweep_stats* st)
     double earliest = INFINITY;
     for (uint32_t t = 0; t < nt; ++t) {
         scc_tri_motion m;
-        fill_motion(&mm, t, &m);
+        memset(&m, 0, sizeof m);
+        scc_mesh_triangle_motion(&mm, t, &m);
         scc_query_summary s;
         scc_contact dummy[1 + SCC_MAX_SUBDIVISION_CONTACTS];
         ck_assert(scc_query_triangle(sdf, &m, 0.0, DT, &pc, &k_alloc, t, dummy, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
@@ -388,7 +372,8 @@ skip_exact:
     ck_assert(scc_bsh_traverse(bsh, mv, sdf, &mm, &pd, &k_alloc, DT, record_visit, &rec, &bst));
     for (uint32_t t = 0; t < nt; ++t) {
         scc_tri_motion m;
-        fill_motion(&mm, t, &m);
+        memset(&m, 0, sizeof m);
+        scc_mesh_triangle_motion(&mm, t, &m);
         scc_query_summary s;
         scc_contact dummy[1 + SCC_MAX_SUBDIVISION_CONTACTS];
         ck_assert(scc_query_triangle(sdf, &m, 0.0, DT, &pd, &k_alloc, t, dummy, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));

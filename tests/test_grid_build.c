@@ -16,16 +16,6 @@
 #define SDFCCD_TEST_TMP_DIR "."
 #endif
 
-static sdfccd_MeshId load_mesh(const char* rel)
-{
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s", SDFCCD_DATA_DIR, rel);
-    sdfccd_MeshId m;
-    sdfccd_Status st = sdfccd_load_mesh(path, NULL, &m);
-    ck_assert_msg(st == SDFCCD_OK, "load %s: %s", path, sdfccd_last_error());
-    return m;
-}
-
 static sdfccd_SdfId sphere_grid(double radius, int res, int threads, double band)
 {
     sdfccd_SdfId s, g;
@@ -89,7 +79,7 @@ static void on_progress(double f, void* user)
 /* 1 and 2 threads give bit-identical grids; progress rises to 1. */
 START_TEST(test_threads_identical_and_progress)
 {
-    sdfccd_MeshId mesh = load_mesh("bullet3/torus_textured.obj");
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/torus_textured.obj");
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[0] = 12; def.resolution[1] = 20; def.resolution[2] = 9;
     sdfccd_SdfId a, b;
@@ -125,7 +115,7 @@ END_TEST
  * bound (its band is unknown, so only |value| <= |exact| is required). */
 START_TEST(test_narrow_band)
 {
-    sdfccd_MeshId mesh = load_mesh("bullet3/bunny.obj");
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/bunny.obj");
     sdfccd_MeshInfo mi;
     ck_assert_int_eq(sdfccd_mesh_get_info(mesh, &mi), SDFCCD_OK);
     /* a domain with room around the bunny, as a scene would use */
@@ -208,7 +198,7 @@ END_TEST
  * it is continuous across the boundary. */
 START_TEST(test_outside_domain)
 {
-    sdfccd_MeshId mesh = load_mesh("bullet3/bunny.obj");
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/bunny.obj");
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[0] = def.resolution[1] = def.resolution[2] = 24;
     sdfccd_SdfId g;
@@ -271,7 +261,7 @@ END_TEST
  * inside it. */
 START_TEST(test_lipschitz_bounds)
 {
-    sdfccd_MeshId mesh = load_mesh("bullet3/torus_textured.obj");
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/torus_textured.obj");
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[0] = def.resolution[1] = def.resolution[2] = 10;
     sdfccd_SdfId id;
@@ -349,7 +339,7 @@ START_TEST(test_ccd_on_grid)
         if (methods[k] == SDFCCD_METHOD_FWGSS) ck_assert_double_near(rg.toi, toi, 1e-5);
     }
     /* the mesh query: a small cube falling onto the sphere grid and the analytic sphere */
-    sdfccd_MeshId cube = load_mesh("bullet3/cube.obj");
+    sdfccd_MeshId cube = test_load_mesh("bullet3/cube.obj");
     sdfccd_RigidMotion cm = sdfccd_default_rigid_motion();
     cm.pose.position = (sdfccd_Vec3){ 0.05, -0.03, 0.5 + 0.5 * 0.2 + 0.1 };
     cm.linear_velocity = (sdfccd_Vec3){ 0.0, 0.0, -9.0 };
@@ -469,7 +459,7 @@ START_TEST(test_mesh_import_formats)
     ck_assert_double_eq(info.bounds.hi.x, 1.0);
     ck_assert_int_eq(sdfccd_destroy_mesh(m), SDFCCD_OK);
     /* the textured torus (v/vt/vn faces) welds to its 501 positions and is closed */
-    sdfccd_MeshId tor = load_mesh("bullet3/torus_textured.obj");
+    sdfccd_MeshId tor = test_load_mesh("bullet3/torus_textured.obj");
     sdfccd_MeshTopology t;
     ck_assert_int_eq(sdfccd_mesh_get_topology(tor, &t), SDFCCD_OK);
     ck_assert_int_eq(t.closed, 1);
@@ -532,7 +522,7 @@ static void* eval_thread(void* arg)
  * points and kept cells) give exactly the serial results. */
 START_TEST(test_concurrent_eval)
 {
-    sdfccd_MeshId mesh = load_mesh("bullet3/torus_textured.obj");
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/torus_textured.obj");
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[0] = def.resolution[1] = def.resolution[2] = 20;
     def.band = 0.05;
@@ -573,7 +563,7 @@ static double sphere_cb(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 
 START_TEST(test_bad_defs)
 {
-    sdfccd_MeshId mesh = load_mesh("bullet3/cube.obj");
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/cube.obj");
     sdfccd_SdfId g, sphere, plane;
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[1] = 0;

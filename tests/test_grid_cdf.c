@@ -35,16 +35,6 @@ static scc_grid* grid_of(sdfccd_SdfId id)
     return g;
 }
 
-static sdfccd_MeshId load_mesh(const char* rel)
-{
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s", SDFCCD_DATA_DIR, rel);
-    sdfccd_MeshId m;
-    sdfccd_Status st = sdfccd_load_mesh(path, NULL, &m);
-    ck_assert_msg(st == SDFCCD_OK, "load %s: %s", path, sdfccd_last_error());
-    return m;
-}
-
 static sdfccd_SdfId load_grid(const char* rel)
 {
     char path[512];
@@ -180,12 +170,6 @@ END_TEST
 
 /* ---------------- Discregrid's box.cdf ---------------- */
 
-static double box_sdf(scc_vec3 p, double h)
-{
-    scc_vec3 q = scc_sub(scc_vabs(p), scc_v3(h, h, h));
-    return scc_len(scc_vmax(q, scc_v3(0, 0, 0))) + fmin(scc_maxc(q), 0.0);
-}
-
 START_TEST(test_box_cdf_loads_and_matches_analytic)
 {
     sdfccd_SdfId id = load_grid("sdf/upstream/box.cdf");
@@ -201,7 +185,7 @@ START_TEST(test_box_cdf_loads_and_matches_analytic)
     scc_grid* g = grid_of(id);
     /* Node values equal the exact box distance at the positions of section 2. */
     for (uint64_t l = 0; l < g->fields[0].node_count; ++l)
-        ck_assert_double_near(scc_grid_node_value(g, 0, l), box_sdf(scc_grid_dense_node_position(g, l), 1.0), 1e-12);
+        ck_assert_double_near(scc_grid_node_value(g, 0, l), test_box_distance(sdfccd__pv(scc_grid_dense_node_position(g, l)), 1.0), 1e-12);
     /* Cell tables equal the dense formulas of section 4. */
     uint32_t ids[32];
     for (uint32_t k = 0, l = 0; k < 5; ++k)
@@ -238,7 +222,7 @@ END_TEST
  * default (fitted) domain gives box.cdf's layout exactly and its node values within 1e-12. */
 START_TEST(test_box_obj_build_matches_discregrid)
 {
-    sdfccd_MeshId mesh = load_mesh("discregrid/box.obj");
+    sdfccd_MeshId mesh = test_load_mesh("discregrid/box.obj");
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[0] = def.resolution[1] = def.resolution[2] = 5;
     def.threads = 2;
@@ -338,7 +322,7 @@ static double winding_number(const scc_mesh* m, scc_vec3 p)
  * comparison. */
 static void compare_with_generated(const char* mesh_rel, const char* cdf_rel, int res, int max_flips)
 {
-    sdfccd_MeshId mesh = load_mesh(mesh_rel);
+    sdfccd_MeshId mesh = test_load_mesh(mesh_rel);
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[0] = def.resolution[1] = def.resolution[2] = res;
     sdfccd_SdfId ours, theirs = load_grid(cdf_rel);
@@ -420,7 +404,7 @@ START_TEST(test_sparse_multifield_cdm)
     ck_assert_int_eq(info.node_count, 83551);
     ck_assert_int_eq(info.cell_count, 24 * 24 * 24);
     ck_assert_int_lt(info.valued_cells, info.cell_count);
-    sdfccd_MeshId mesh = load_mesh("bullet3/bunny.obj");
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/bunny.obj");
     sdfccd_GridDef def = sdfccd_default_grid_def();
     def.resolution[0] = def.resolution[1] = def.resolution[2] = 24;
     sdfccd_SdfId dense;
@@ -548,7 +532,7 @@ START_TEST(test_corrupt_files)
         ck_assert_int_eq(sdfccd_grid_interpolate(id, 0, p, &raw, NULL, &has), SDFCCD_OK);
         ck_assert_int_eq(has, 0);
         ck_assert_int_eq(sdfccd_sdf_eval(id, p, &v, &gr), SDFCCD_OK);
-        const double exact = box_sdf(sdfccd__v(p), 1.0); /* the point is inside the box, in the +x face cell */
+        const double exact = test_box_distance(p, 1.0); /* the point is inside the box, in the +x face cell */
         ck_assert_msg(isfinite(v) && (v < 0) == (exact < 0) && fabs(v) <= fabs(exact) + 1e-12, "fallback %g, box distance %g", v, exact);
         ck_assert_double_near(gr.x * gr.x + gr.y * gr.y + gr.z * gr.z, 1.0, 1e-9);
         ck_assert_int_eq(sdfccd_destroy_sdf(id), SDFCCD_OK);

@@ -11,16 +11,6 @@
 #include "grid_internal.h"
 #include "../core/mesh_distance.h"
 
-static sdfccd_MeshId load_mesh(const char* rel)
-{
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s", SDFCCD_DATA_DIR, rel);
-    sdfccd_MeshId m;
-    sdfccd_Status st = sdfccd_load_mesh(path, NULL, &m);
-    ck_assert_msg(st == SDFCCD_OK, "load %s: %s", path, sdfccd_last_error());
-    return m;
-}
-
 static double winding_number(const scc_mesh* m, scc_vec3 p)
 {
     double w = 0;
@@ -86,7 +76,7 @@ START_TEST(test_bvh_vs_brute_force)
     const char* meshes[] = { "bullet3/bunny.obj", "bullet3/torus_textured.obj", "bullet3/concave_box.obj", "bullet3/cylinder.obj", "bullet3/shape_sorter.obj" };
     test_rng rng = { 2 };
     for (size_t mi = 0; mi < sizeof meshes / sizeof meshes[0]; ++mi) {
-        sdfccd_MeshId id = load_mesh(meshes[mi]);
+        sdfccd_MeshId id = test_load_mesh(meshes[mi]);
         const scc_mesh* m = &sdfccd__mesh_lookup(id)->mesh;
         scc_tri_bvh bvh;
         ck_assert_int_eq(scc_tri_bvh_build(&bvh, sdfccd__allocator(), m), 0);
@@ -129,23 +119,17 @@ START_TEST(test_bvh_vs_brute_force)
 }
 END_TEST
 
-static double box_sdf(scc_vec3 p, double h)
-{
-    scc_vec3 q = scc_sub(scc_vabs(p), scc_v3(h, h, h));
-    return scc_len(scc_vmax(q, scc_v3(0, 0, 0))) + fmin(scc_maxc(q), 0.0);
-}
-
 /* cube.obj (+-0.5) gives the exact box distance, inside and outside. */
 START_TEST(test_cube_closed_form)
 {
-    sdfccd_MeshId id = load_mesh("bullet3/cube.obj");
+    sdfccd_MeshId id = test_load_mesh("bullet3/cube.obj");
     enum { N = 5000 };
     sdfccd_Vec3* p = malloc(N * sizeof *p);
     double* d = malloc(N * sizeof *d);
     test_rng rng = { 3 };
     for (int i = 0; i < N; ++i) p[i] = (sdfccd_Vec3){ test_rng_uniform(&rng, -1.5, 1.5), test_rng_uniform(&rng, -1.5, 1.5), test_rng_uniform(&rng, -1.5, 1.5) };
     ck_assert_int_eq(sdfccd_mesh_signed_distance(id, p, N, 0, d, NULL), SDFCCD_OK);
-    for (int i = 0; i < N; ++i) ck_assert_double_near(d[i], box_sdf(sdfccd__v(p[i]), 0.5), 1e-12);
+    for (int i = 0; i < N; ++i) ck_assert_double_near(d[i], test_box_distance(p[i], 0.5), 1e-12);
     free(p);
     free(d);
     ck_assert_int_eq(sdfccd_destroy_mesh(id), SDFCCD_OK);
@@ -248,7 +232,7 @@ START_TEST(test_signs_vs_winding_number)
                              "libigl-tutorial-data/armadillo.obj" };
     test_rng rng = { 5 };
     for (size_t mi = 0; mi < sizeof meshes / sizeof meshes[0]; ++mi) {
-        sdfccd_MeshId id = load_mesh(meshes[mi]);
+        sdfccd_MeshId id = test_load_mesh(meshes[mi]);
         const scc_mesh* m = &sdfccd__mesh_lookup(id)->mesh;
         sdfccd_MeshTopology topo;
         ck_assert_int_eq(sdfccd_mesh_get_topology(id, &topo), SDFCCD_OK);

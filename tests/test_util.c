@@ -2,7 +2,12 @@
 #include "test_util.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+
+#ifndef SDFCCD_DATA_DIR
+#define SDFCCD_DATA_DIR "data"
+#endif
 
 uint64_t test_rng_next(test_rng* r)
 {
@@ -42,4 +47,21 @@ int test_run_suite(Suite* s)
     int failed = srunner_ntests_failed(sr);
     srunner_free(sr);
     return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+}
+
+sdfccd_MeshId test_load_mesh(const char* rel)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", SDFCCD_DATA_DIR, rel);
+    sdfccd_MeshId m = { 0, 0 };
+    sdfccd_Status st = sdfccd_load_mesh(path, NULL, &m);
+    ck_assert_msg(st == SDFCCD_OK, "load %s: %s", path, sdfccd_last_error());
+    return m;
+}
+
+double test_box_distance(sdfccd_Vec3 p, double h)
+{
+    const double q[3] = { fabs(p.x) - h, fabs(p.y) - h, fabs(p.z) - h };
+    const double ox = fmax(q[0], 0.0), oy = fmax(q[1], 0.0), oz = fmax(q[2], 0.0);
+    return sqrt(ox * ox + oy * oy + oz * oz) + fmin(fmax(q[0], fmax(q[1], q[2])), 0.0);
 }

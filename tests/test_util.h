@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT
- * Shared helpers for the Check suites: a seeded RNG, the allocator-balance fixture and
- * a runner that prints the suite's summary line. */
+ * The shared test support of the Check suites (one place for scaffolding several suites use):
+ * a seeded RNG, the allocator-balance fixture, a runner that prints the suite's summary line,
+ * loading the data folder's meshes and the closed-form distance to a box. */
 #ifndef SDFCCD_TEST_UTIL_H
 #define SDFCCD_TEST_UTIL_H
 
@@ -19,6 +20,13 @@ void test_memory_setup(void);
 void test_memory_teardown(void);
 /* Adds the memory fixture to a TCase. */
 void test_add_memory_fixture(TCase* tc);
+
+/* Loads `rel` (a path under data/, e.g. "bullet3/cube.obj") with the default load def; fails the
+ * test with the library's message when it cannot. */
+sdfccd_MeshId test_load_mesh(const char* rel);
+
+/* Exact signed distance from p to the axis-aligned cube [-h, h]^3 (negative inside). */
+double test_box_distance(sdfccd_Vec3 p, double h);
 
 /* Runs a suite (CK_NORMAL output) and returns the process exit code. */
 int test_run_suite(Suite* s);
