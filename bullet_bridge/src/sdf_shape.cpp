@@ -25,7 +25,7 @@ bool finiteBox(const btVector3& lo, const btVector3& hi)
 } // namespace
 
 SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type)
-    : m_sdf(sdf), m_scaling(1, 1, 1), m_margin(0), m_resolution(48), m_scaled(kNullSdf), m_scaledValid(false),
+    : m_sdf(sdf), m_valid(false), m_scaling(1, 1, 1), m_margin(0), m_resolution(48), m_scaled(kNullSdf), m_scaledValid(false),
       m_triangulated(false), m_meshInterface(nullptr), m_bvh(nullptr)
 {
     m_shapeType = shape_type;
@@ -33,7 +33,12 @@ SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type)
     m_lo.setValue(-BT_LARGE_FLOAT, -BT_LARGE_FLOAT, -BT_LARGE_FLOAT);
     m_hi.setValue(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT);
     sdfccd_SdfInfo info;
-    if (sdfccd_sdf_get_info(sdf, &info) == SDFCCD_OK) {
+    m_valid = sdfccd_sdf_get_info(sdf, &info) == SDFCCD_OK;
+    if (!m_valid) {
+        // An empty box at the origin (not the whole world): nothing pairs with a dead shape.
+        m_lo.setValue(0, 0, 0);
+        m_hi.setValue(0, 0, 0);
+    } else {
         const double blo[3] = { info.bounds.lo.x, info.bounds.lo.y, info.bounds.lo.z };
         const double bhi[3] = { info.bounds.hi.x, info.bounds.hi.y, info.bounds.hi.z };
         const double dlo[3] = { info.domain.lo.x, info.domain.lo.y, info.domain.lo.z };
@@ -44,6 +49,15 @@ SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type)
             if (std::isfinite(hi)) m_hi[i] = (btScalar)hi;
         }
     }
+}
+
+SdfShape* SdfShape::create(sdfccd_SdfId sdf, int shape_type, sdfccd_Status* status)
+{
+    sdfccd_SdfInfo info;
+    sdfccd_Status st = sdfccd_sdf_get_info(sdf, &info);
+    if (status) *status = st;
+    if (st != SDFCCD_OK) return nullptr;
+    return new SdfShape(sdf, shape_type);
 }
 
 SdfShape::~SdfShape()

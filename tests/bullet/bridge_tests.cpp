@@ -2,6 +2,7 @@
 // Bullet bridge tests (built once per Bullet precision). Usage: bridge_tests [test-name ...];
 // no argument runs every test. Prints one line per failed check and a closing
 // "N passed, N failed"; exits non-zero on any failure.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -173,6 +174,7 @@ static CubeRun runCube(bool bridge_on, bool mesh_first, int steps, sdfccd_bullet
             r.z.push_back(z);
             r.vz.push_back(body->getLinearVelocity().z());
             if (r.impact_step < 0 && std::fabs(z - free_z) > 1e-3) r.impact_step = i;
+            if (kVerbose) std::printf("  cube step %d: z %.6f vz %.4f\n", i, z, body->getLinearVelocity().z());
         }
         if (stats_out) *stats_out = bridge.stats();
     }
@@ -448,13 +450,16 @@ static void test_cdf_concave_box()
                 floor_z, final_z - half.z(), worst + floor_z, impact, (long long)stats.queries);
 }
 
-// ---- a convex box resting on our shape through the triangulation path; ray test ----
+// ---- a convex box resting on our shape: through the bridge's CCD (default) or, with
+// Config::convex_shapes off, through Bullet's convex-concave path on the triangulation; ray test ----
 
 static void test_convex_box_on_triangulation()
 {
     sdfccd_SdfId ground = makeBoxSdf(2, 2, 0.25);
-    {
-        Bridge bridge;
+    for (int ccd = 1; ccd >= 0; --ccd) {
+        sdfccd_bullet::Config cfg;
+        cfg.convex_shapes = ccd != 0;
+        Bridge bridge(cfg);
         World w;
         CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
         SdfShape shape(ground);
@@ -463,18 +468,22 @@ static void test_convex_box_on_triangulation()
         w.add(&shape, 0, btVector3(0, 0, 0));
         btRigidBody* body = w.add(&box, 1, btVector3(0.3, -0.2, 1.0), btVector3(0.2, 0.2, 0.2));
         for (int i = 0; i < 180; ++i) w.step();
-        CHECK(shape.getTriangulationTriangleCount() > 0, "no triangulation");
+        // The bridge's path never needs the triangulation; Bullet's path builds it.
+        CHECK((shape.getTriangulationTriangleCount() > 0) == !ccd, "%s: triangulation %d", ccd ? "bridge" : "triangulation",
+              shape.getTriangulationTriangleCount());
+        CHECK((bridge.stats().queries > 0) == (ccd != 0), "bridge queries %lld", (long long)bridge.stats().queries);
         double z = body->getCenterOfMassPosition().z();
         CHECK(std::fabs(z - 0.45) <= 0.005, "convex box rests at z %.5f, expected 0.45 +- 0.005", z);
         CHECK(body->getLinearVelocity().length() < 0.05, "convex box not at rest: %.4f m/s", body->getLinearVelocity().length());
-        // A ray straight down hits the top face at z = 0.25.
+        // A ray straight down hits the top face at z = 0.25 (rays use the triangulation).
         btVector3 from(-1.0, 1.0, 3.0), to(-1.0, 1.0, -3.0);
         btCollisionWorld::ClosestRayResultCallback ray(from, to);
         w.world.rayTest(from, to, ray);
         CHECK(ray.hasHit() && std::fabs(ray.m_hitPointWorld.z() - 0.25) < 1e-3, "ray test: hit %d at z %.5f", (int)ray.hasHit(),
               ray.hasHit() ? (double)ray.m_hitPointWorld.z() : NAN);
-        std::printf("convex box on triangulation (%d triangles): rests at z = %.5f; ray hit z = %.5f\n",
-                    shape.getTriangulationTriangleCount(), z, ray.hasHit() ? (double)ray.m_hitPointWorld.z() : NAN);
+        std::printf("convex box on our shape (%s): rests at z = %.5f; ray hit z = %.5f (%d triangles)\n",
+                    ccd ? "bridge CCD" : "Bullet, triangulation", z, ray.hasHit() ? (double)ray.m_hitPointWorld.z() : NAN,
+                    shape.getTriangulationTriangleCount());
     }
     sdfccd_destroy_sdf(ground);
 }
@@ -705,6 +714,431 @@ static void test_hard_clamp()
     std::printf("hard clamp: deepest end-of-step penetration %.5f m without, %.5f m with (%d corrections)\n", off, on, clamps_on);
 }
 
+
+// ---- issue 8: whole-mesh contacts, speculative contacts from any start, compounds, callbacks,
+// convex shapes, SDF pairs, misuse ----
+
+// A torus mesh in the xy plane (ring radius R, tube radius r), nu x nv quads as triangles.
+static std::unique_ptr<TriMesh> makeTorus(double R, double r, int nu, int nv)
+{
+    std::unique_ptr<TriMesh> m(new TriMesh);
+    for (int i = 0; i < nu; ++i)
+        for (int j = 0; j < nv; ++j) {
+            double u = 2 * M_PI * i / nu, v = 2 * M_PI * j / nv;
+            m->v.push_back((btScalar)((R + r * std::cos(v)) * std::cos(u)));
+            m->v.push_back((btScalar)((R + r * std::cos(v)) * std::sin(u)));
+            m->v.push_back((btScalar)(r * std::sin(v)));
+        }
+    for (int i = 0; i < nu; ++i)
+        for (int j = 0; j < nv; ++j) {
+            int a = i * nv + j, b = ((i + 1) % nu) * nv + j, c = ((i + 1) % nu) * nv + (j + 1) % nv, d = i * nv + (j + 1) % nv;
+            const int t[6] = { a, b, c, a, c, d };
+            m->f.insert(m->f.end(), t, t + 6);
+        }
+    m->finish();
+    return m;
+}
+
+// The deepest vertex of `mesh` (body pose t) in `sdf` (evaluated exactly at every vertex): >= 0 when none is inside.
+static double vertexPenetration(const TriMesh& mesh, const btTransform& t, sdfccd_SdfId sdf, const btTransform& sdf_pose)
+{
+    double worst = 0;
+    for (size_t i = 0; i + 2 < mesh.v.size(); i += 3) {
+        btVector3 p = sdf_pose.invXform(t * btVector3(mesh.v[i], mesh.v[i + 1], mesh.v[i + 2]));
+        worst = std::max(worst, -phiAt(sdf, p));
+    }
+    return worst;
+}
+
+// Manifold sanity after a step: no two points of one manifold at the same place (both precisions).
+static int duplicatePoints(btCollisionDispatcher& d)
+{
+    int dup = 0;
+    for (int m = 0; m < d.getNumManifolds(); ++m) {
+        const btPersistentManifold* pm = d.getManifoldByIndexInternal(m);
+        for (int i = 0; i < pm->getNumContacts(); ++i)
+            for (int j = i + 1; j < pm->getNumContacts(); ++j)
+                if ((pm->getContactPoint(i).m_localPointA - pm->getContactPoint(j).m_localPointA).length() < btScalar(1e-4)) ++dup;
+    }
+    return dup;
+}
+
+static void test_corner_cube()
+{
+    // A 1 m GImpact cube, one corner straight down (its diagonal vertical), at 20 m/s onto a
+    // 0.1 m SDF slab: the corner lands, the cube tips over its edges onto a face. No vertex may be
+    // more than 1 cm inside the slab after any step (the exact box SDF at all 8 vertices).
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    double worst = 0;
+    int dups = 0, steps_in_contact = 0;
+    btVector3 final_v, final_w;
+    double final_z = 0;
+    {
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(cube->shape.get(), 1, btVector3(0.2, -0.1, 2.0), btVector3(0.5, 0.5, 0.5));
+        // Rotate the (1,1,1) diagonal onto -z, then a little more so it falls to one side.
+        btQuaternion q = shortestArcQuat(btVector3(1, 1, 1).normalized(), btVector3(0, 0, -1));
+        q = btQuaternion(btVector3(1, 0, 0), btScalar(0.05)) * q;
+        btTransform t = body->getWorldTransform();
+        t.setRotation(q);
+        body->setCenterOfMassTransform(t);
+        body->setLinearVelocity(btVector3(0, 0, -20));
+        body->setAngularVelocity(btVector3(0, 0, 0));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        btTransform id;
+        id.setIdentity();
+        for (int i = 0; i < 240; ++i) {
+            w.step();
+            double pen = vertexPenetration(*cube, body->getWorldTransform(), slab, id);
+            worst = std::max(worst, pen);
+            dups += duplicatePoints(w.dispatcher);
+            if (w.dispatcher.getNumManifolds() > 0 && w.dispatcher.getManifoldByIndexInternal(0)->getNumContacts() > 0) ++steps_in_contact;
+            if (kVerbose)
+                std::printf("  corner step %d: z %.4f v %.3f w %.3f pen %.5f\n", i, body->getCenterOfMassPosition().z(),
+                            body->getLinearVelocity().length(), body->getAngularVelocity().length(), pen);
+        }
+        final_v = body->getLinearVelocity();
+        final_w = body->getAngularVelocity();
+        final_z = body->getCenterOfMassPosition().z();
+    }
+    CHECK(steps_in_contact > 0, "never in contact");
+    CHECK(worst <= 0.01, "a vertex went %.4f m into the slab (limit 0.01)", worst);
+    CHECK(dups == 0, "%d duplicate manifold points", dups);
+    CHECK(std::fabs(final_z - 0.55) <= 0.01 && final_v.length() < 0.05 && final_w.length() < 0.05,
+          "not resting on a face: z %.4f v %.4f w %.4f", final_z, final_v.length(), final_w.length());
+    std::printf("corner-first cube at 20 m/s (%s): deepest vertex %.5f m over 240 steps, rests at z %.4f\n",
+                SDFCCD_BULLET_PRECISION_NAME, worst, final_z);
+    sdfccd_destroy_sdf(slab);
+}
+
+static void test_torus_flat()
+{
+    // A GImpact torus (1536 triangles) lying flat, at 50 m/s onto a slab: its whole ring lands at
+    // once (hundreds of contacts); the 4 manifold points must hold all of it.
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    double worst = 0;
+    int dups = 0;
+    double final_z = 0, final_v = 0, final_w = 0;
+    sdfccd_bullet::Stats stats;
+    {
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> torus = makeTorus(1.0, 0.25, 48, 16);
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(torus->shape.get(), 1, btVector3(0, 0, 1.5), btVector3(1.2, 1.2, 0.25));
+        body->setLinearVelocity(btVector3(0, 0, -50));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        btTransform id;
+        id.setIdentity();
+        for (int i = 0; i < 180; ++i) {
+            w.step();
+            worst = std::max(worst, vertexPenetration(*torus, body->getWorldTransform(), slab, id));
+            dups += duplicatePoints(w.dispatcher);
+        }
+        final_z = body->getCenterOfMassPosition().z();
+        final_v = body->getLinearVelocity().length();
+        final_w = body->getAngularVelocity().length();
+        stats = bridge.stats();
+    }
+    CHECK(worst <= 0.02, "a vertex went %.4f m into the slab (limit 0.02)", worst);
+    CHECK(dups == 0, "%d duplicate manifold points", dups);
+    CHECK(std::fabs(final_z - 0.30) <= 0.01 && final_v < 0.05 && final_w < 0.05, "not resting flat: z %.4f v %.4f w %.4f", final_z,
+          final_v, final_w);
+    std::printf("flat torus at 50 m/s (%s): deepest vertex %.5f m, rests at z %.4f, %.1f candidates per query\n",
+                SDFCCD_BULLET_PRECISION_NAME, worst, final_z, stats.queries ? (double)stats.candidates / stats.queries : 0.0);
+    sdfccd_destroy_sdf(slab);
+}
+
+static void test_compound_child()
+{
+    // A GImpact cube as an offset, rotated child of a btCompoundShape (the usual way to move a
+    // mesh's centre of mass) falls onto the slab: it must land and rest like a top-level mesh.
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    double worst = 0, lowest_final = 0;
+    sdfccd_bullet::Stats stats;
+    double final_v = 0;
+    {
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        btCompoundShape compound;
+        btTransform child;
+        child.setIdentity();
+        child.setOrigin(btVector3(0.3, 0.1, -0.2));
+        child.setRotation(btQuaternion(btVector3(0, 0, 1), btScalar(0.4)));
+        compound.addChildShape(child, cube->shape.get());
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(&compound, 1, btVector3(0, 0, 1.2), btVector3(0.5, 0.5, 0.5));
+        body->setLinearVelocity(btVector3(0, 0, -5));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        btTransform id;
+        id.setIdentity();
+        for (int i = 0; i < 180; ++i) {
+            w.step();
+            worst = std::max(worst, vertexPenetration(*cube, body->getWorldTransform() * child, slab, id));
+        }
+        lowest_final = 1e9;
+        for (size_t i = 0; i + 2 < cube->v.size(); i += 3)
+            lowest_final = std::min(lowest_final, (double)(body->getWorldTransform() * child * btVector3(cube->v[i], cube->v[i + 1], cube->v[i + 2])).z());
+        final_v = body->getLinearVelocity().length();
+        stats = bridge.stats();
+    }
+    CHECK(stats.hits > 0, "the compound child never reached the bridge's algorithm");
+    CHECK(worst <= 0.01, "the child went %.4f m into the slab", worst);
+    CHECK(std::fabs(lowest_final - 0.05) <= 0.005 && final_v < 0.05, "child's lowest vertex rests at %.4f (slab top 0.05), speed %.4f",
+          lowest_final, final_v);
+    std::printf("compound child (%s): deepest %.5f m, rests with its lowest vertex at %.4f\n", SDFCCD_BULLET_PRECISION_NAME, worst,
+                lowest_final);
+    sdfccd_destroy_sdf(slab);
+}
+
+// Contact callbacks, counted per manifold.
+static int g_started = 0, g_ended = 0, g_processed = 0, g_added = 0, g_unpaired = 0;
+static std::vector<const btPersistentManifold*> g_open;
+static void onStarted(btPersistentManifold* const& m)
+{
+    ++g_started;
+    if (std::find(g_open.begin(), g_open.end(), m) != g_open.end()) ++g_unpaired;
+    else g_open.push_back(m);
+}
+static void onEnded(btPersistentManifold* const& m)
+{
+    ++g_ended;
+    auto it = std::find(g_open.begin(), g_open.end(), m);
+    if (it == g_open.end()) ++g_unpaired;
+    else g_open.erase(it);
+}
+static bool onProcessed(btManifoldPoint&, void*, void*)
+{
+    ++g_processed;
+    return true;
+}
+static bool onAdded(btManifoldPoint& cp, const btCollisionObjectWrapper*, int, int, const btCollisionObjectWrapper*, int, int)
+{
+    ++g_added;
+    cp.m_combinedFriction = btScalar(0.7); // user's material: must survive
+    return true;
+}
+
+static void test_callbacks()
+{
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    g_started = g_ended = g_processed = g_added = g_unpaired = 0;
+    g_open.clear();
+    gContactStartedCallback = onStarted;
+    gContactEndedCallback = onEnded;
+    gContactProcessedCallback = onProcessed;
+    gContactAddedCallback = onAdded;
+    int started_landed = 0, ended_resting = 0, processed_resting = 0, added_resting = 0;
+    bool friction_kept = false;
+    {
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(cube->shape.get(), 1, btVector3(0, 0, 1.0), btVector3(0.5, 0.5, 0.5));
+        body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_CUSTOM_MATERIAL_CALLBACK);
+        body->setActivationState(DISABLE_DEACTIVATION);
+        for (int i = 0; i < 120; ++i) w.step(); // lands and rests
+        started_landed = g_started;
+        ended_resting = g_ended;
+        processed_resting = g_processed;
+        added_resting = g_added;
+        if (w.dispatcher.getNumManifolds() > 0 && w.dispatcher.getManifoldByIndexInternal(0)->getNumContacts() > 0)
+            friction_kept = std::fabs(w.dispatcher.getManifoldByIndexInternal(0)->getContactPoint(0).m_combinedFriction - 0.7) < 1e-6;
+        // Lift it far away: the contact ends once.
+        btTransform t = body->getWorldTransform();
+        t.setOrigin(btVector3(0, 0, 3));
+        body->setCenterOfMassTransform(t);
+        body->setLinearVelocity(btVector3(0, 0, 0));
+        for (int i = 0; i < 5; ++i) w.step();
+        CHECK(g_ended == 1, "after lifting: %d ended callbacks, expected 1", g_ended);
+        for (int i = 0; i < 120; ++i) w.step(); // falls and lands again
+    }
+    gContactStartedCallback = nullptr;
+    gContactEndedCallback = nullptr;
+    gContactProcessedCallback = nullptr;
+    gContactAddedCallback = nullptr;
+    CHECK(started_landed == 1, "landing and resting: %d started callbacks, expected 1", started_landed);
+    CHECK(ended_resting == 0, "while resting: %d ended callbacks, expected 0", ended_resting);
+    CHECK(processed_resting > 0 && added_resting > 0, "processed %d added %d callbacks", processed_resting, added_resting);
+    CHECK(friction_kept, "the contact-added callback's friction was not kept");
+    CHECK(g_started == 2 && g_unpaired == 0, "%d started, %d ended, %d unpaired", g_started, g_ended, g_unpaired);
+    std::printf("callbacks (%s): started %d ended %d processed %d added %d, unpaired %d\n", SDFCCD_BULLET_PRECISION_NAME, g_started,
+                g_ended, g_processed, g_added, g_unpaired);
+    sdfccd_destroy_sdf(slab);
+}
+
+static void test_convex_box_fast()
+{
+    // A btBoxShape at 50 m/s (0.83 m per step) onto a 0.1 m SDF slab: the same CCD as meshes.
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    const btVector3 half(0.2, 0.2, 0.2);
+    double worst = 0, final_z = 0, final_v = 0;
+    {
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        btBoxShape box(half);
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(&box, 1, btVector3(0.3, -0.2, 2.0), half);
+        body->setLinearVelocity(btVector3(0, 0, -50));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        const btVector3 h = box.getHalfExtentsWithMargin();
+        for (int i = 0; i < 120; ++i) {
+            w.step();
+            for (int c = 0; c < 8; ++c) {
+                btVector3 p = body->getWorldTransform() * btVector3(c & 1 ? h.x() : -h.x(), c & 2 ? h.y() : -h.y(), c & 4 ? h.z() : -h.z());
+                worst = std::max(worst, -phiAt(slab, p));
+            }
+        }
+        final_z = body->getCenterOfMassPosition().z();
+        final_v = body->getLinearVelocity().length();
+    }
+    // btBoxShape's half extents include its margin: it rests with its centre at 0.05 + 0.2.
+    CHECK(worst <= 0.01, "a box corner went %.4f m into the slab", worst);
+    CHECK(std::fabs(final_z - 0.25) <= 0.005 && final_v < 0.05, "box at z %.4f speed %.4f: passed through or not at rest", final_z,
+          final_v);
+    std::printf("convex box at 50 m/s (%s): deepest corner %.5f m, rests at z %.4f\n", SDFCCD_BULLET_PRECISION_NAME, worst, final_z);
+    sdfccd_destroy_sdf(slab);
+}
+
+static void test_sdf_on_sdf()
+{
+    // A dynamic SDF ball (its triangulation) at 30 m/s onto a static SDF slab.
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    sdfccd_SdfId ball = { 0, 0 };
+    CHECK(sdfccd_create_sphere(0.5, &ball) == SDFCCD_OK, "sphere");
+    double lowest = 1e9, final_z = 0, final_v = 0;
+    {
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape ground(slab), ball_shape(ball);
+        w.add(&ground, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(&ball_shape, 1, btVector3(0, 0, 2.0), btVector3(0.35, 0.35, 0.35));
+        body->setLinearVelocity(btVector3(0, 0, -30));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        for (int i = 0; i < 120; ++i) {
+            w.step();
+            lowest = std::min(lowest, (double)body->getCenterOfMassPosition().z());
+        }
+        final_z = body->getCenterOfMassPosition().z();
+        final_v = body->getLinearVelocity().length();
+        CHECK(bridge.stats().hits > 0, "no SDF-SDF contact");
+    }
+    // The ball's centre rests 0.5 above the slab top (0.05); the triangulation lies within a cell
+    // of the sphere (48 cells over 1 m: ~2 cm).
+    CHECK(lowest >= 0.55 - 0.03, "the ball went down to z %.4f (surface contact at 0.55)", lowest);
+    CHECK(std::fabs(final_z - 0.55) <= 0.03 && final_v < 0.05, "ball rests at z %.4f speed %.4f", final_z, final_v);
+    std::printf("SDF ball on SDF slab (%s): lowest centre %.4f, rests at %.4f (contact at 0.55)\n", SDFCCD_BULLET_PRECISION_NAME, lowest,
+                final_z);
+    sdfccd_destroy_sdf(ball);
+    sdfccd_destroy_sdf(slab);
+}
+
+static int g_user_pre = 0, g_user_post = 0;
+static void* g_user_info_seen = nullptr;
+static void userPre(btDynamicsWorld* w, btScalar)
+{
+    ++g_user_pre;
+    g_user_info_seen = w->getWorldUserInfo();
+}
+static void userPost(btDynamicsWorld*, btScalar) { ++g_user_post; }
+
+static void test_misuse()
+{
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    std::string msg;
+    {
+        // Not registered.
+        Bridge bridge;
+        World w;
+        CHECK(bridge.check(&w.world, &msg) == Status::NotRegistered, "unregistered world: %s", msg.c_str());
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        CHECK(bridge.check(&w.world, &msg) == Status::Ok, "registered world: %s", msg.c_str());
+        // Overwritten by a later registration.
+        btGImpactCollisionAlgorithm::registerAlgorithm(&w.dispatcher);
+        CHECK(bridge.check(&w.world, &msg) == Status::Overwritten, "overwritten: %s", msg.c_str());
+    }
+    {
+        // Too late: the pair's algorithm was created (GImpact's) before the bridge's registration.
+        Bridge bridge;
+        World w;
+        btGImpactCollisionAlgorithm::registerAlgorithm(&w.dispatcher);
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        w.add(cube->shape.get(), 1, btVector3(0, 0, 0.6), btVector3(0.5, 0.5, 0.5)); // boxes overlap, no contact yet
+        w.world.performDiscreteCollisionDetection();
+        CHECK(bridge.registerWith(&w.dispatcher) == Status::Ok, "register on the dispatcher");
+        CHECK(bridge.check(&w.world, &msg) == Status::TooLate, "too late: %s", msg.c_str());
+    }
+    {
+        // Invalid and destroyed handles.
+        sdfccd_SdfId null_id = { 0, 0 };
+        sdfccd_Status st = SDFCCD_OK;
+        CHECK(SdfShape::create(null_id, sdfccd_bullet::kDefaultSdfShapeType, &st) == nullptr && st != SDFCCD_OK,
+              "SdfShape::create accepted a null handle");
+        sdfccd_SdfId ball = { 0, 0 };
+        CHECK(sdfccd_create_sphere(0.5, &ball) == SDFCCD_OK, "sphere");
+        std::unique_ptr<SdfShape> ok(SdfShape::create(ball));
+        CHECK(ok && ok->isValid(), "SdfShape::create refused a live handle");
+        SdfShape dead(null_id);
+        CHECK(!dead.isValid(), "a null handle makes a valid shape");
+        btTransform id;
+        id.setIdentity();
+        btVector3 lo, hi;
+        dead.getAabb(id, lo, hi);
+        CHECK((hi - lo).length() < 1e-6, "a dead shape's box is not empty");
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        w.add(ok.get(), 0, btVector3(0, 0, 0));
+        CHECK(bridge.check(&w.world, &msg) == Status::Ok, "live shape: %s", msg.c_str());
+        sdfccd_destroy_sdf(ball); // destroyed while in the world
+        CHECK(bridge.check(&w.world, &msg) == Status::InvalidShape, "destroyed handle: %s", msg.c_str());
+    }
+    {
+        // The hard clamp chains the user's tick callbacks and keeps the world's user info.
+        g_user_pre = g_user_post = 0;
+        int info = 42;
+        Bridge bridge;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        w.world.setInternalTickCallback(userPre, &info, true);
+        w.world.setInternalTickCallback(userPost, &info, false);
+        CHECK(bridge.setHardClamp(&w.world, true) == Status::Ok, "clamp on");
+        w.step();
+        CHECK(g_user_pre == 1 && g_user_post == 1 && g_user_info_seen == &info, "user callbacks %d %d (info %p)", g_user_pre,
+              g_user_post, g_user_info_seen);
+        CHECK(bridge.check(&w.world, &msg) == Status::Ok, "clamp chained: %s", msg.c_str());
+        CHECK(bridge.setHardClamp(&w.world, false) == Status::Ok, "clamp off");
+        w.step();
+        CHECK(g_user_pre == 2 && g_user_post == 2, "user callbacks not restored: %d %d", g_user_pre, g_user_post);
+        // A callback installed after the clamp displaces it: reported, and stepping is safe.
+        CHECK(bridge.setHardClamp(&w.world, true) == Status::Ok, "clamp on again");
+        w.world.setInternalTickCallback(userPost, nullptr, false);
+        CHECK(bridge.check(&w.world, &msg) == Status::ClampDisplaced, "displaced clamp: %s", msg.c_str());
+        w.step();
+        CHECK(g_user_post == 3, "user post callback %d", g_user_post);
+        bridge.setHardClamp(&w.world, false);
+    }
+    sdfccd_destroy_sdf(slab);
+}
+
 // ---------------------------------------------------------------------------------------------
 struct Test {
     const char* name;
@@ -723,6 +1157,13 @@ static const Test kTests[] = {
     { "registration", test_registration },
     { "closest_points_and_toi", test_closest_points_and_toi },
     { "hard_clamp", test_hard_clamp },
+    { "corner_cube", test_corner_cube },
+    { "torus_flat", test_torus_flat },
+    { "compound_child", test_compound_child },
+    { "callbacks", test_callbacks },
+    { "convex_box_fast", test_convex_box_fast },
+    { "sdf_on_sdf", test_sdf_on_sdf },
+    { "misuse", test_misuse },
 };
 
 int main(int argc, char** argv)

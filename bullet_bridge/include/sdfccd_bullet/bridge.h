@@ -2,37 +2,58 @@
 /** @file bridge.h  Registers sdfccd's triangle-SDF continuous collision detection in Bullet.
  *
  * What it does (Bullet 3.24; see notes/bullet-integration.md for the reasons):
- *  - registers a collision algorithm for btGImpactMeshShape against SdfShape (both body orders)
- *    and, optionally, against Bullet's own btSdfCollisionShape (type 29, sampled through
- *    queryPoint), AFTER btGImpactCollisionAlgorithm::registerAlgorithm, which it calls itself;
- *  - registers the same pairs in the closest-points table, so contactTest/contactPairTest work;
- *  - per step and pair: takes the mesh's start pose (world transform) and predicted end pose
- *    (interpolation transform), the SDF body's likewise (static: fixed; kinematic: rebuilt
- *    backwards from its velocities), runs ONE CCD sdfccd_query_mesh over [0, dt] (plus, in a
- *    step with an impact, one discrete query at the predicted end pose), and writes at
- *    most four well-spread contacts straight into the pair's manifold. Each contact's distance
- *    is the gap at the start of the step along the contact normal, so the solver lets the mesh
- *    travel exactly to the surface in the impact step. Contacts of an impact inside the step
- *    are speculative (restitution 0); contacts of features already within the contact margin
- *    at the start of the step are ordinary ones (restitution from Bullet's callback).
+ *  - registers ONE collision algorithm, AFTER btGImpactCollisionAlgorithm::registerAlgorithm
+ *    (which it calls itself), for these pairs in both body orders, in the contact-point and the
+ *    closest-point tables (so contactTest/contactPairTest work):
+ *      btGImpactMeshShape (top level or a child of a btCompoundShape) vs SdfShape, and vs
+ *      Bullet's btSdfCollisionShape (type 29, sampled through queryPoint; Config::handle_bt_sdf_shape);
+ *      any convex shape (btBoxShape, spheres, hulls...) vs SdfShape (Config::convex_shapes),
+ *      as triangles: a box's 12, other shapes' btShapeHull hull;
+ *      SdfShape vs SdfShape (Config::sdf_pairs): the moving one's isosurface triangulation
+ *      against the other's field.
+ *  - the contact model, per pair and step (contact_policy.cpp):
+ *      1. one CCD query (sdfccd_query_mesh) over the step from the start pose (world transform)
+ *         to the predicted end pose (interpolation transform); its whole contact set at the
+ *         earliest time of impact is kept (every triangle in the library's TOI window, with
+ *         subdivision contacts), plus those triangles' vertices within Config::vertex_distance;
+ *      2. whenever the step has any contact, also when it STARTS in contact, two discrete
+ *         queries: at the start pose with the margin widened by the step's travel (every
+ *         feature that can reach the surface in the step) and at the predicted end pose; each
+ *         feature found is constrained by its own closest surface point at the start of the
+ *         step (speculative contacts for the rest of the motion: resting, sliding and tipping
+ *         over an edge cannot sink, and a fast body is held by its whole front, not one point);
+ *      3. every candidate is expressed at the start of the step (distance = gap along the normal,
+ *         negative when penetrating) and the set is reduced to the manifold's 4 points: the
+ *         deepest, then the points that maximise the contact polygon's area (as Bullet's
+ *         sortCachedPoints and Box2D do), deterministically and never two at one place;
+ *      4. points carry over the last step's warm-start impulses when they are the same material
+ *         point, and the contact added (CF_CUSTOM_MATERIAL_CALLBACK), processed, started and
+ *         ended callbacks fire as for Bullet's own manifolds.
+ *    A point with gap d > 0 lets the solver close at most d in the step, so the mesh stops on
+ *    the surface in its impact step; such speculative points have restitution 0.
+ *  - Bridge::check(world) reports misuse (not registered, registered too late, overwritten,
+ *    an SdfShape with a dead handle, a displaced hard clamp).
  *  - optional hard clamp (off by default), see setHardClamp().
  *
- * Manifold convention: body A = the mesh, body B = the SDF; the normal is grad phi (pointing
- * out of the SDF, towards the mesh); the point on B is on the surface; distance < 0 means
- * penetration. Points are written directly, so gContactAddedCallback/gContactStartedCallback
- * are not called for them.
+ * Manifold convention: body A = the mesh (or convex/moving SDF) body, body B = the SDF body; the
+ * normal is grad phi (out of the SDF, towards the mesh); the point on B is on the surface;
+ * distance < 0 means penetration; m_index0 = the triangle of the mesh (of the hull for convex
+ * shapes), m_index1 = the SDF wrapper's index.
  *
  * Known limits: the speculative constraint is linear, so a body that rotates a lot in one step
- * can end slightly inside (the next step's ordinary contacts push it out; the hard clamp
- * prevents it); restitution at impact speed is lost (the impact step only slows the body to
- * gap/dt); GImpact compound shapes fall back to GImpact's own algorithm (which sees the
- * SdfShape's triangulation, without CCD).
+ * can end slightly inside (the next step's contacts push it out); restitution at impact speed is
+ * lost (the impact step only slows the body to gap/dt); Bullet's compound algorithm only gives a
+ * child a pair when its box overlaps the SDF's box at the START of the step, so a compound child
+ * faster than its own size per step can still pass through a thin SDF; GImpact compound shapes
+ * (btGImpactCompoundShape) fall back to GImpact's own algorithm (which sees the SdfShape's
+ * triangulation, without CCD).
  */
 #ifndef SDFCCD_BULLET_BRIDGE_H
 #define SDFCCD_BULLET_BRIDGE_H
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 #include "sdfccd/sdfccd.h"
 #include "config.h"
@@ -54,9 +75,11 @@ enum class Status {
     Overwritten,       /**< verify(): the dispatcher no longer finds our algorithm for GImpact vs SDF,
                             e.g. btGImpactCollisionAlgorithm::registerAlgorithm was called after us. */
     NotRegistered,     /**< verify()/setHardClamp() before a successful registerWith(). */
-    InvalidArgument    /**< NULL world/dispatcher, a dispatcher that is not a btCollisionDispatcher,
+    InvalidArgument,   /**< NULL world/dispatcher, a dispatcher that is not a btCollisionDispatcher,
                             a shape type id that is not concave, or setHardClamp() without a
                             btDiscreteDynamicsWorld. */
+    InvalidShape,      /**< check(): an SdfShape in the world wraps a null or destroyed sdfccd handle. */
+    ClampDisplaced     /**< check(): an internal tick callback set after setHardClamp() replaced the clamp's. */
 };
 
 /** Constant name of a status, e.g. "TooLate". */
@@ -79,6 +102,22 @@ struct Config {
     double contact_margin = 0.01;
     /** Contacts written per pair and step, 1..4 (the manifold holds 4). Default 4. */
     int max_contacts = 4;
+    /** The vertices of a triangle in contact that are within this distance (m) of the surface at
+     * the triangle's time of impact are contact candidates too (a face landing flat gives its
+     * corners). Default 0.02 m. */
+    double vertex_distance = 0.02;
+    /** The reduction to 4 points weighs a candidate's spread (distance, area) by
+     * exp(-(its gap - the deepest gap) / spread_depth_scale): points about to touch are preferred
+     * to features that might only reach the surface late in the step. Default 0.3 m. */
+    double spread_depth_scale = 0.3;
+    /** Handle convex shapes (box, sphere, capsule, hulls...) against SdfShape with the same
+     * CCD (box: its 12 triangles; others: their btShapeHull). Off: Bullet's convex-concave
+     * algorithm against the shape's triangulation (no CCD). Default on. */
+    bool convex_shapes = true;
+    /** Handle SdfShape vs SdfShape: the moving shape's triangulation (SdfShape::buildTriangulation)
+     * against the other's field. Off: such pairs have no algorithm and pass through each other
+     * (check() cannot see that; keep it on unless no two SDF bodies can meet). Default on. */
+    bool sdf_pairs = true;
     /** Query parameters passed to sdfccd_query_mesh (margin is replaced by contact_margin).
      * The library's defaults. Keep subdivision on: a long triangle lying across two separate
      * contact regions (a bar across a torus's ring) has only one primary contact, and
@@ -91,13 +130,16 @@ struct Config {
 /** Counters for measurements (all since construction or resetStats()). */
 struct Stats {
     int64_t queries = 0;               /**< CCD queries (sdfccd_query_mesh over the step) made by the algorithm. */
-    int64_t end_pose_queries = 0;      /**< Discrete queries at the predicted end pose (impact steps only). */
+    int64_t end_pose_queries = 0;      /**< Discrete queries at the predicted end pose (steps with contact). */
+    int64_t requeries = 0;             /**< Queries repeated because the contact buffer was too small. */
+    int64_t sdf_evaluations = 0;       /**< SDF evaluations of all those queries (the library's count). */
+    int64_t candidates = 0;            /**< Contact candidates before the reduction to 4 points. */
     double query_seconds = 0;          /**< Wall time inside all those calls. */
     int64_t hits = 0;                  /**< Queries that found contact (hit). */
     int64_t speculative_contacts = 0;  /**< Contacts written for impacts inside a step. */
     int64_t ordinary_contacts = 0;     /**< Contacts written for features in contact at step start. */
-    int64_t query_errors = 0;          /**< Queries that returned an error status (no contacts written). */
-    int64_t fallbacks = 0;             /**< Pairs handed to GImpact's algorithm (unsupported shapes). */
+    int64_t query_errors = 0;          /**< Queries that failed or had no mesh/SDF to work with (no contacts written). */
+    int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
     int64_t clamps = 0;                /**< Hard-clamp corrections. */
     double last_toi_fraction = 1;      /**< Fraction of the last hit (1 when none). */
     int last_state = 0;                /**< sdfccd_ResultState of the last query. */
@@ -139,6 +181,17 @@ public:
      * NotRegistered before registerWith(). Cheap; safe to call at any time. */
     Status verify() const;
 
+    /** Checks how the bridge is used in `world` (call after adding bodies, e.g. before the first
+     * step; a few microseconds per pair). Returns the first problem found, with a sentence in
+     * `*message` if given:
+     *  NotRegistered  this bridge is not registered with the world's dispatcher;
+     *  Overwritten    something replaced our create functions after registerWith();
+     *  InvalidShape   an SdfShape in the world has a null or destroyed sdfccd handle;
+     *  TooLate        a mesh-SDF pair still has an algorithm created before registerWith();
+     *  ClampDisplaced the hard clamp's tick callbacks were replaced;
+     *  Ok             none of these (the message mentions failed queries, if any). */
+    Status check(btCollisionWorld* world, std::string* message = nullptr) const;
+
     /** Restores the dispatcher's slots to the collision configuration's defaults (note: this also
      * drops GImpact's registration for those pairs) and forgets the dispatcher. */
     void unregister();
@@ -146,9 +199,11 @@ public:
     /** Optional hard clamp (off by default). With it on, internal pre- and post-tick callbacks
      * of `world` save each GImpact body's start pose and, after integration, move a mesh that
      * ends a step inside an SDF by more than `tolerance` (m) back to its time of impact and
-     * remove its velocity into the surface. It uses the world's single tick-callback slot pair
-     * and world user info (it fails with InvalidArgument if a callback is already installed);
-     * off restores them to none. Costs one extra query per mesh-SDF pair and step. */
+     * remove its velocity into the surface. Tick callbacks installed before are chained (called
+     * after the clamp's, with the world's user info unchanged) and put back when it is turned
+     * off; install your own callbacks BEFORE turning the clamp on (one installed later replaces
+     * the clamp's: check() reports ClampDisplaced). Costs one extra query per mesh-SDF pair and
+     * step. AlreadyRegistered: another bridge clamps this world. */
     Status setHardClamp(btDiscreteDynamicsWorld* world, bool on, double tolerance = 1e-3);
     bool hardClampEnabled() const;
 

@@ -41,6 +41,13 @@ public:
      * frame. `shape_type` must be a concave id (20 < id < 30) that no other shape in the world
      * uses; the bridge must be registered with the same id (Config::sdf_shape_type). */
     explicit SdfShape(sdfccd_SdfId sdf, int shape_type = kDefaultSdfShapeType);
+    /** The checked way to make a shape: NULL (and `*status` set, if given) when `sdf` is not a live
+     * sdfccd handle (null, destroyed, or never created), instead of a shape nothing collides with. */
+    static SdfShape* create(sdfccd_SdfId sdf, int shape_type = kDefaultSdfShapeType, sdfccd_Status* status = nullptr);
+    /** False when the handle was not a live sdfccd SDF at construction. Such a shape has an empty
+     * box at its origin, the bridge refuses its pairs, and Bridge::check() reports InvalidShape
+     * (as it does for a handle destroyed while the shape is in a world). */
+    bool isValid() const { return m_valid; }
     ~SdfShape() override;
     SdfShape(const SdfShape&) = delete;
     SdfShape& operator=(const SdfShape&) = delete;
@@ -71,6 +78,11 @@ public:
     int buildTriangulation() const;
     /** Triangles of the cached triangulation (0 if not built). */
     int getTriangulationTriangleCount() const;
+    /** The cached triangulation (unscaled local frame; empty if not built): x, y, z per vertex
+     * and three vertex indices per triangle. The bridge samples a moving SdfShape with it
+     * against another SDF. */
+    const std::vector<btScalar>& triangulationVertices() const { return m_vertices; }
+    const std::vector<int>& triangulationIndices() const { return m_indices; }
 
     // ---- btCollisionShape ----
     /** Local box scaled component-wise by the local scaling, padded by the margin, then
@@ -94,6 +106,7 @@ private:
     void dropDerived() const;
 
     sdfccd_SdfId m_sdf;
+    bool m_valid;
     btVector3 m_lo, m_hi;          // unscaled local bounds
     btVector3 m_scaling;
     btScalar m_margin;

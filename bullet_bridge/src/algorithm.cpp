@@ -1,0 +1,430 @@
+// SPDX-License-Identifier: MIT
+// sdfccd Bullet bridge: the collision algorithm, its create function, registration, verify()
+// and check() (see bridge.h).
+//
+// Dispatch: ONE create function per dispatcher table serves every registered pair in both body
+// orders. It decides once, when Bullet creates the pair's algorithm, which body is the mesh
+// (GImpact mesh, convex shape, or the moving SdfShape of an SDF-SDF pair) and which the SDF; the
+// algorithm then orders the wrappers in one place and everything downstream sees (mesh, SDF).
+#include "internal.h"
+
+#include <cstdio>
+#include <mutex>
+#include <new>
+#include <set>
+#include <string>
+
+#include <BulletCollision/Gimpact/btGImpactShape.h>
+#include <LinearMath/btPoolAllocator.h>
+
+SDFCCD_BULLET_NAMESPACE_BEGIN
+
+using namespace detail;
+
+namespace {
+
+// Dispatchers that have a bridge (for the "registered twice" check across bridges).
+std::mutex g_registry_mutex;
+std::set<const btCollisionDispatcher*> g_registered;
+
+} // namespace
+
+namespace detail {
+
+class MeshSdfAlgorithm : public btCollisionAlgorithm
+{
+public:
+    MeshSdfAlgorithm(const btCollisionAlgorithmConstructionInfo& ci, BridgeImpl* bridge, bool mesh_is_body1, bool closest)
+        : btCollisionAlgorithm(ci), m_bridge(bridge), m_manifold(ci.m_manifold), m_own(false),
+          m_mesh_is_body1(mesh_is_body1), m_closest(closest)
+    {
+    }
+    ~MeshSdfAlgorithm() override
+    {
+        if (m_manifold && m_own) m_dispatcher->releaseManifold(m_manifold);
+    }
+
+    void processCollision(const btCollisionObjectWrapper* body0Wrap, const btCollisionObjectWrapper* body1Wrap,
+                          const btDispatcherInfo& dispatchInfo, btManifoldResult* resultOut) override
+    {
+        const btCollisionObjectWrapper* mw = body0Wrap;
+        const btCollisionObjectWrapper* sw = body1Wrap;
+        if (m_mesh_is_body1) std::swap(mw, sw);
+        // The manifold's order is fixed whatever the dispatcher's: A = mesh, B = SDF. A manifold
+        // handed in by a compound is used when it has that order.
+        if (m_manifold && !m_own && m_manifold->getBody0() != mw->getCollisionObject()) m_manifold = nullptr;
+        if (!m_manifold) {
+            m_manifold = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
+            m_own = true;
+        }
+        resultOut->setPersistentManifold(m_manifold);
+        m_bridge->process(mw, sw, dispatchInfo, resultOut, m_manifold, m_closest);
+    }
+
+    btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1, const btDispatcherInfo& dispatchInfo,
+                                   btManifoldResult*) override
+    {
+        if (m_mesh_is_body1) std::swap(body0, body1);
+        return (btScalar)m_bridge->timeOfImpact(body0, body1, dispatchInfo.m_timeStep);
+    }
+
+    void getAllContactManifolds(btManifoldArray& manifoldArray) override
+    {
+        if (m_manifold && m_own) manifoldArray.push_back(m_manifold);
+    }
+
+private:
+    BridgeImpl* m_bridge;
+    btPersistentManifold* m_manifold;
+    bool m_own;
+    bool m_mesh_is_body1;
+    bool m_closest;
+};
+
+// Bullet's collision-algorithm pool hands out 192-byte elements in both Debian builds; the
+// algorithm stays far below (and falls back to btAlignedAlloc if a pool is smaller).
+static_assert(sizeof(MeshSdfAlgorithm) <= 192, "MeshSdfAlgorithm must fit Bullet's collision-algorithm pool element");
+
+} // namespace detail
+
+struct BridgeImpl::CreateFunc : public btCollisionAlgorithmCreateFunc {
+    BridgeImpl* bridge;
+    bool closest;
+    CreateFunc(BridgeImpl* b, bool closest_points) : bridge(b), closest(closest_points) {}
+
+    btCollisionAlgorithm* CreateCollisionAlgorithm(btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* w0,
+                                                   const btCollisionObjectWrapper* w1) override
+    {
+        bool mesh_is_body1 = false;
+        if (!bridge->orient(w0, w1, mesh_is_body1)) {
+            // Not ours after all (a GImpact compound, an SdfShape without a valid handle): what
+            // the slot held before us, counted so check() can report it.
+            bridge->stats.fallbacks++;
+            btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(ci.m_dispatcher1);
+            const int t0 = w0->getCollisionShape()->getShapeType(), t1 = w1->getCollisionShape()->getShapeType();
+            if (!closest && (t0 == GIMPACT_SHAPE_PROXYTYPE || t1 == GIMPACT_SHAPE_PROXYTYPE))
+                return bridge->gimpact_fn.CreateCollisionAlgorithm(ci, w0, w1);
+            if (!d) return nullptr;
+            btCollisionConfiguration* cc = d->getCollisionConfiguration();
+            btCollisionAlgorithmCreateFunc* f =
+                closest ? cc->getClosestPointsAlgorithmCreateFunc(t0, t1) : cc->getCollisionAlgorithmCreateFunc(t0, t1);
+            return f ? f->CreateCollisionAlgorithm(ci, w0, w1) : nullptr;
+        }
+        void* mem = nullptr;
+        btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(ci.m_dispatcher1);
+        btPoolAllocator* pool = d ? d->getCollisionConfiguration()->getCollisionAlgorithmPool() : nullptr;
+        if (pool && pool->getElementSize() >= (int)sizeof(MeshSdfAlgorithm))
+            mem = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(MeshSdfAlgorithm));
+        else
+            mem = btAlignedAlloc(sizeof(MeshSdfAlgorithm), 16); // freeCollisionAlgorithm falls back to btAlignedFree
+        return new (mem) MeshSdfAlgorithm(ci, bridge, mesh_is_body1, closest);
+    }
+};
+
+BridgeImpl::BridgeImpl(const Config& c) : cfg(c)
+{
+    cfg.max_contacts = std::max(1, std::min(cfg.max_contacts, 4));
+    if (!(cfg.contact_margin >= 0)) cfg.contact_margin = 0;
+    if (!(cfg.vertex_distance >= 0)) cfg.vertex_distance = 0;
+}
+
+bool BridgeImpl::isOurSdf(const btCollisionShape* s) const
+{
+    const int type = s->getShapeType();
+    if (type == cfg.sdf_shape_type) {
+        const SdfShape* shape = dynamic_cast<const SdfShape*>(s);
+        return shape && shape->isValid();
+    }
+    return type == SDF_SHAPE_PROXYTYPE && cfg.handle_bt_sdf_shape && dynamic_cast<const btSdfCollisionShape*>(s);
+}
+
+bool BridgeImpl::isMeshLike(const btCollisionShape* s) const
+{
+    const int type = s->getShapeType();
+    if (type == GIMPACT_SHAPE_PROXYTYPE)
+        return static_cast<const btGImpactShapeInterface*>(s)->getGImpactShapeType() != CONST_GIMPACT_COMPOUND_SHAPE;
+    if (s->isConvex()) return cfg.convex_shapes;
+    if (type == cfg.sdf_shape_type && cfg.sdf_pairs) {
+        const SdfShape* shape = dynamic_cast<const SdfShape*>(s);
+        return shape && shape->isValid() && shape->hasFiniteBounds();
+    }
+    return false;
+}
+
+bool BridgeImpl::orient(const btCollisionObjectWrapper* w0, const btCollisionObjectWrapper* w1, bool& mesh_is_body1) const
+{
+    const btCollisionShape* s0 = w0->getCollisionShape();
+    const btCollisionShape* s1 = w1->getCollisionShape();
+    const bool m0 = isMeshLike(s0), m1 = isMeshLike(s1), sdf0 = isOurSdf(s0), sdf1 = isOurSdf(s1);
+    if (m0 && m1 && sdf0 && sdf1) {
+        // Two SdfShapes: the moving one is sampled by its triangulation against the other.
+        mesh_is_body1 = w0->getCollisionObject()->isStaticOrKinematicObject() &&
+                        !w1->getCollisionObject()->isStaticOrKinematicObject();
+        return true;
+    }
+    if (m0 && sdf1 && !sdf0) {
+        mesh_is_body1 = false;
+        return true;
+    }
+    if (m1 && sdf0 && !sdf1) {
+        mesh_is_body1 = true;
+        return true;
+    }
+    return false;
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+// The slots the bridge writes: (a, b) pairs of shape types, each order.
+std::vector<std::pair<int, int>> slots(const Config& cfg)
+{
+    std::vector<std::pair<int, int>> s;
+    auto both = [&](int a, int b) {
+        s.push_back(std::make_pair(a, b));
+        if (a != b) s.push_back(std::make_pair(b, a));
+    };
+    both(GIMPACT_SHAPE_PROXYTYPE, cfg.sdf_shape_type);
+    if (cfg.handle_bt_sdf_shape && cfg.sdf_shape_type != SDF_SHAPE_PROXYTYPE) both(GIMPACT_SHAPE_PROXYTYPE, SDF_SHAPE_PROXYTYPE);
+    if (cfg.convex_shapes)
+        for (int t = 0; t < CONCAVE_SHAPES_START_HERE; ++t) both(t, cfg.sdf_shape_type);
+    if (cfg.sdf_pairs) both(cfg.sdf_shape_type, cfg.sdf_shape_type);
+    return s;
+}
+
+// A probe pair for verify(): a one-triangle GImpact mesh, a box, our shape, Bullet's SDF shape.
+struct Probe {
+    btVector3 verts[3];
+    int idx[3];
+    btTriangleIndexVertexArray mesh;
+    btGImpactMeshShape gimpact;
+    btBoxShape box;
+    btCollisionObject gimpact_object, box_object;
+    Probe()
+        : verts{ btVector3(0, 0, 0), btVector3(1, 0, 0), btVector3(0, 1, 0) }, idx{ 0, 1, 2 },
+          mesh(1, idx, 3 * (int)sizeof(int), 3, &verts[0][0], (int)sizeof(btVector3)), gimpact(&mesh),
+          box(btVector3(1, 1, 1))
+    {
+        gimpact.updateBound();
+        gimpact_object.setCollisionShape(&gimpact);
+        box_object.setCollisionShape(&box);
+    }
+};
+
+// True when the dispatcher creates our algorithm for (a, b) in `table`.
+bool createsOurs(btCollisionDispatcher* d, btCollisionObject& a, btCollisionObject& b, ebtDispatcherQueryType table)
+{
+    btCollisionObjectWrapper wa(nullptr, a.getCollisionShape(), &a, a.getWorldTransform(), -1, -1);
+    btCollisionObjectWrapper wb(nullptr, b.getCollisionShape(), &b, b.getWorldTransform(), -1, -1);
+    btCollisionAlgorithm* alg = d->findAlgorithm(&wa, &wb, nullptr, table);
+    bool ours = dynamic_cast<MeshSdfAlgorithm*>(alg) != nullptr;
+    if (alg) {
+        alg->~btCollisionAlgorithm();
+        d->freeCollisionAlgorithm(alg);
+    }
+    return ours;
+}
+
+void say(std::string* message, const char* fmt, const char* a = "", long long n = 0)
+{
+    if (!message) return;
+    char buf[512];
+    std::snprintf(buf, sizeof buf, fmt, a, n);
+    *message = buf;
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+const char* statusString(Status s)
+{
+    switch (s) {
+    case Status::Ok: return "Ok";
+    case Status::AlreadyRegistered: return "AlreadyRegistered";
+    case Status::TooLate: return "TooLate";
+    case Status::Overwritten: return "Overwritten";
+    case Status::NotRegistered: return "NotRegistered";
+    case Status::InvalidArgument: return "InvalidArgument";
+    case Status::InvalidShape: return "InvalidShape";
+    case Status::ClampDisplaced: return "ClampDisplaced";
+    }
+    return "?";
+}
+
+std::size_t collisionAlgorithmSize() { return sizeof(MeshSdfAlgorithm); }
+
+Bridge::Bridge(const Config& config) : m_impl(new BridgeImpl(config))
+{
+    m_impl->fn[0].reset(new BridgeImpl::CreateFunc(m_impl, false));
+    m_impl->fn[1].reset(new BridgeImpl::CreateFunc(m_impl, true));
+}
+
+Bridge::~Bridge()
+{
+    if (m_impl->dispatcher) {
+        std::lock_guard<std::mutex> lock(g_registry_mutex);
+        g_registered.erase(m_impl->dispatcher);
+    }
+    clampForget(m_impl);
+    delete m_impl;
+}
+
+Status Bridge::registerWith(btCollisionWorld* world)
+{
+    if (!world) return Status::InvalidArgument;
+    btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(world->getDispatcher());
+    if (!d) return Status::InvalidArgument;
+    if (m_impl->dispatcher) return Status::AlreadyRegistered;
+    {
+        std::lock_guard<std::mutex> lock(g_registry_mutex);
+        if (g_registered.count(d)) return Status::AlreadyRegistered;
+    }
+    const btCollisionObjectArray& objs = world->getCollisionObjectArray();
+    for (int i = 0; i < objs.size(); ++i) {
+        const btCollisionShape* s = objs[i]->getCollisionShape();
+        if (s->getShapeType() == GIMPACT_SHAPE_PROXYTYPE || s->getShapeType() == m_impl->cfg.sdf_shape_type ||
+            m_impl->isOurSdf(s))
+            return Status::TooLate;
+    }
+    return registerWith(d);
+}
+
+Status Bridge::registerWith(btCollisionDispatcher* d)
+{
+    const Config& cfg = m_impl->cfg;
+    if (!d) return Status::InvalidArgument;
+    if (!(cfg.sdf_shape_type > CONCAVE_SHAPES_START_HERE && cfg.sdf_shape_type < CONCAVE_SHAPES_END_HERE) ||
+        cfg.sdf_shape_type == GIMPACT_SHAPE_PROXYTYPE)
+        return Status::InvalidArgument;
+    if (m_impl->dispatcher) return Status::AlreadyRegistered;
+    {
+        std::lock_guard<std::mutex> lock(g_registry_mutex);
+        if (g_registered.count(d)) return Status::AlreadyRegistered;
+        if (d->getNumManifolds() > 0) return Status::TooLate;
+        g_registered.insert(d);
+    }
+    // GImpact first: its registerAlgorithm overwrites every (GIMPACT, x) and (x, GIMPACT) slot.
+    btGImpactCollisionAlgorithm::registerAlgorithm(d);
+    for (const auto& s : slots(cfg)) {
+        d->registerCollisionCreateFunc(s.first, s.second, m_impl->fn[0].get());
+        if (cfg.closest_points) d->registerClosestPointsCreateFunc(s.first, s.second, m_impl->fn[1].get());
+    }
+    m_impl->dispatcher = d;
+    return verify();
+}
+
+Status Bridge::verify() const
+{
+    btCollisionDispatcher* d = m_impl->dispatcher;
+    if (!d) return Status::NotRegistered;
+    const Config& cfg = m_impl->cfg;
+    Probe probe;
+    // A valid SDF for the probe shape (a sphere), so the create function takes it as ours.
+    sdfccd_SdfId sphere = kNullSdf;
+    if (sdfccd_create_sphere(1.0, &sphere) != SDFCCD_OK) return Status::InvalidArgument;
+    Status result = Status::Ok;
+    {
+        SdfShape ours(sphere, cfg.sdf_shape_type);
+        btCollisionObject ours_object;
+        ours_object.setCollisionShape(&ours);
+        btSdfCollisionShape theirs;
+        btCollisionObject theirs_object;
+        theirs_object.setCollisionShape(&theirs);
+        std::vector<std::pair<btCollisionObject*, btCollisionObject*>> probes;
+        probes.push_back(std::make_pair(&probe.gimpact_object, &ours_object));
+        if (cfg.handle_bt_sdf_shape && cfg.sdf_shape_type != SDF_SHAPE_PROXYTYPE)
+            probes.push_back(std::make_pair(&probe.gimpact_object, &theirs_object));
+        if (cfg.convex_shapes) probes.push_back(std::make_pair(&probe.box_object, &ours_object));
+        for (const auto& p : probes) {
+            bool ok = createsOurs(d, *p.first, *p.second, BT_CONTACT_POINT_ALGORITHMS) &&
+                      createsOurs(d, *p.second, *p.first, BT_CONTACT_POINT_ALGORITHMS);
+            if (cfg.closest_points)
+                ok = ok && createsOurs(d, *p.first, *p.second, BT_CLOSEST_POINT_ALGORITHMS) &&
+                     createsOurs(d, *p.second, *p.first, BT_CLOSEST_POINT_ALGORITHMS);
+            if (!ok) result = Status::Overwritten;
+        }
+    }
+    sdfccd_destroy_sdf(sphere);
+    return result;
+}
+
+Status Bridge::check(btCollisionWorld* world, std::string* message) const
+{
+    say(message, "ok");
+    if (!world) {
+        say(message, "check: no world");
+        return Status::InvalidArgument;
+    }
+    if (!m_impl->dispatcher || m_impl->dispatcher != world->getDispatcher()) {
+        say(message, "the bridge is not registered with this world's dispatcher: call Bridge::registerWith(world) right "
+                     "after creating the world, before adding bodies");
+        return Status::NotRegistered;
+    }
+    if (verify() != Status::Ok) {
+        say(message, "the dispatcher no longer creates the bridge's algorithm (registerCollisionCreateFunc or "
+                     "btGImpactCollisionAlgorithm::registerAlgorithm was called after Bridge::registerWith)");
+        return Status::Overwritten;
+    }
+    const btCollisionObjectArray& objs = world->getCollisionObjectArray();
+    for (int i = 0; i < objs.size(); ++i) {
+        const SdfShape* s = dynamic_cast<const SdfShape*>(objs[i]->getCollisionShape());
+        if (!s) continue;
+        sdfccd_SdfInfo info;
+        if (!s->isValid() || sdfccd_sdf_get_info(s->sdf(), &info) != SDFCCD_OK) {
+            say(message, "collision object %lld has an SdfShape whose sdfccd handle is invalid or destroyed", "", i);
+            return Status::InvalidShape;
+        }
+    }
+    // Pairs whose algorithm was created before the registration keep it.
+    btBroadphasePairArray& pairs = world->getPairCache()->getOverlappingPairArray();
+    for (int i = 0; i < pairs.size(); ++i) {
+        const btBroadphasePair& p = pairs[i];
+        if (!p.m_algorithm || !p.m_pProxy0 || !p.m_pProxy1) continue;
+        const btCollisionObject* a = static_cast<const btCollisionObject*>(p.m_pProxy0->m_clientObject);
+        const btCollisionObject* b = static_cast<const btCollisionObject*>(p.m_pProxy1->m_clientObject);
+        btCollisionObjectWrapper wa(nullptr, a->getCollisionShape(), a, a->getWorldTransform(), -1, -1);
+        btCollisionObjectWrapper wb(nullptr, b->getCollisionShape(), b, b->getWorldTransform(), -1, -1);
+        bool swapped;
+        if (m_impl->orient(&wa, &wb, swapped) && !dynamic_cast<MeshSdfAlgorithm*>(p.m_algorithm)) {
+            say(message, "a mesh-SDF pair has an algorithm created before Bridge::registerWith (register before adding "
+                         "bodies)");
+            return Status::TooLate;
+        }
+    }
+    if (clampCheck(m_impl, world) != Status::Ok) {
+        say(message, "an internal tick callback installed after Bridge::setHardClamp replaced the clamp's; install "
+                     "yours first (the clamp chains it)");
+        return Status::ClampDisplaced;
+    }
+    if (m_impl->stats.query_errors > 0)
+        say(message, "ok, but %s%lld queries failed (see sdfccd_last_error)", "", (long long)m_impl->stats.query_errors);
+    return Status::Ok;
+}
+
+void Bridge::unregister()
+{
+    btCollisionDispatcher* d = m_impl->dispatcher;
+    if (!d) return;
+    btCollisionConfiguration* cc = d->getCollisionConfiguration();
+    for (const auto& s : slots(m_impl->cfg)) {
+        d->registerCollisionCreateFunc(s.first, s.second, cc->getCollisionAlgorithmCreateFunc(s.first, s.second));
+        d->registerClosestPointsCreateFunc(s.first, s.second, cc->getClosestPointsAlgorithmCreateFunc(s.first, s.second));
+    }
+    std::lock_guard<std::mutex> lock(g_registry_mutex);
+    g_registered.erase(d);
+    m_impl->dispatcher = nullptr;
+}
+
+double Bridge::timeOfImpact(const btCollisionObject* mesh_body, const btCollisionObject* sdf_body, double dt)
+{
+    if (!mesh_body || !sdf_body) return 1.0;
+    return m_impl->timeOfImpact(mesh_body, sdf_body, dt);
+}
+
+void Bridge::invalidateShape(const btCollisionShape* shape) { m_impl->shapes.invalidate(shape); }
+
+const Config& Bridge::config() const { return m_impl->cfg; }
+Stats Bridge::stats() const { return m_impl->stats; }
+void Bridge::resetStats() { m_impl->stats = Stats(); }
+
+SDFCCD_BULLET_NAMESPACE_END

@@ -1,0 +1,440 @@
+// SPDX-License-Identifier: MIT
+// sdfccd Bullet bridge: the contact policy of one mesh-SDF pair per step (see bridge.h).
+//
+//  1. One CCD query over the step (sdfccd_query_mesh on [0, dt]) with the contact margin. Its
+//     WHOLE contact set at the earliest time of impact is kept (the buffer grows to
+//     contacts_found; every triangle within the library's TOI window, with subdivision contacts),
+//     plus the vertices of those triangles within Config::vertex_distance of the surface then.
+//  2. Whenever the step has any contact, also when it STARTS in contact: two discrete queries,
+//     one at the start pose with the margin widened by the step's travel (every feature that
+//     can reach the surface during the step: phi is 1-Lipschitz), one at the predicted end pose;
+//     each feature they report is constrained by its own closest surface point at the START of
+//     the step (the classic speculative-contact rule), so the rest of the motion (a rotation
+//     about a touching corner, a slide, a face landing after its first point) cannot push it in.
+//  3. Every candidate is expressed at the start of the step: point on the mesh, point on the SDF
+//     surface, normal, and gap d along the normal (negative: penetrating). The set is reduced to
+//     the manifold's 4 points: deepest, then the points maximising the contact polygon's area.
+//  4. The points are written into the pair's manifold the way btManifoldResult and
+//     btPersistentManifold::refreshContactPoints do it: persistent points keep their warm-start
+//     impulses and lifetime, and the contact added / processed / started / ended callbacks fire.
+// The speculative constraint (notes/bullet-integration.md section 3.4 A): a point with gap d > 0
+// lets the solver close at most d in the step, so the mesh stops on the surface.
+#include "internal.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+SDFCCD_BULLET_NAMESPACE_BEGIN
+namespace detail {
+
+// Among points giving at least this share of the best spread, the one with the smallest gap wins.
+static const double kSpreadShare = 0.95;
+
+// Adds points to `out` (up to k) maximising the spread of the projected points P.
+static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>& P, const btVector3& nref, int k, double tol,
+                   double depth_scale, std::vector<int>& out)
+{
+    const int n = (int)c.size();
+    std::vector<double> score(n, 0.0);
+    while ((int)out.size() < k) {
+        const size_t m = out.size();
+        const btVector3& a0 = P[out[0]];
+        double orient = 1;
+        if (m == 3) orient = (P[out[1]] - a0).cross(P[out[2]] - a0).dot(nref) >= 0 ? 1.0 : -1.0;
+        double best = 0;
+        for (int i = 0; i < n; ++i) {
+            score[i] = -1;
+            const btVector3& q = P[i];
+            bool dup = false;
+            for (int j : out) dup |= (double)(q - P[j]).length() <= tol;
+            if (dup) continue;
+            double sc;
+            if (m == 1) {
+                sc = (double)(q - a0).length();
+            } else if (m == 2) {
+                sc = 0.5 * (double)(P[out[1]] - a0).cross(q - a0).length();
+            } else {
+                // Area the point adds outside the triangle (0 inside it).
+                sc = 0;
+                for (int e = 0; e < 3; ++e) {
+                    const btVector3& a = P[out[e]];
+                    const btVector3& b = P[out[(e + 1) % 3]];
+                    const double sa = 0.5 * orient * (double)(b - a).cross(q - a).dot(nref);
+                    if (sa < 0) sc -= sa;
+                }
+            }
+            // A point far from the surface (a feature that may reach it late in the step) counts
+            // less than one about to touch.
+            if (depth_scale > 0) sc *= std::exp(-(c[i].d - c[out[0]].d) / depth_scale);
+            score[i] = sc;
+            best = std::max(best, sc);
+        }
+        // Nothing adds spread: one point, a segment, or everything inside the triangle.
+        double scale;
+        if (m == 1) scale = tol;
+        else if (m == 2) scale = 0.5 * tol * (double)(P[out[1]] - a0).length();
+        else scale = 0.5 * tol * (double)std::max((P[out[1]] - a0).length(), (P[out[2]] - a0).length());
+        if (!(best > scale)) break;
+        int pick = -1;
+        for (int i = 0; i < n; ++i)
+            if (score[i] >= kSpreadShare * best && (pick < 0 || c[i].d < c[pick].d)) pick = i;
+        out.push_back(pick);
+    }
+}
+
+std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale)
+{
+    std::vector<int> out;
+    if (c.empty() || k <= 0) return out;
+    int first = 0;
+    for (int i = 1; i < (int)c.size(); ++i)
+        if (c[i].d < c[first].d) first = i;
+    // Spread is measured between the points on the SDF's surface, projected on the plane of the
+    // deepest point's normal (the contact plane, as in Box2D's manifolds): two features of the
+    // mesh above one another (a bottom and a top corner) constrain the same place, and only the
+    // one with the smaller gap matters.
+    const btVector3 nref = c[first].n0;
+    std::vector<btVector3> P(c.size());
+    for (size_t i = 0; i < c.size(); ++i) P[i] = c[i].pB0 - nref * nref.dot(c[i].pB0);
+    // Several points equally deep (a face landing flat): start from the one farthest from their
+    // centre, a corner of the region, so the polygon grows to the region's corners.
+    const double d0 = c[first].d, same = 1e-3 * tol; // equal up to rounding
+    btVector3 centre(0, 0, 0);
+    int m = 0;
+    for (size_t i = 0; i < c.size(); ++i)
+        if (c[i].d <= d0 + same) {
+            centre += P[i];
+            ++m;
+        }
+    centre /= btScalar(m);
+    double far = -1;
+    for (int i = 0; i < (int)c.size(); ++i) {
+        if (!(c[i].d <= d0 + same)) continue;
+        const double r = (double)(P[i] - centre).length();
+        if (r > far + tol) {
+            far = r;
+            first = i;
+        }
+    }
+    out.push_back(first);
+    spread(c, P, nref, k, tol, depth_scale, out);
+    return out;
+}
+
+namespace {
+
+double seconds(std::chrono::steady_clock::time_point a)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
+}
+
+// Everything the candidate builders of one pair and step share.
+struct Gatherer {
+    const MeshEntry* me;
+    sdfccd_SdfId sdf;
+    BodyMotion M, S;
+    double margin;
+    std::vector<Candidate>* out;
+    std::vector<std::pair<uint32_t, double>> tris;
+
+    // A material point (mesh frame) constrained by a surface point qB and normal nL (SDF frame)
+    // found at some time in the step; all expressed at the start of the step.
+    void add(const btVector3& local, const btVector3& qB, const btVector3& nL, int tri)
+    {
+        Candidate c;
+        c.local = local;
+        c.pA0 = M.t0 * local;
+        c.pB0 = S.t0 * qB;
+        c.n0 = S.t0.getBasis() * nL;
+        c.d = (double)c.n0.dot(c.pA0 - c.pB0);
+        c.triangle = tri;
+        c.speculative = c.d > margin;
+        out->push_back(c);
+    }
+    // The material point constrained by its own closest surface point at the START of the step.
+    void addFromStart(const btVector3& local, int tri)
+    {
+        const btVector3 q = S.t0.invXform(M.t0 * local);
+        double phi = 0;
+        sdfccd_Vec3 g;
+        if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !std::isfinite(phi)) return;
+        btVector3 nL = bt(g);
+        const btScalar len = nL.length();
+        if (!(len > btScalar(0))) return;
+        nL /= len;
+        add(local, q - nL * (btScalar)phi, nL, tri);
+    }
+    // Features in contact at the predicted end pose (Mx, Sx), and the vertices of their triangles
+    // within `accept` there, each constrained from the start of the step.
+    void addPose(const sdfccd_Contact* cs, int count, const btTransform& Mx, const btTransform& Sx, double accept)
+    {
+        std::vector<uint32_t> ts;
+        for (int i = 0; i < count; ++i) {
+            addFromStart(Mx.invXform(bt(cs[i].point)), (int)cs[i].triangle);
+            if (cs[i].triangle < me->indices.size() / 3) ts.push_back(cs[i].triangle);
+        }
+        std::vector<std::pair<uint32_t, uint32_t>> vt;
+        for (uint32_t t : ts)
+            for (int j = 0; j < 3; ++j) vt.push_back(std::make_pair(me->indices[3 * (size_t)t + j], t));
+        std::sort(vt.begin(), vt.end());
+        for (size_t i = 0; i < vt.size(); ++i) {
+            if (i > 0 && vt[i].first == vt[i - 1].first) continue;
+            const double* v = &me->vertices[3 * (size_t)vt[i].first];
+            const btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
+            double phi = 0;
+            if (sdfccd_sdf_eval(sdf, v3(Sx.invXform(Mx * local)), &phi, nullptr) != SDFCCD_OK || !(phi <= accept)) continue;
+            addFromStart(local, (int)vt[i].second);
+        }
+    }
+    // Each contact at its own triangle's time of impact, plus the vertices of that triangle within
+    // `accept` of the surface at that time (a face landing flat gives its corners).
+    void addContacts(const sdfccd_Contact* cs, int count, double accept)
+    {
+        // Contacts come sorted by time; one pose pair per distinct time.
+        double t_pose = -1;
+        btTransform Mx = M.t0, Sx = S.t0;
+        tris.clear();
+        for (int i = 0; i < count; ++i) {
+            const sdfccd_Contact& k = cs[i];
+            if (k.toi != t_pose) {
+                t_pose = k.toi;
+                Mx = M.at(k.toi);
+                Sx = S.at(k.toi);
+            }
+            const btVector3 p = bt(k.point);
+            const btVector3 nL = Sx.getBasis().transpose() * bt(k.normal);
+            add(Mx.invXform(p), Sx.invXform(p) - nL * (btScalar)k.distance, nL, (int)k.triangle);
+            if (k.triangle >= me->indices.size() / 3) continue;
+            if (!tris.empty() && tris.back().first == k.triangle) continue;
+            tris.push_back(std::make_pair(k.triangle, k.toi));
+        }
+        // Each (vertex, triangle's TOI) once, in a fixed order.
+        std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>> vt;
+        for (const auto& t : tris)
+            for (int j = 0; j < 3; ++j) vt.push_back(std::make_pair(me->indices[3 * (size_t)t.first + j], std::make_pair(t.second, t.first)));
+        std::sort(vt.begin(), vt.end());
+        for (size_t i = 0; i < vt.size(); ++i) {
+            if (i > 0 && vt[i].first == vt[i - 1].first) continue; // the earliest TOI of the vertex
+            const double t = vt[i].second.first;
+            if (t != t_pose) {
+                t_pose = t;
+                Mx = M.at(t);
+                Sx = S.at(t);
+            }
+            const double* v = &me->vertices[3 * (size_t)vt[i].first];
+            const btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
+            const btVector3 q = Sx.invXform(Mx * local);
+            double phi = 0;
+            sdfccd_Vec3 g;
+            if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !(phi <= accept)) continue;
+            btVector3 nL = bt(g);
+            const btScalar len = nL.length();
+            if (!(len > btScalar(0))) continue;
+            nL /= len;
+            add(local, q - nL * (btScalar)phi, nL, (int)vt[i].second.second);
+        }
+    }
+};
+
+} // namespace
+} // namespace detail
+
+using namespace detail;
+
+bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin,
+                        std::vector<Candidate>& cands, double* out_radius)
+{
+    cands.clear();
+    Gatherer G;
+    G.me = shapes.meshFor(mw->getCollisionShape());
+    G.sdf = shapes.sdfFor(sw->getCollisionShape(), cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
+    if (!G.me || !G.sdf.index1) {
+        stats.query_errors++;
+        return false;
+    }
+    if (out_radius) *out_radius = G.me->radius;
+    G.M = motionOf(mw->getCollisionObject(), mw->getWorldTransform(), dt);
+    G.S = motionOf(sw->getCollisionObject(), sw->getWorldTransform(), dt);
+    G.margin = margin;
+    G.out = &cands;
+    const sdfccd_RigidMotion mm = G.M.rigid(), sm = G.S.rigid();
+    sdfccd_QueryParams params = cfg.query;
+    params.margin = margin;
+    if (contacts.size() < 256) contacts.resize(256);
+    sdfccd_QueryResult res;
+    auto start = std::chrono::steady_clock::now();
+    sdfccd_Status status = sdfccd_query_mesh(G.sdf, &sm, G.me->id, &mm, 0.0, dt, &params, contacts.data(),
+                                             (int32_t)contacts.size(), &res);
+    if (status == SDFCCD_OK && res.contacts_found > res.contact_count) {
+        // Keep the whole set: grow the buffer and ask again (rare once the buffer has grown).
+        contacts.resize((size_t)res.contacts_found);
+        stats.requeries++;
+        status = sdfccd_query_mesh(G.sdf, &sm, G.me->id, &mm, 0.0, dt, &params, contacts.data(), (int32_t)contacts.size(),
+                                   &res);
+    }
+    stats.query_seconds += seconds(start);
+    stats.queries++;
+    if (status != SDFCCD_OK) {
+        stats.query_errors++;
+        return false;
+    }
+    stats.last_state = (int)res.state;
+    stats.sdf_evaluations += res.sdf_evaluations;
+    if (!res.hit) {
+        stats.last_toi_fraction = 1;
+        return false;
+    }
+    stats.hits++;
+    stats.last_toi_fraction = res.fraction;
+    G.addContacts(contacts.data(), res.contact_count, margin + std::max(cfg.vertex_distance, params.contact_slop));
+
+    // Each triangle gives its FIRST contact only, so the rest of a face that lands after its first
+    // point, or passes through a thin part of the SDF within the step, needs more: every feature
+    // within the step's travel of the surface at the START of the step (the speculative-contact
+    // rule: phi is 1-Lipschitz, so nothing else can reach the surface in the step), and every
+    // feature in contact at the predicted end pose, each constrained by its own closest surface
+    // point at the start of the step.
+    auto discrete = [&](const btTransform& Mx, const btTransform& Sx, double dcd_margin) {
+        sdfccd_RigidMotion m1 = sdfccd_default_rigid_motion(), s1 = sdfccd_default_rigid_motion();
+        m1.pose = toPose(Mx);
+        s1.pose = toPose(Sx);
+        sdfccd_QueryParams dcd = params;
+        dcd.method = SDFCCD_METHOD_DCD;
+        dcd.margin = dcd_margin;
+        sdfccd_QueryResult r1;
+        auto t_start = std::chrono::steady_clock::now();
+        sdfccd_Status st1 = sdfccd_query_mesh(G.sdf, &s1, G.me->id, &m1, 0.0, 0.0, &dcd, contacts.data(),
+                                              (int32_t)contacts.size(), &r1);
+        if (st1 == SDFCCD_OK && r1.contacts_found > r1.contact_count) {
+            contacts.resize((size_t)r1.contacts_found);
+            stats.requeries++;
+            st1 = sdfccd_query_mesh(G.sdf, &s1, G.me->id, &m1, 0.0, 0.0, &dcd, contacts.data(), (int32_t)contacts.size(), &r1);
+        }
+        stats.query_seconds += seconds(t_start);
+        stats.end_pose_queries++;
+        if (st1 == SDFCCD_OK) stats.sdf_evaluations += r1.sdf_evaluations;
+        if (st1 == SDFCCD_OK && r1.hit) G.addPose(contacts.data(), r1.contact_count, Mx, Sx, dcd_margin);
+    };
+    if (dt > 0) {
+        const double reach = G.me->radius + (double)(G.M.t0.getOrigin() - G.S.t0.getOrigin()).length();
+        const double travel = dt * ((double)(G.M.v - G.S.v).length() + (double)G.M.w.length() * G.me->radius +
+                                    (double)G.S.w.length() * reach);
+        if (res.toi > 0 || travel > margin) discrete(G.M.t0, G.S.t0, margin + travel);
+        discrete(G.M.t1, G.S.t1, margin);
+    }
+    stats.candidates += (int64_t)cands.size();
+    return !cands.empty();
+}
+
+void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
+                         btManifoldResult* out, btPersistentManifold* manifold, bool closest)
+{
+    const btCollisionObject* mo = mw->getCollisionObject();
+    const btCollisionObject* so = sw->getCollisionObject();
+    const double dt = closest ? 0.0 : (double)info.m_timeStep;
+    const double margin = closest ? std::max(0.0, (double)out->m_closestPointDistanceThreshold) : cfg.contact_margin;
+    if (!closest && clamp_world) {
+        PairRecord r;
+        r.mesh = mo;
+        r.sdf = so;
+        r.child = mo->getWorldTransform().inverseTimes(mw->getWorldTransform());
+        r.shape = mw->getCollisionShape();
+        pairs.push_back(r);
+    }
+    double radius = 0;
+    const bool any = gather(mw, sw, dt, margin, scratch, &radius);
+    std::vector<int> pick;
+    if (any) pick = reduceContacts(scratch, cfg.max_contacts, std::max(1e-6, 1e-3 * radius), cfg.spread_depth_scale);
+    if (closest) {
+        for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
+        return;
+    }
+    if (pick.empty()) {
+        manifold->clearManifold(); // fires the contact-ended callback if it had points
+        return;
+    }
+    // The new points, in the manifold's order (A = mesh, B = SDF) and its bodies' frames.
+    const btTransform& worldA = mo->getWorldTransform();
+    const btTransform& worldB = so->getWorldTransform();
+    const int n_old = manifold->getNumContacts();
+    btManifoldPoint old[MANIFOLD_CACHE_SIZE];
+    for (int i = 0; i < n_old; ++i) old[i] = manifold->getContactPoint(i);
+    bool matched[MANIFOLD_CACHE_SIZE] = { false, false, false, false };
+    const btScalar match = manifold->getContactBreakingThreshold();
+    btManifoldPoint pts[MANIFOLD_CACHE_SIZE];
+    const int n = std::min((int)pick.size(), (int)MANIFOLD_CACHE_SIZE);
+    const int flags = mo->getCollisionFlags() | so->getCollisionFlags();
+    for (int k = 0; k < n; ++k) {
+        const Candidate& c = scratch[pick[k]];
+        btManifoldPoint pt(worldA.invXform(c.pA0), worldB.invXform(c.pB0), c.n0, (btScalar)c.d);
+        pt.m_positionWorldOnA = c.pA0;
+        pt.m_positionWorldOnB = c.pB0;
+        pt.m_combinedFriction = gCalculateCombinedFrictionCallback(mo, so);
+        pt.m_combinedRestitution = c.speculative ? btScalar(0) : gCalculateCombinedRestitutionCallback(mo, so);
+        pt.m_combinedRollingFriction = gCalculateCombinedRollingFrictionCallback(mo, so);
+        pt.m_combinedSpinningFriction = gCalculateCombinedSpinningFrictionCallback(mo, so);
+        if (flags & btCollisionObject::CF_HAS_CONTACT_STIFFNESS_DAMPING) {
+            pt.m_combinedContactDamping1 = gCalculateCombinedContactDampingCallback(mo, so);
+            pt.m_combinedContactStiffness1 = gCalculateCombinedContactStiffnessCallback(mo, so);
+            pt.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
+        }
+        btPlaneSpace1(pt.m_normalWorldOnB, pt.m_lateralFrictionDir1, pt.m_lateralFrictionDir2);
+        pt.m_partId0 = mw->m_partId;
+        pt.m_index0 = c.triangle; // the mesh triangle (or compound child: see mw->m_index)
+        pt.m_partId1 = sw->m_partId;
+        pt.m_index1 = sw->m_index;
+        // The same material point as a point of the last step keeps its warm start and lifetime
+        // (btPersistentManifold::getCacheEntry / replaceContactPoint).
+        int best = -1;
+        btScalar best_d2 = match * match;
+        for (int j = 0; j < n_old; ++j) {
+            const btScalar d2 = (old[j].m_localPointA - pt.m_localPointA).length2();
+            if (!matched[j] && d2 < best_d2) {
+                best_d2 = d2;
+                best = j;
+            }
+        }
+        if (best >= 0) {
+            matched[best] = true;
+            pt.m_appliedImpulse = old[best].m_appliedImpulse;
+            pt.m_prevRHS = old[best].m_prevRHS;
+            pt.m_appliedImpulseLateral1 = old[best].m_appliedImpulseLateral1;
+            pt.m_appliedImpulseLateral2 = old[best].m_appliedImpulseLateral2;
+            pt.m_userPersistentData = old[best].m_userPersistentData;
+            pt.m_lifeTime = old[best].m_lifeTime + 1;
+        }
+        pts[k] = pt;
+        if (c.speculative) stats.speculative_contacts++;
+        else stats.ordinary_contacts++;
+    }
+    // Points that did not persist are dropped as refreshContactPoints drops them; the manifold
+    // never passes through 0 points here, so there is no ended callback while contact goes on.
+    manifold->setNumContacts(n);
+    for (int k = 0; k < n; ++k) manifold->getContactPoint(k) = pts[k];
+    if (gContactAddedCallback && (flags & btCollisionObject::CF_CUSTOM_MATERIAL_CALLBACK))
+        for (int k = 0; k < n; ++k)
+            gContactAddedCallback(manifold->getContactPoint(k), mw, pts[k].m_partId0, pts[k].m_index0, sw, pts[k].m_partId1,
+                                  pts[k].m_index1);
+    if (gContactStartedCallback && n_old == 0) gContactStartedCallback(manifold);
+    if (gContactProcessedCallback)
+        for (int k = 0; k < n; ++k)
+            gContactProcessedCallback(manifold->getContactPoint(k), (void*)manifold->getBody0(), (void*)manifold->getBody1());
+}
+
+double BridgeImpl::timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt)
+{
+    if (!(dt > 0)) return 1.0;
+    const MeshEntry* me = shapes.meshFor(mo->getCollisionShape());
+    sdfccd_SdfId sdf = shapes.sdfFor(so->getCollisionShape(), cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
+    if (!me || !sdf.index1) return 1.0;
+    BodyMotion M = motionOf(mo, mo->getWorldTransform(), dt), S = motionOf(so, so->getWorldTransform(), dt);
+    sdfccd_RigidMotion mm = M.rigid(), sm = S.rigid();
+    sdfccd_QueryParams params = cfg.query;
+    params.margin = 0;
+    sdfccd_QueryResult res;
+    if (sdfccd_query_mesh(sdf, &sm, me->id, &mm, 0.0, dt, &params, nullptr, 0, &res) != SDFCCD_OK || !res.hit) return 1.0;
+    return std::max(0.0, std::min(1.0, res.fraction));
+}
+
+SDFCCD_BULLET_NAMESPACE_END

@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: MIT
+// sdfccd Bullet bridge, internal: what the bridge's source files share.
+//   shape_cache.cpp    Bullet shapes -> sdfccd meshes (GImpact, convex hulls, SDF triangulations)
+//                      and SDF handles (SdfShape, btSdfCollisionShape)
+//   contact_policy.cpp the queries of one pair and step, the contact set, its reduction to the
+//                      manifold's 4 points, and writing them with Bullet's callbacks
+//   algorithm.cpp      the collision algorithm, its create functions, registration, check()
+//   hard_clamp.cpp     the optional post-step clamp (chained internal tick callbacks)
+#ifndef SDFCCD_BULLET_INTERNAL_H
+#define SDFCCD_BULLET_INTERNAL_H
+
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletCollision/CollisionDispatch/btCollisionObjectWrapper.h>
+#include <BulletCollision/CollisionShapes/btSdfCollisionShape.h>
+#include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
+#include <LinearMath/btTransformUtil.h>
+
+#include "sdfccd_bullet/bridge.h"
+
+SDFCCD_BULLET_NAMESPACE_BEGIN
+namespace detail {
+
+const sdfccd_SdfId kNullSdf = { 0, 0 };
+
+inline sdfccd_Vec3 v3(const btVector3& v)
+{
+    sdfccd_Vec3 r = { (double)v.x(), (double)v.y(), (double)v.z() };
+    return r;
+}
+inline btVector3 bt(const sdfccd_Vec3& v) { return btVector3((btScalar)v.x, (btScalar)v.y, (btScalar)v.z); }
+sdfccd_Pose toPose(const btTransform& t);
+
+// Start and end pose of a body (or compound child) over a step, and the constant velocities that
+// connect them in Bullet's motion model (origin lerp + exponential-map rotation), sdfccd's too.
+struct BodyMotion {
+    btTransform t0, t1;
+    btVector3 v, w;
+    sdfccd_RigidMotion rigid() const;
+    btTransform at(double t) const;
+};
+// `wrapper_transform` is the wrapper's world transform (a compound child's includes its offset).
+BodyMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt);
+
+// A shape packed as a triangle mesh for sdfccd (scaled, in the shape's local frame).
+struct MeshEntry {
+    sdfccd_MeshId id = { 0, 0 };
+    btVector3 scaling;
+    btScalar margin = 0;
+    int source_count = 0;
+    double radius = 0; // largest vertex distance from the local origin
+    std::vector<double> vertices;
+    std::vector<uint32_t> indices;
+    bool ok = false;
+};
+
+// btSdfCollisionShape sampled through queryPoint, as an sdfccd callback SDF.
+struct BtSdfData {
+    btSdfCollisionShape* shape;
+    btVector3 lo, hi;
+    double hole_value;
+};
+struct BtSdfEntry {
+    sdfccd_SdfId id = { 0, 0 };
+    std::unique_ptr<BtSdfData> data;
+};
+
+// Packed meshes and SDF handles per Bullet shape (keyed by address; see Bridge::invalidateShape).
+class ShapeCache
+{
+public:
+    ~ShapeCache();
+    /** The shape as a triangle mesh: GImpact meshes and parts, convex shapes (box corners, other
+     * convex shapes through btShapeHull), SdfShape (its isosurface triangulation). NULL otherwise. */
+    const MeshEntry* meshFor(const btCollisionShape* shape);
+    /** The SDF handle of an SdfShape (with its scaling) or of a btSdfCollisionShape. Null otherwise. */
+    sdfccd_SdfId sdfFor(const btCollisionShape* shape, int sdf_shape_type, bool bt_sdf);
+    void invalidate(const btCollisionShape* shape);
+
+private:
+    sdfccd_SdfId btSdfFor(const btSdfCollisionShape* shape);
+    std::unordered_map<const btCollisionShape*, MeshEntry> m_meshes;
+    std::unordered_map<const btCollisionShape*, BtSdfEntry> m_bt_sdfs;
+};
+
+// One contact candidate, in the frames at the START of the step.
+struct Candidate {
+    btVector3 local;  // material point in the mesh's (wrapper's) frame
+    btVector3 pA0;    // that point at step start (world)
+    btVector3 pB0;    // the SDF surface point it is constrained by (world, at step start)
+    btVector3 n0;     // normal at step start (world, out of the SDF)
+    double d;         // gap at step start along n0 (negative: penetrating)
+    int triangle;
+    bool speculative; // from an impact later in the step (restitution 0)
+};
+
+/** Reduction of a contact set to at most k points (Bullet/Box2D style): the deepest point (smallest
+ * gap; among equally deep ones the outermost), then the point farthest from it, then the one
+ * maximising the triangle's area, then the one adding most area to the polygon; distances and
+ * areas between the SDF surface points, projected on the plane of the deepest point's normal,
+ * each weighted by exp(-(gap - deepest gap) / depth_scale). Points closer than `tol` to a chosen
+ * one are never chosen (no duplicates).
+ * Ties go to the smaller gap, then to the lower index: deterministic for a given input. */
+std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale);
+
+class MeshSdfAlgorithm;
+
+Status clampCheck(const BridgeImpl* impl, const btCollisionWorld* world);
+void clampForget(BridgeImpl* impl);
+
+} // namespace detail
+
+class BridgeImpl
+{
+public:
+    explicit BridgeImpl(const Config& c);
+
+    // Which side of a pair is the mesh and which the SDF (false if the bridge does not handle it).
+    bool orient(const btCollisionObjectWrapper* w0, const btCollisionObjectWrapper* w1, bool& mesh_is_body1) const;
+    bool isOurSdf(const btCollisionShape* s) const;
+    bool isMeshLike(const btCollisionShape* s) const;
+
+    // contact_policy.cpp
+    bool gather(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin,
+                std::vector<detail::Candidate>& cands, double* out_radius);
+    void process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
+                 btManifoldResult* out, btPersistentManifold* manifold, bool closest);
+    double timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt);
+
+    // hard_clamp.cpp
+    void clampPre(btDynamicsWorld* world);
+    void clampPost(btDynamicsWorld* world, double dt);
+
+    Config cfg;
+    Stats stats;
+    detail::ShapeCache shapes;
+    btCollisionDispatcher* dispatcher = nullptr;
+    btDiscreteDynamicsWorld* clamp_world = nullptr;
+    btInternalTickCallback user_pre = nullptr, user_post = nullptr; // chained by the clamp
+    double clamp_tolerance = 1e-3;
+    struct PairRecord { const btCollisionObject* mesh; const btCollisionObject* sdf; btTransform child; const btCollisionShape* shape; };
+    std::unordered_map<const btCollisionObject*, btTransform> starts;
+    std::vector<PairRecord> pairs;
+    // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
+    std::vector<detail::Candidate> scratch;
+    std::vector<sdfccd_Contact> contacts;
+
+    struct CreateFunc;
+    std::unique_ptr<CreateFunc> fn[2]; // contact points, closest points
+    btGImpactCollisionAlgorithm::CreateFunc gimpact_fn;
+};
+
+SDFCCD_BULLET_NAMESPACE_END
+
+#endif

@@ -1,0 +1,310 @@
+// SPDX-License-Identifier: MIT
+// sdfccd Bullet bridge: Bullet shapes as sdfccd meshes and SDF handles (see internal.h).
+#include "internal.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <BulletCollision/CollisionShapes/btShapeHull.h>
+#include <BulletCollision/Gimpact/btGImpactShape.h>
+
+SDFCCD_BULLET_NAMESPACE_BEGIN
+namespace detail {
+
+sdfccd_Pose toPose(const btTransform& t)
+{
+    sdfccd_Pose p;
+    p.position = v3(t.getOrigin());
+    btQuaternion q = t.getRotation();
+    p.orientation.w = q.w();
+    p.orientation.x = q.x();
+    p.orientation.y = q.y();
+    p.orientation.z = q.z();
+    return p;
+}
+
+sdfccd_RigidMotion BodyMotion::rigid() const
+{
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose = toPose(t0);
+    m.linear_velocity = v3(v);
+    m.angular_velocity = v3(w);
+    return m;
+}
+
+btTransform BodyMotion::at(double t) const
+{
+    btTransform r;
+    btTransformUtil::integrateTransform(t0, v, w, (btScalar)t, r);
+    return r;
+}
+
+BodyMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt)
+{
+    BodyMotion m;
+    m.t0 = m.t1 = wrapper_transform;
+    m.v.setZero();
+    m.w.setZero();
+    if (!(dt > 0)) return m;
+    // A compound child's offset from its body (identity for a top-level shape).
+    const btTransform child = co->getWorldTransform().inverseTimes(wrapper_transform);
+    // Kinematic first: Bullet's idiom for a kinematic body (mass 0 plus CF_KINEMATIC_OBJECT)
+    // leaves CF_STATIC_OBJECT set as well.
+    if (co->isKinematicObject()) {
+        // saveKinematicState has already moved the world transform to the END of the step and
+        // set the interpolation velocities; rebuild the start pose by integrating backwards.
+        btTransform body0;
+        btTransformUtil::integrateTransform(co->getWorldTransform(), -co->getInterpolationLinearVelocity(),
+                                            -co->getInterpolationAngularVelocity(), (btScalar)dt, body0);
+        m.t0 = body0 * child;
+        btTransformUtil::calculateVelocity(m.t0, m.t1, (btScalar)dt, m.v, m.w);
+        return m;
+    }
+    if (co->isStaticObject()) return m;
+    // Dynamic: world transform = start, interpolation transform = predicted end (set by
+    // predictUnconstraintMotion before the narrow phase).
+    m.t1 = co->getInterpolationWorldTransform() * child;
+    btTransformUtil::calculateVelocity(m.t0, m.t1, (btScalar)dt, m.v, m.w);
+    return m;
+}
+
+namespace {
+
+// Appends triangle (a, b, c) unless it has (almost) no area, so the library's triangle numbers
+// are ours.
+void pushTriangle(MeshEntry& e, uint32_t a, uint32_t b, uint32_t c)
+{
+    const double* va = &e.vertices[3 * (size_t)a];
+    const double* vb = &e.vertices[3 * (size_t)b];
+    const double* vc = &e.vertices[3 * (size_t)c];
+    const double u[3] = { vb[0] - va[0], vb[1] - va[1], vb[2] - va[2] };
+    const double w[3] = { vc[0] - va[0], vc[1] - va[1], vc[2] - va[2] };
+    const double n[3] = { u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0] };
+    const double s = std::max(u[0] * u[0] + u[1] * u[1] + u[2] * u[2], w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (!(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-10 * s)) return;
+    e.indices.push_back(a);
+    e.indices.push_back(b);
+    e.indices.push_back(c);
+}
+
+void pushVertex(MeshEntry& e, const btVector3& v)
+{
+    e.vertices.push_back((double)v.x());
+    e.vertices.push_back((double)v.y());
+    e.vertices.push_back((double)v.z());
+}
+
+void packPart(const btGImpactMeshShapePart* part, MeshEntry& e)
+{
+    part->lockChildShapes();
+    const uint32_t base = (uint32_t)(e.vertices.size() / 3);
+    const int nv = part->getVertexCount();
+    for (int i = 0; i < nv; ++i) {
+        btVector3 v;
+        part->getVertex(i, v); // scaled by the shape's local scaling
+        pushVertex(e, v);
+    }
+    btGImpactMeshShapePart::TrimeshPrimitiveManager* pm =
+        const_cast<btGImpactMeshShapePart*>(part)->getTrimeshPrimitiveManager();
+    const int nt = part->getNumChildShapes();
+    for (int t = 0; t < nt; ++t) {
+        unsigned int a, b, c;
+        pm->get_indices(t, a, b, c);
+        if ((int)a >= nv || (int)b >= nv || (int)c >= nv) continue;
+        pushTriangle(e, base + a, base + b, base + c);
+    }
+    part->unlockChildShapes();
+}
+
+int gimpactCount(const btGImpactShapeInterface* g)
+{
+    if (g->getGImpactShapeType() == CONST_GIMPACT_TRIMESH_SHAPE) {
+        const btGImpactMeshShape* m = static_cast<const btGImpactMeshShape*>(g);
+        int n = 0;
+        for (int i = 0; i < m->getMeshPartCount(); ++i) n += m->getMeshPart(i)->getNumChildShapes();
+        return n;
+    }
+    return g->getNumChildShapes();
+}
+
+// The box with its collision margin (Bullet's box surface), 12 outward triangles.
+void packBox(const btBoxShape* box, MeshEntry& e)
+{
+    const btVector3 h = box->getHalfExtentsWithMargin();
+    for (int i = 0; i < 8; ++i)
+        pushVertex(e, btVector3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(), (i & 4) ? h.z() : -h.z()));
+    static const uint32_t faces[12][3] = { { 0, 2, 1 }, { 1, 2, 3 }, { 4, 5, 6 }, { 5, 7, 6 }, { 0, 1, 4 }, { 1, 5, 4 },
+                                           { 2, 6, 3 }, { 3, 6, 7 }, { 0, 4, 2 }, { 2, 4, 6 }, { 1, 3, 5 }, { 3, 7, 5 } };
+    for (const auto& f : faces) pushTriangle(e, f[0], f[1], f[2]);
+}
+
+// Any other convex shape: the hull of its support points (margin included) in 42+ directions.
+void packConvex(const btConvexShape* convex, MeshEntry& e)
+{
+    btShapeHull hull(convex);
+    if (!hull.buildHull(0, 1)) return;
+    for (int i = 0; i < hull.numVertices(); ++i) pushVertex(e, hull.getVertexPointer()[i]);
+    const unsigned int* idx = hull.getIndexPointer();
+    for (int t = 0; t < hull.numTriangles(); ++t) pushTriangle(e, idx[3 * t], idx[3 * t + 1], idx[3 * t + 2]);
+}
+
+// An SdfShape as the moving side of an SDF-SDF pair: its isosurface triangulation, scaled.
+void packSdfShape(const SdfShape* s, MeshEntry& e)
+{
+    s->buildTriangulation();
+    const std::vector<btScalar>& v = s->triangulationVertices();
+    const std::vector<int>& f = s->triangulationIndices();
+    const btVector3& k = s->getLocalScaling();
+    for (size_t i = 0; i + 2 < v.size(); i += 3) pushVertex(e, btVector3(v[i], v[i + 1], v[i + 2]) * k);
+    for (size_t i = 0; i + 2 < f.size(); i += 3) pushTriangle(e, (uint32_t)f[i], (uint32_t)f[i + 1], (uint32_t)f[i + 2]);
+}
+
+// The number that must not change for a cached pack to stay valid.
+int sourceCount(const btCollisionShape* shape)
+{
+    if (shape->getShapeType() == GIMPACT_SHAPE_PROXYTYPE)
+        return gimpactCount(static_cast<const btGImpactShapeInterface*>(shape));
+    if (const SdfShape* s = dynamic_cast<const SdfShape*>(shape)) return s->getTriangulationResolution();
+    return 0;
+}
+
+double btSdfEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
+{
+    BtSdfData* d = static_cast<BtSdfData*>(user);
+    btVector3 x = bt(p);
+    btVector3 eps = (d->hi - d->lo) * btScalar(1e-6);
+    btVector3 q = x;
+    q.setMax(d->lo + eps);
+    q.setMin(d->hi - eps);
+    btVector3 out = x - q;
+    double outside = (double)out.length();
+    btScalar dist = 0;
+    btVector3 n(0, 0, 0);
+    bool ok = d->shape->queryPoint(q, dist, n);
+    btVector3 g;
+    double phi;
+    if (ok) {
+        phi = (double)dist + outside; // outside the grid: distance to the box plus the boundary value
+        g = outside > 0 ? out / btScalar(outside) : n;
+    } else {
+        // A cell without data (narrow-band grids): far from the surface by construction.
+        phi = d->hole_value + outside;
+        g = x - (d->lo + d->hi) * btScalar(0.5);
+    }
+    if (out_grad) {
+        btScalar l = g.length();
+        *out_grad = v3(l > btScalar(0) ? g / l : btVector3(0, 0, 1));
+    }
+    return phi;
+}
+
+} // namespace
+
+ShapeCache::~ShapeCache()
+{
+    for (auto& m : m_meshes)
+        if (m.second.id.index1) sdfccd_destroy_mesh(m.second.id);
+    for (auto& s : m_bt_sdfs)
+        if (s.second.id.index1) sdfccd_destroy_sdf(s.second.id);
+}
+
+const MeshEntry* ShapeCache::meshFor(const btCollisionShape* shape)
+{
+    const int type = shape->getShapeType();
+    const btGImpactShapeInterface* g = nullptr;
+    const SdfShape* sdf_shape = nullptr;
+    if (type == GIMPACT_SHAPE_PROXYTYPE) {
+        g = static_cast<const btGImpactShapeInterface*>(shape);
+        if (g->getGImpactShapeType() == CONST_GIMPACT_COMPOUND_SHAPE) return nullptr;
+    } else if (!shape->isConvex()) {
+        sdf_shape = dynamic_cast<const SdfShape*>(shape);
+        if (!sdf_shape) return nullptr;
+    }
+    const int count = sourceCount(shape);
+    auto it = m_meshes.find(shape);
+    if (it != m_meshes.end()) {
+        const MeshEntry& e = it->second;
+        if (e.scaling == shape->getLocalScaling() && e.margin == shape->getMargin() && e.source_count == count)
+            return e.ok ? &e : nullptr;
+        if (e.id.index1) sdfccd_destroy_mesh(e.id);
+        m_meshes.erase(it);
+    }
+    MeshEntry& e = m_meshes[shape];
+    e.scaling = shape->getLocalScaling();
+    e.margin = shape->getMargin();
+    e.source_count = count;
+    if (g) {
+        if (g->getGImpactShapeType() == CONST_GIMPACT_TRIMESH_SHAPE) {
+            const btGImpactMeshShape* m = static_cast<const btGImpactMeshShape*>(g);
+            for (int i = 0; i < m->getMeshPartCount(); ++i) packPart(m->getMeshPart(i), e);
+        } else {
+            packPart(static_cast<const btGImpactMeshShapePart*>(g), e);
+        }
+    } else if (sdf_shape) {
+        packSdfShape(sdf_shape, e);
+    } else if (type == BOX_SHAPE_PROXYTYPE) {
+        packBox(static_cast<const btBoxShape*>(shape), e);
+    } else {
+        packConvex(static_cast<const btConvexShape*>(shape), e);
+    }
+    if (e.indices.empty()) return nullptr;
+    for (size_t i = 0; i + 2 < e.vertices.size(); i += 3)
+        e.radius = std::max(e.radius, std::sqrt(e.vertices[i] * e.vertices[i] + e.vertices[i + 1] * e.vertices[i + 1] +
+                                                e.vertices[i + 2] * e.vertices[i + 2]));
+    sdfccd_MeshDef def = sdfccd_default_mesh_def();
+    def.vertices = e.vertices.data();
+    def.vertex_count = (uint32_t)(e.vertices.size() / 3);
+    def.indices = e.indices.data();
+    def.triangle_count = (uint32_t)(e.indices.size() / 3);
+    def.drop_degenerate = 1;
+    e.ok = sdfccd_create_mesh(&def, &e.id) == SDFCCD_OK;
+    return e.ok ? &e : nullptr;
+}
+
+sdfccd_SdfId ShapeCache::sdfFor(const btCollisionShape* shape, int sdf_shape_type, bool bt_sdf)
+{
+    const int type = shape->getShapeType();
+    if (type == sdf_shape_type)
+        if (const SdfShape* s = dynamic_cast<const SdfShape*>(shape)) return s->querySdf();
+    if (type == SDF_SHAPE_PROXYTYPE && bt_sdf)
+        if (const btSdfCollisionShape* s = dynamic_cast<const btSdfCollisionShape*>(shape)) return btSdfFor(s);
+    return kNullSdf;
+}
+
+sdfccd_SdfId ShapeCache::btSdfFor(const btSdfCollisionShape* shape)
+{
+    auto it = m_bt_sdfs.find(shape);
+    if (it != m_bt_sdfs.end()) return it->second.id;
+    BtSdfEntry& e = m_bt_sdfs[shape];
+    e.data.reset(new BtSdfData);
+    e.data->shape = const_cast<btSdfCollisionShape*>(shape); // queryPoint is non-const but only reads
+    btTransform id;
+    id.setIdentity();
+    shape->getAabb(id, e.data->lo, e.data->hi);
+    e.data->hole_value = 0.05 * (double)(e.data->hi - e.data->lo).length();
+    sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
+    def.eval = btSdfEval;
+    def.user = e.data.get();
+    def.lipschitz = 1.0;
+    def.bounds.lo = v3(e.data->lo);
+    def.bounds.hi = v3(e.data->hi);
+    if (sdfccd_create_callback_sdf(&def, &e.id) != SDFCCD_OK) e.id = kNullSdf;
+    return e.id;
+}
+
+void ShapeCache::invalidate(const btCollisionShape* shape)
+{
+    auto it = m_meshes.find(shape);
+    if (it != m_meshes.end()) {
+        if (it->second.id.index1) sdfccd_destroy_mesh(it->second.id);
+        m_meshes.erase(it);
+    }
+    auto jt = m_bt_sdfs.find(shape);
+    if (jt != m_bt_sdfs.end()) {
+        if (jt->second.id.index1) sdfccd_destroy_sdf(jt->second.id);
+        m_bt_sdfs.erase(jt);
+    }
+}
+
+} // namespace detail
+SDFCCD_BULLET_NAMESPACE_END
