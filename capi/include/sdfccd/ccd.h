@@ -31,12 +31,13 @@
 extern "C" {
 #endif
 
+/** The narrow-phase method of a query (sdfccd_QueryParams::method); the README compares them. */
 typedef enum sdfccd_Method {
-    SDFCCD_METHOD_FWGSS = 0,
-    SDFCCD_METHOD_FW,
-    SDFCCD_METHOD_DCD,
-    SDFCCD_METHOD_CERTIFIED,
-    SDFCCD_METHOD_COUNT
+    SDFCCD_METHOD_FWGSS = 0, /**< Frank-Wolfe with golden-section search (the paper's Algorithm 2). Default. */
+    SDFCCD_METHOD_FW,        /**< Frank-Wolfe with line search along the motion (Section 4.2). */
+    SDFCCD_METHOD_DCD,       /**< Discrete: deepest point at the end pose (Macklin et al. 2020); misses tunnelling. */
+    SDFCCD_METHOD_CERTIFIED, /**< Lipschitz branch and bound: no contact before toi_lower (ground truth; slow). */
+    SDFCCD_METHOD_COUNT      /**< Number of methods (not a method). */
 } sdfccd_Method;
 
 /** Every cap and tolerance of a query. Must be initialised with sdfccd_default_query_params(). */
@@ -97,6 +98,7 @@ typedef struct sdfccd_QueryParams {
  * values stay finite, so no intermediate overflows; larger inputs give ::SDFCCD_INVALID_ARGUMENT. */
 #define SDFCCD_MAX_QUERY_MAGNITUDE 1e150
 
+/** The default query parameters (see each field of ::sdfccd_QueryParams). */
 SDFCCD_API sdfccd_QueryParams sdfccd_default_query_params(void);
 
 /** Rigid motion over the interval (the paper's Eq. 14). At t0 the body's frame has pose
@@ -124,6 +126,7 @@ typedef enum sdfccd_ResultState {
                                         nevertheless witnessed (then toi/contacts are the best estimate). */
 } sdfccd_ResultState;
 
+/** Where a contact comes from. */
 typedef enum sdfccd_ContactKind {
     SDFCCD_CONTACT_PRIMARY = 0,    /**< The TOI point of a triangle. */
     SDFCCD_CONTACT_SUBDIVISION     /**< An extra point found by adaptive subdivision at the TOI. */
@@ -138,11 +141,12 @@ typedef struct sdfccd_Contact {
     double toi;               /**< Time of impact of this contact's triangle (s). */
     double barycentric[3];    /**< Weights of the triangle's vertices 0, 1, 2. */
     uint32_t triangle;        /**< Triangle index in the mesh (0 for single-triangle queries). */
-    sdfccd_ContactKind kind;
+    sdfccd_ContactKind kind;  /**< Primary (the triangle's TOI point) or from subdivision. */
 } sdfccd_Contact;
 
+/** Summary of a query: the earliest time of impact over all triangles and the work done. */
 typedef struct sdfccd_QueryResult {
-    sdfccd_ResultState state;
+    sdfccd_ResultState state; /**< Hit, no hit, penetrating at t0, or not converged. */
     int32_t hit;              /**< 1 when a contact was found (state HIT or PENETRATING, or NOT_CONVERGED with a witness). */
     double toi;               /**< Time of impact (s); t1 when there is no hit. */
     double fraction;          /**< (toi - t0) / (t1 - t0). */

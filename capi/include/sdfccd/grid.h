@@ -69,7 +69,7 @@ typedef struct sdfccd_GridDef {
      * are unreliable). */
     int32_t allow_open_mesh;
     sdfccd_ProgressFcn* progress; /**< May be NULL. */
-    void* progress_user;
+    void* progress_user;    /**< Passed to `progress`. */
     int32_t internal_value; /**< Set by sdfccd_default_grid_def(); do not change. */
 } sdfccd_GridDef;
 
@@ -108,6 +108,7 @@ SDFCCD_API sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path);
 /* ------------------------------------------------------------------------------------------ */
 /** @name Inspection */
 
+/** What sdfccd_grid_get_info() reports. */
 typedef struct sdfccd_GridInfo {
     int32_t resolution[3];  /**< Cells per axis. */
     sdfccd_Aabb domain;     /**< Grid box (m). */

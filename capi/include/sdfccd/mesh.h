@@ -15,14 +15,17 @@ extern "C" {
 #endif
 
 /** Handle to a mesh. Generation-checked; a null handle has index1 == 0. */
-typedef struct sdfccd_MeshId { uint32_t index1; uint32_t generation; } sdfccd_MeshId;
+typedef struct sdfccd_MeshId {
+    uint32_t index1;     /**< Slot + 1; 0 is the null handle. */
+    uint32_t generation; /**< Generation of the slot when the handle was made. */
+} sdfccd_MeshId;
 
 /** Describes a mesh to create. Must be initialised with sdfccd_default_mesh_def(). */
 typedef struct sdfccd_MeshDef {
     const double* vertices;   /**< 3 * vertex_count coordinates, x y z per vertex, local frame. */
-    uint32_t vertex_count;
+    uint32_t vertex_count;    /**< Number of vertices (>= 3). */
     const uint32_t* indices;  /**< 3 * triangle_count vertex indices, counter-clockwise. */
-    uint32_t triangle_count;
+    uint32_t triangle_count;  /**< Number of triangles (>= 1). */
     /** 0 (default): a zero-area triangle is an error (::SDFCCD_DEGENERATE, the message names it).
      * 1: zero-area triangles are dropped and counted in sdfccd_MeshInfo::dropped_triangles. */
     int32_t drop_degenerate;
@@ -36,15 +39,18 @@ SDFCCD_API sdfccd_MeshDef sdfccd_default_mesh_def(void);
  * no triangles (::SDFCCD_DEGENERATE), a zero-area triangle unless dropped. */
 SDFCCD_API sdfccd_Status sdfccd_create_mesh(const sdfccd_MeshDef* def, sdfccd_MeshId* out_mesh);
 
+/** Releases the mesh. */
 SDFCCD_API sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId mesh);
 
+/** What sdfccd_mesh_get_info() reports. */
 typedef struct sdfccd_MeshInfo {
-    uint32_t vertex_count;
-    uint32_t triangle_count;
+    uint32_t vertex_count;      /**< Vertices stored. */
+    uint32_t triangle_count;    /**< Triangles kept (without dropped ones). */
     uint32_t dropped_triangles; /**< Degenerate triangles dropped at creation or import. */
     sdfccd_Aabb bounds;         /**< Local-frame bounding box. */
-    int64_t memory_bytes;
+    int64_t memory_bytes;       /**< Bytes the mesh holds (arrays and broad-phase hierarchy). */
 } sdfccd_MeshInfo;
+/** Describes a mesh. */
 SDFCCD_API sdfccd_Status sdfccd_mesh_get_info(sdfccd_MeshId mesh, sdfccd_MeshInfo* out_info);
 
 /** Copies the mesh's data out: `out_vertices` (3 * vertex_count doubles) and `out_indices`

@@ -19,13 +19,26 @@ extern "C" {
 #endif
 
 /** Handle to an SDF. Generation-checked: a stale handle gives ::SDFCCD_INVALID_HANDLE. */
-typedef struct sdfccd_SdfId { uint32_t index1; uint32_t generation; } sdfccd_SdfId;
+typedef struct sdfccd_SdfId {
+    uint32_t index1;     /**< Slot + 1; 0 is the null handle. */
+    uint32_t generation; /**< Generation of the slot when the handle was made. */
+} sdfccd_SdfId;
 
 /** Kinds of SDF, as reported by sdfccd_sdf_get_info(). */
 typedef enum sdfccd_SdfKind {
-    SDFCCD_SDF_SPHERE, SDFCCD_SDF_BOX, SDFCCD_SDF_ROUNDED_BOX, SDFCCD_SDF_TORUS, SDFCCD_SDF_CAPSULE,
-    SDFCCD_SDF_CYLINDER, SDFCCD_SDF_HALF_SPACE, SDFCCD_SDF_SPIKE_GRID, SDFCCD_SDF_CSG,
-    SDFCCD_SDF_TRANSFORM, SDFCCD_SDF_CALLBACK, SDFCCD_SDF_GRID, SDFCCD_SDF_KIND_COUNT
+    SDFCCD_SDF_SPHERE,      /**< sdfccd_create_sphere() */
+    SDFCCD_SDF_BOX,         /**< sdfccd_create_box() */
+    SDFCCD_SDF_ROUNDED_BOX, /**< sdfccd_create_rounded_box() */
+    SDFCCD_SDF_TORUS,       /**< sdfccd_create_torus() */
+    SDFCCD_SDF_CAPSULE,     /**< sdfccd_create_capsule() */
+    SDFCCD_SDF_CYLINDER,    /**< sdfccd_create_cylinder() */
+    SDFCCD_SDF_HALF_SPACE,  /**< sdfccd_create_half_space() */
+    SDFCCD_SDF_SPIKE_GRID,  /**< sdfccd_create_spike_grid() */
+    SDFCCD_SDF_CSG,         /**< sdfccd_create_csg() */
+    SDFCCD_SDF_TRANSFORM,   /**< sdfccd_create_transformed() */
+    SDFCCD_SDF_CALLBACK,    /**< sdfccd_create_callback_sdf() */
+    SDFCCD_SDF_GRID,        /**< A grid (grid.h): built, or loaded from a `.cdf` file. */
+    SDFCCD_SDF_KIND_COUNT   /**< Number of kinds (not a kind). */
 } sdfccd_SdfKind;
 
 /** Sphere of radius `radius` > 0 centred at the origin. Exact distance. */
@@ -51,20 +64,28 @@ SDFCCD_API sdfccd_Status sdfccd_create_half_space(sdfccd_Vec3 normal, double off
  * cones (each point tests the cones of its own and the 8 neighbouring cells), so it is
  * 1-Lipschitz. Beyond the grid's edge only the ground remains. */
 typedef struct sdfccd_SpikeGridDef {
-    double spacing;
-    double base_radius;
-    double height;
-    int32_t count_x, count_y;
+    double spacing;         /**< Distance between neighbouring cone axes (m), > 0. */
+    double base_radius;     /**< Cone base radius (m), in (0, spacing / 2]. */
+    double height;          /**< Cone height above the ground (m), > 0. */
+    int32_t count_x;        /**< Cones along x, in [1, 100000]. */
+    int32_t count_y;        /**< Cones along y, in [1, 100000]. */
     int32_t internal_value; /**< Set by sdfccd_default_spike_grid_def(); do not change. */
 } sdfccd_SpikeGridDef;
 /** Defaults: spacing 0.1 m, base radius 0.05 m, height 0.1 m, 20 x 20 cones. */
 SDFCCD_API sdfccd_SpikeGridDef sdfccd_default_spike_grid_def(void);
+/** Creates the spike grid `def` describes. Errors: bad def (::SDFCCD_INVALID_ARGUMENT). */
 SDFCCD_API sdfccd_Status sdfccd_create_spike_grid(const sdfccd_SpikeGridDef* def, sdfccd_SdfId* out_sdf);
 
 /** Boolean combinations. Union = min(a, b); intersection = max(a, b); difference (a minus b)
  * = max(a, -b). The results are 1-Lipschitz but are exact distances only outside (union) or in
  * simple cases; the certified method relies only on the Lipschitz bound. */
-typedef enum sdfccd_CsgOp { SDFCCD_CSG_UNION, SDFCCD_CSG_INTERSECTION, SDFCCD_CSG_DIFFERENCE } sdfccd_CsgOp;
+typedef enum sdfccd_CsgOp {
+    SDFCCD_CSG_UNION,        /**< min(a, b) */
+    SDFCCD_CSG_INTERSECTION, /**< max(a, b) */
+    SDFCCD_CSG_DIFFERENCE    /**< a minus b: max(a, -b) */
+} sdfccd_CsgOp;
+/** Creates the combination `op` of `a` and `b`; the new SDF keeps both alive (they may be
+ * destroyed by the caller afterwards). */
 SDFCCD_API sdfccd_Status sdfccd_create_csg(sdfccd_CsgOp op, sdfccd_SdfId a, sdfccd_SdfId b, sdfccd_SdfId* out_sdf);
 
 /** `child` placed with `pose` and uniformly scaled by `scale` > 0:
@@ -78,15 +99,17 @@ SDFCCD_API sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Po
  * everywhere (1 for a true distance field); the certified method is only as sound as this bound.
  * `bounds` must contain every point with phi <= 0 (use +-INFINITY if unbounded). */
 typedef double sdfccd_SdfEvalFcn(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user);
+/** Describes a user SDF (see ::sdfccd_SdfEvalFcn). Initialise with sdfccd_default_callback_sdf_def(). */
 typedef struct sdfccd_CallbackSdfDef {
-    sdfccd_SdfEvalFcn* eval;
-    void* user;
-    double lipschitz;
-    sdfccd_Aabb bounds;
+    sdfccd_SdfEvalFcn* eval; /**< phi and its gradient; must be set. */
+    void* user;              /**< Passed to `eval`. */
+    double lipschitz;        /**< Bound on |grad phi| everywhere (> 0). */
+    sdfccd_Aabb bounds;      /**< Contains every point with phi <= 0 (+-INFINITY if unbounded). */
     int32_t internal_value; /**< Set by sdfccd_default_callback_sdf_def(); do not change. */
 } sdfccd_CallbackSdfDef;
 /** Defaults: eval NULL (must be set), user NULL, lipschitz 1, infinite bounds. */
 SDFCCD_API sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void);
+/** Creates a user SDF. The library does not check that `eval` keeps `lipschitz`. */
 SDFCCD_API sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfccd_SdfId* out_sdf);
 
 /** Releases the handle. The shape's memory is freed once no combination uses it. */
@@ -95,13 +118,15 @@ SDFCCD_API sdfccd_Status sdfccd_destroy_sdf(sdfccd_SdfId sdf);
 /** Value (and gradient when out_grad is not NULL) at p, in the SDF's local frame. */
 SDFCCD_API sdfccd_Status sdfccd_sdf_eval(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad);
 
+/** What sdfccd_sdf_get_info() reports. */
 typedef struct sdfccd_SdfInfo {
-    sdfccd_SdfKind kind;
+    sdfccd_SdfKind kind;  /**< What created the SDF. */
     sdfccd_Aabb domain;   /**< Where values are exact (a grid's box); +-INFINITY for analytic shapes. */
     sdfccd_Aabb bounds;   /**< Contains every point with phi <= 0 (may be infinite). */
     double lipschitz;     /**< Global bound on |grad phi|. */
     int64_t memory_bytes; /**< Bytes owned by this shape alone (children not counted). */
 } sdfccd_SdfInfo;
+/** Describes an SDF. */
 SDFCCD_API sdfccd_Status sdfccd_sdf_get_info(sdfccd_SdfId sdf, sdfccd_SdfInfo* out_info);
 
 #ifdef __cplusplus

@@ -10,17 +10,32 @@ extern "C" {
 #endif
 
 /** A point or vector in metres (or m/s, rad/s). */
-typedef struct sdfccd_Vec3 { double x, y, z; } sdfccd_Vec3;
+typedef struct sdfccd_Vec3 {
+    double x; /**< x component. */
+    double y; /**< y component. */
+    double z; /**< z component. */
+} sdfccd_Vec3;
 
 /** A unit quaternion, scalar part first (w, x, y, z), as in the case file. Non-unit input is
  * normalised by the functions that take it; a zero quaternion is rejected. */
-typedef struct sdfccd_Quat { double w, x, y, z; } sdfccd_Quat;
+typedef struct sdfccd_Quat {
+    double w; /**< Scalar part (cos of half the angle). */
+    double x; /**< x of the vector part (axis times sin of half the angle). */
+    double y; /**< y of the vector part. */
+    double z; /**< z of the vector part. */
+} sdfccd_Quat;
 
 /** A rigid pose: x_world = rotate(orientation, x_local) + position. */
-typedef struct sdfccd_Pose { sdfccd_Vec3 position; sdfccd_Quat orientation; } sdfccd_Pose;
+typedef struct sdfccd_Pose {
+    sdfccd_Vec3 position;    /**< Translation (m), world frame. */
+    sdfccd_Quat orientation; /**< Rotation from the local to the world frame. */
+} sdfccd_Pose;
 
 /** An axis-aligned box. */
-typedef struct sdfccd_Aabb { sdfccd_Vec3 lo, hi; } sdfccd_Aabb;
+typedef struct sdfccd_Aabb {
+    sdfccd_Vec3 lo; /**< Lower corner (min x, y, z). */
+    sdfccd_Vec3 hi; /**< Upper corner (max x, y, z). */
+} sdfccd_Aabb;
 
 /** The identity pose. */
 SDFCCD_API sdfccd_Pose sdfccd_pose_identity(void);
