@@ -320,7 +320,7 @@ static int march(trav* tr, uint32_t i, uint32_t s, double from, double to, doubl
     return 1;
 }
 
-static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void* user, const scc_allocator* alloc)
+static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void* user, scc_workspace* ws)
 {
     /* DCD: the pose at t_end only. Depth-first with an explicit stack (depth <= 64 for a
      * median-split tree of up to 2^30 triangles, but grow it anyway). */
@@ -328,9 +328,11 @@ static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void
     scc_quat q = scc_quat_identity();
     scc_vec3 p = scc_v3(0, 0, 0);
     if (!tr->moving) scc_rigid_pose_at(tr->mm->body, t_end, &q, &p);
-    size_t cap = 128, n = 0;
-    uint32_t* stack = scc_alloc(alloc, cap * sizeof *stack);
+    size_t n = 0;
+    uint32_t* stack = scc_ws_get(ws, SCC_WS_STACK, 128 * sizeof *stack);
     if (!stack) return 0;
+    size_t cap = ws->slot[SCC_WS_STACK].bytes / sizeof *stack;
+    const scc_allocator* alloc = ws->alloc;
     stack[n++] = 0;
     int ok = 1;
     double te = t_end;
@@ -349,19 +351,19 @@ static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void
             uint32_t* ns = scc_alloc(alloc, 2 * cap * sizeof *ns);
             if (!ns) { ok = 0; break; }
             memcpy(ns, stack, n * sizeof *ns);
-            scc_free(alloc, stack, cap * sizeof *stack);
+            scc_free(alloc, stack, ws->slot[SCC_WS_STACK].bytes);
             stack = ns;
             cap *= 2;
+            scc_ws_adopt(ws, SCC_WS_STACK, stack, cap * sizeof *stack);
         }
         stack[n++] = b->nodes[i].first + 1;
         stack[n++] = b->nodes[i].first;
     }
-    scc_free(alloc, stack, cap * sizeof *stack);
     return ok;
 }
 
 int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_sdf* sdf,
-                     const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc, double t_end,
+                     const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws, double t_end,
                      scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats)
 {
     stats->evals = stats->nodes_visited = stats->candidates = 0;
@@ -377,7 +379,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
     tr.w_body2 = mm->body && !moving ? scc_len2(mm->body->w) : 0.0;
     tr.stats = stats;
     tr.seg = NULL;
-    if (p->method == SCC_METHOD_DCD) return traverse_static(&tr, t_end, visit, user, alloc);
+    if (p->method == SCC_METHOD_DCD) return traverse_static(&tr, t_end, visit, user, ws);
 
     /* Segments: no more than min(pi, max_rotation) of relative rotation each. */
     double w = (mm->body && !moving ? scc_len(mm->body->w) : 0.0) + (mm->sdf ? scc_len(mm->sdf->w) : 0.0);
@@ -407,9 +409,15 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
             if (k > nseg) nseg = (uint32_t)k;
         }
     }
-    segment* seg = scc_alloc(alloc, nseg * sizeof *seg);
-    uint8_t* tested = scc_alloc(alloc, ((size_t)bsh->triangle_count + 7) / 8);
-    item_heap heap = { NULL, 0, 0, alloc };
+    segment* seg = scc_ws_get(ws, SCC_WS_SEGMENTS, nseg * sizeof *seg);
+    uint8_t* tested = scc_ws_get(ws, SCC_WS_TESTED, ((size_t)bsh->triangle_count + 7) / 8);
+    /* the heap grows in its workspace slot (its storage is handed back at the end) */
+    item_heap heap = { ws->slot[SCC_WS_HEAP].p, 0, ws->slot[SCC_WS_HEAP].bytes / sizeof(item), ws->alloc };
+    if (heap.cap * sizeof(item) != ws->slot[SCC_WS_HEAP].bytes) { /* not the heap's own storage: start afresh */
+        scc_free(ws->alloc, heap.a, ws->slot[SCC_WS_HEAP].bytes);
+        heap.a = NULL;
+        heap.cap = 0;
+    }
     int ok = seg && tested;
     if (ok) {
         memset(tested, 0, ((size_t)bsh->triangle_count + 7) / 8);
@@ -459,8 +467,6 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
             }
         }
     }
-    scc_free(alloc, heap.a, heap.cap * sizeof *heap.a);
-    scc_free(alloc, tested, ((size_t)bsh->triangle_count + 7) / 8);
-    scc_free(alloc, seg, nseg * sizeof *seg);
+    scc_ws_adopt(ws, SCC_WS_HEAP, heap.a, heap.cap * sizeof(item));
     return ok;
 }

@@ -38,6 +38,7 @@
 #include "ccd.h"
 #include "mesh.h"
 #include "sdf.h"
+#include "workspace.h"
 
 typedef struct scc_bsh_node {
     scc_vec3 center;   /* local frame */
@@ -85,10 +86,11 @@ typedef int scc_bsh_visit_fn(void* user, uint32_t triangle, double t_candidate, 
 
 /* Traverses `bsh` for the motion `mm` over [mm->t0, t_end]: continuous (padded sphere tracing)
  * unless `p->method` is DCD, which tests the pose at t_end only. `moving` is the refit for linear
- * motion (NULL for rigid motion; required when mm->body is NULL). Returns 0 on allocation failure,
+ * motion (NULL for rigid motion; required when mm->body is NULL). Scratch storage comes from `ws`
+ * (workspace.h), which keeps it for the next traversal. Returns 0 on allocation failure,
  * when the visitor aborts, or when linear motion comes without its refit. */
 int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_sdf* sdf,
-                     const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc, double t_end,
+                     const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws, double t_end,
                      scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats);
 
 #endif

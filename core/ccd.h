@@ -10,6 +10,7 @@
 #include "mesh.h"
 #include "motion.h"
 #include "sdf.h"
+#include "workspace.h"
 
 typedef enum scc_method { SCC_METHOD_FWGSS, SCC_METHOD_FW, SCC_METHOD_DCD, SCC_METHOD_CERTIFIED } scc_method;
 
@@ -117,13 +118,17 @@ int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
                    scc_contact* out, int capacity, scc_query_summary* sum);
 /* The motion of triangle t of the mesh motion `mm` (what the mesh query tests per triangle). */
 void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_motion* out);
+/* The same with the scratch storage in a caller-kept workspace (workspace.h): after a first query
+ * of a given size, later ones allocate nothing. */
+int scc_query_mesh_ws(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws, scc_contact* out,
+                      int capacity, scc_query_summary* sum);
 
 /* scc_query_mesh with instrumentation for benchmarks (mesh_query.c): `probe` (may be NULL) is
  * called with begin = 1 right before and begin = 0 right after each narrow-phase triangle test,
  * so a caller can time triangles; *out_broad_evals (may be NULL) receives the broad phase's
  * share of sum->evals. */
 typedef void scc_mesh_probe_fn(void* user, uint32_t triangle, int begin);
-int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
+int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws,
                           scc_contact* out, int capacity, scc_query_summary* sum, scc_mesh_probe_fn* probe, void* probe_user,
                           int64_t* out_broad_evals);
 

@@ -63,6 +63,7 @@ void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_mot
 }
 
 typedef struct mesh_ctx {
+    scc_workspace* ws;
     const scc_sdf* sdf;
     const scc_mesh_motion* mm;
     const scc_params* p;
@@ -154,24 +155,21 @@ static int run_broad_phase(mesh_ctx* c)
         bsh = own;
     }
     scc_bsh_moving_node* moving = NULL;
-    size_t moving_bytes = 0;
     int ok = 1;
     if (!mm->body) {
-        moving_bytes = (size_t)bsh->node_count * sizeof *moving;
-        moving = scc_alloc(alloc, moving_bytes);
+        moving = scc_ws_get(c->ws, SCC_WS_MOVING, (size_t)bsh->node_count * sizeof *moving);
         if (!moving) ok = 0;
         else scc_bsh_refit_linear(bsh, mm->mesh, mm->start, mm->end, moving);
     }
     if (ok) {
         scc_bsh_stats st = { 0, 0, 0 };
         c->broad = &st;
-        ok = scc_bsh_traverse(bsh, moving, c->sdf, mm, c->p, alloc, mm->t1, visit_candidate, c, &st);
+        ok = scc_bsh_traverse(bsh, moving, c->sdf, mm, c->p, c->ws, mm->t1, visit_candidate, c, &st);
         if (budget_left(c) <= 0) c->budget_exhausted = 1;
         c->broad = NULL;
         c->sum->evals += st.evals;
         c->broad_evals += st.evals;
     }
-    scc_free(alloc, moving, moving_bytes);
     scc_bsh_destroy(own, alloc);
     return ok;
 }
@@ -179,21 +177,40 @@ static int run_broad_phase(mesh_ctx* c)
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum)
 {
-    return scc_query_mesh_probed(sdf, mm, p, alloc, out, capacity, sum, NULL, NULL, NULL);
+    scc_workspace ws;
+    scc_ws_init(&ws, alloc);
+    int ok = scc_query_mesh_probed(sdf, mm, p, &ws, out, capacity, sum, NULL, NULL, NULL);
+    scc_ws_release(&ws);
+    return ok;
 }
 
-int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
+int scc_query_mesh_ws(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws, scc_contact* out,
+                      int capacity, scc_query_summary* sum)
+{
+    return scc_query_mesh_probed(sdf, mm, p, ws, out, capacity, sum, NULL, NULL, NULL);
+}
+
+int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws,
                           scc_contact* out, int capacity, scc_query_summary* sum, scc_mesh_probe_fn* probe, void* probe_user,
                           int64_t* out_broad_evals)
 {
+    const scc_allocator* alloc = ws->alloc;
     mesh_ctx c;
+    c.ws = ws;
     c.sdf = sdf;
     c.mm = mm;
     c.p = p;
     c.alloc = alloc;
-    c.buf.a = NULL;
-    c.buf.n = c.buf.cap = 0;
+    /* the contact buffer grows in its workspace slot and is handed back at the end */
+    c.buf.a = ws->slot[SCC_WS_CONTACTS].p;
+    c.buf.n = 0;
+    c.buf.cap = ws->slot[SCC_WS_CONTACTS].bytes / sizeof(scc_contact);
     c.buf.alloc = alloc;
+    if (c.buf.cap * sizeof(scc_contact) != ws->slot[SCC_WS_CONTACTS].bytes) {
+        scc_free(alloc, c.buf.a, ws->slot[SCC_WS_CONTACTS].bytes);
+        c.buf.a = NULL;
+        c.buf.cap = 0;
+    }
     c.best = c.lower = INFINITY;
     c.best_state = SCC_NO_HIT;
     c.any_not_converged = 0;
@@ -215,10 +232,8 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     double best = c.best, lower = c.lower;
     scc_state best_state = c.best_state;
     int any_not_converged = c.any_not_converged || c.budget_exhausted;
-    if (!ok) {
-        scc_free(alloc, buf.a, buf.cap * sizeof *buf.a);
-        return 0;
-    }
+    scc_ws_adopt(ws, SCC_WS_CONTACTS, buf.a, buf.cap * sizeof *buf.a);
+    if (!ok) return 0;
     /* Earliest first; insertion sort is fine for the handful of contacts at one TOI. */
     for (size_t i = 1; i < buf.n; ++i) {
         scc_contact key = buf.a[i];
@@ -233,6 +248,5 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
                           : (any_not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT);
     sum->contacts_found = (int)buf.n;
     for (size_t i = 0; i < buf.n && (int)i < capacity; ++i) out[i] = buf.a[i];
-    scc_free(alloc, buf.a, buf.cap * sizeof *buf.a);
     return 1;
 }

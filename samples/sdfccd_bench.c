@@ -693,6 +693,7 @@ static scc_params core_params(const sdfccd_QueryParams* in)
 static void* c_alloc(size_t n, void* u) { (void)u; return malloc(n); }
 static void c_free(void* p, size_t n, void* u) { (void)n; (void)u; free(p); }
 static const scc_allocator k_alloc = { c_alloc, c_free, NULL };
+static scc_workspace g_ws = { &k_alloc, { { NULL, 0 } } };
 
 typedef struct probe_rec { double t_begin; double* us; size_t n, cap; } probe_rec;
 static void probe_fn(void* user, uint32_t tri, int begin)
@@ -733,7 +734,7 @@ static fall_result fall(const scc_sdf* sdf, const scc_mesh* mesh, const scc_para
         scc_query_summary s;
         int64_t be = 0;
         double t0 = now_us();
-        if (!scc_query_mesh_probed(sdf, &mm, p, &k_alloc, out, 1024, &s, probe ? probe_fn : NULL, probe, &be)) {
+        if (!scc_query_mesh_probed(sdf, &mm, p, &g_ws, out, 1024, &s, probe ? probe_fn : NULL, probe, &be)) {
             fprintf(stderr, "out of memory\n");
             exit(1);
         }

@@ -297,7 +297,9 @@ static void run_case(test_rng* rng, const fields* fl, int kind, sweep_stats* st)
     rec.tc = malloc(nt * sizeof *rec.tc);
     for (uint32_t t = 0; t < nt; ++t) rec.tc[t] = INFINITY;
     scc_bsh_stats bst;
-    ck_assert(scc_bsh_traverse(bsh, mv, sdf, &mm, &pc, &k_alloc, DT, record_visit, &rec, &bst));
+    scc_workspace ws;
+    scc_ws_init(&ws, &k_alloc);
+    ck_assert(scc_bsh_traverse(bsh, mv, sdf, &mm, &pc, &ws, DT, record_visit, &rec, &bst));
 
     /* Brute force: the certified TOI of every triangle over the whole step. */
     double* cert = malloc(nt * sizeof *cert);
@@ -369,7 +371,7 @@ skip_exact:
     /* DCD: the static descent keeps every triangle whose end pose touches, and agrees with the loop. */
     scc_params pd = default_params(SCC_METHOD_DCD);
     for (uint32_t t = 0; t < nt; ++t) rec.tc[t] = INFINITY;
-    ck_assert(scc_bsh_traverse(bsh, mv, sdf, &mm, &pd, &k_alloc, DT, record_visit, &rec, &bst));
+    ck_assert(scc_bsh_traverse(bsh, mv, sdf, &mm, &pd, &ws, DT, record_visit, &rec, &bst));
     for (uint32_t t = 0; t < nt; ++t) {
         scc_tri_motion m;
         memset(&m, 0, sizeof m);
@@ -391,6 +393,7 @@ skip_exact:
     free(mv);
     free(lin);
     scc_bsh_destroy(bsh, &k_alloc);
+    scc_ws_release(&ws);
     free_mesh(&rm);
 }
 

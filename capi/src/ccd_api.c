@@ -313,37 +313,124 @@ sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
     return run_triangle(&q, &m, t0, t1, out_contacts, capacity, out_result, fn);
 }
 
-static sdfccd_Status run_mesh(const query_setup* q, const scc_mesh_motion* mm, sdfccd_Contact* out_contacts, int32_t capacity,
-                              sdfccd_QueryResult* out_result, const char* fn)
+/* A caller-kept workspace: the mesh query's scratch storage, reused from call to call. */
+struct sdfccd_Workspace {
+    scc_workspace ws;
+};
+
+sdfccd_Status sdfccd_create_workspace(sdfccd_Workspace** out_workspace)
 {
-    const int32_t kCap = 1024;
-    int32_t cap = capacity < kCap ? kCap : capacity;
-    scc_contact* c = sdfccd__alloc((size_t)cap * sizeof *c);
-    if (!c) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(out_workspace, "sdfccd_create_workspace: out_workspace"))) return st;
+    *out_workspace = NULL;
+    sdfccd_Workspace* w = sdfccd__alloc(sizeof *w);
+    if (!w) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "sdfccd_create_workspace: out of memory");
+    scc_ws_init(&w->ws, sdfccd__allocator());
+    *out_workspace = w;
+    return SDFCCD_OK;
+}
+
+void sdfccd_destroy_workspace(sdfccd_Workspace* workspace)
+{
+    if (!workspace) return;
+    scc_ws_release(&workspace->ws);
+    sdfccd__free(workspace, sizeof *workspace);
+}
+
+int64_t sdfccd_workspace_bytes(const sdfccd_Workspace* workspace)
+{
+    return workspace ? (int64_t)(sizeof *workspace + scc_ws_bytes(&workspace->ws)) : 0;
+}
+
+/* The mesh query in `ws` (a caller's, or a temporary one freed before returning). */
+static sdfccd_Status run_mesh(const query_setup* q, const scc_mesh_motion* mm, scc_workspace* ws, sdfccd_Contact* out_contacts,
+                              int32_t capacity, sdfccd_QueryResult* out_result, const char* fn)
+{
+    scc_contact* c = NULL;
+    if (capacity > 0 && !(c = scc_ws_get(ws, SCC_WS_STAGING, (size_t)capacity * sizeof *c)))
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
     scc_query_summary s;
-    int ok = scc_query_mesh(q->sdf->sdf, mm, &q->p, sdfccd__allocator(), c, cap, &s);
+    int ok = scc_query_mesh_ws(q->sdf->sdf, mm, &q->p, ws, c, capacity, &s);
     if (ok) write_result(q, mm->t0, mm->t1, &s, c, out_contacts, capacity, out_result);
-    sdfccd__free(c, (size_t)cap * sizeof *c);
     return ok ? SDFCCD_OK : sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+}
+
+static sdfccd_Status query_mesh(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
+                                sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result, const char* fn)
+{
+    query_setup q;
+    sdfccd_Status st;
+    char what[96];
+    if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
+    snprintf(what, sizeof what, "%s: motion", fn);
+    if ((st = sdfccd__check_ptr(motion, what))) return st;
+    scc_rigid body;
+    if ((st = convert_motion(motion, t0, t1, what, &body))) return st;
+    if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
+    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
+    if (!m) return SDFCCD_INVALID_HANDLE;
+    if ((st = check_mesh_bounds(m, fn))) return st;
+    scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1 };
+    if (workspace) return run_mesh(&q, &mm, &workspace->ws, out_contacts, capacity, out_result, fn);
+    scc_workspace tmp;
+    scc_ws_init(&tmp, sdfccd__allocator());
+    st = run_mesh(&q, &mm, &tmp, out_contacts, capacity, out_result, fn);
+    scc_ws_release(&tmp);
+    return st;
 }
 
 sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
                                 const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
                                 sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
-    static const char fn[] = "sdfccd_query_mesh";
+    return query_mesh(NULL, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh");
+}
+
+sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                   const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
+                                   sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
+{
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_mesh_ws: workspace"))) return st;
+    return query_mesh(workspace, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh_ws");
+}
+
+static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                       sdfccd_MeshId mesh, const double* start, const double* end, double t0, double t1,
+                                       const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+                                       sdfccd_QueryResult* out_result, const char* fn)
+{
     query_setup q;
     sdfccd_Status st;
+    char what[96];
     if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
-    if ((st = sdfccd__check_ptr(motion, "sdfccd_query_mesh: motion"))) return st;
-    scc_rigid body;
-    if ((st = convert_motion(motion, t0, t1, "sdfccd_query_mesh: motion", &body))) return st;
-    if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
+    snprintf(what, sizeof what, "%s: start", fn);
+    if ((st = sdfccd__check_ptr(start, what))) return st;
+    snprintf(what, sizeof what, "%s: end", fn);
+    if ((st = sdfccd__check_ptr(end, what))) return st;
     sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
-    if ((st = check_mesh_bounds(m, fn))) return st;
-    scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1 };
-    return run_mesh(&q, &mm, out_contacts, capacity, out_result, fn);
+    uint32_t nv = m->mesh.vertex_count;
+    for (uint32_t i = 0; i < 3 * nv; ++i)
+        if (!(fabs(start[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE) || !(fabs(end[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i / 3);
+    scc_workspace tmp;
+    scc_ws_init(&tmp, sdfccd__allocator());
+    scc_workspace* ws = workspace ? &workspace->ws : &tmp;
+    scc_vec3* v = scc_ws_get(ws, SCC_WS_VERTICES, 2 * (size_t)nv * sizeof(scc_vec3));
+    if (!v) {
+        scc_ws_release(&tmp);
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    }
+    for (uint32_t i = 0; i < nv; ++i) {
+        v[i] = scc_v3(start[3 * i], start[3 * i + 1], start[3 * i + 2]);
+        v[nv + i] = scc_v3(end[3 * i], end[3 * i + 1], end[3 * i + 2]);
+    }
+    scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1 };
+    st = run_mesh(&q, &mm, ws, out_contacts, capacity, out_result, fn);
+    scc_ws_release(&tmp);
+    return st;
 }
 
 sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
@@ -351,27 +438,17 @@ sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotio
                                        const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
                                        sdfccd_QueryResult* out_result)
 {
-    static const char fn[] = "sdfccd_query_mesh_linear";
-    query_setup q;
+    return query_mesh_linear(NULL, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
+                             "sdfccd_query_mesh_linear");
+}
+
+sdfccd_Status sdfccd_query_mesh_linear_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                          sdfccd_MeshId mesh, const double* start, const double* end, double t0, double t1,
+                                          const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+                                          sdfccd_QueryResult* out_result)
+{
     sdfccd_Status st;
-    if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
-    if ((st = sdfccd__check_ptr(start, "sdfccd_query_mesh_linear: start")) || (st = sdfccd__check_ptr(end, "sdfccd_query_mesh_linear: end")))
-        return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
-    if (!m) return SDFCCD_INVALID_HANDLE;
-    uint32_t nv = m->mesh.vertex_count;
-    for (uint32_t i = 0; i < 3 * nv; ++i)
-        if (!(fabs(start[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE) || !(fabs(end[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE))
-            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i / 3);
-    size_t bytes = 2 * (size_t)nv * sizeof(scc_vec3);
-    scc_vec3* v = sdfccd__alloc(bytes);
-    if (!v) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
-    for (uint32_t i = 0; i < nv; ++i) {
-        v[i] = scc_v3(start[3 * i], start[3 * i + 1], start[3 * i + 2]);
-        v[nv + i] = scc_v3(end[3 * i], end[3 * i + 1], end[3 * i + 2]);
-    }
-    scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1 };
-    st = run_mesh(&q, &mm, out_contacts, capacity, out_result, fn);
-    sdfccd__free(v, bytes);
-    return st;
+    if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_mesh_linear_ws: workspace"))) return st;
+    return query_mesh_linear(workspace, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
+                             "sdfccd_query_mesh_linear_ws");
 }

@@ -191,6 +191,31 @@ SDFCCD_API sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd
     const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
     sdfccd_QueryResult* out_result);
 
+/** A reusable workspace for mesh queries: the scratch storage of the broad phase and the contact
+ * buffers, kept from call to call so that, after a first query of a given size, queries through
+ * it allocate nothing (a physics engine querying every pair every step should keep one per
+ * thread). A workspace may be used by one thread at a time; it holds no handle. */
+typedef struct sdfccd_Workspace sdfccd_Workspace;
+
+/** Creates an empty workspace (it grows on first use). */
+SDFCCD_API sdfccd_Status sdfccd_create_workspace(sdfccd_Workspace** out_workspace);
+/** Frees a workspace and its storage. NULL is a no-op. */
+SDFCCD_API void sdfccd_destroy_workspace(sdfccd_Workspace* workspace);
+/** Bytes the workspace holds (0 for NULL). */
+SDFCCD_API int64_t sdfccd_workspace_bytes(const sdfccd_Workspace* workspace);
+
+/** sdfccd_query_mesh with its scratch storage in `workspace` (not NULL); same results. */
+SDFCCD_API sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf,
+    const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh, const sdfccd_RigidMotion* motion, double t0, double t1,
+    const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+    sdfccd_QueryResult* out_result);
+
+/** sdfccd_query_mesh_linear with its scratch storage in `workspace` (not NULL); same results. */
+SDFCCD_API sdfccd_Status sdfccd_query_mesh_linear_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf,
+    const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh, const double* start, const double* end, double t0,
+    double t1, const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+    sdfccd_QueryResult* out_result);
+
 #ifdef __cplusplus
 }
 #endif

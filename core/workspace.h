@@ -1,0 +1,78 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: a reusable workspace for the mesh query (issue 9). The mesh query's scratch
+ * storage (contact buffer, broad-phase heap, segment table, tested-triangle bits, refit nodes,
+ * output staging) lives in slots that only grow, so a caller who keeps one workspace per thread
+ * allocates nothing after the first query of a given size. A query given no workspace uses a
+ * temporary one and frees it at the end (the allocations of a one-off call). */
+#ifndef SCC_WORKSPACE_H
+#define SCC_WORKSPACE_H
+
+#include <stddef.h>
+#include "alloc.h"
+
+enum {
+    SCC_WS_CONTACTS,  /* mesh query: contacts of the triangles within the TOI window */
+    SCC_WS_HEAP,      /* broad phase: earliest-candidate heap */
+    SCC_WS_SEGMENTS,  /* broad phase: time segments */
+    SCC_WS_TESTED,    /* broad phase: one bit per triangle */
+    SCC_WS_STACK,     /* broad phase (DCD): descent stack */
+    SCC_WS_MOVING,    /* broad phase: nodes refitted for linear motion */
+    SCC_WS_STAGING,   /* the ABI: contacts before conversion to the world frame */
+    SCC_WS_VERTICES,  /* the ABI: linear-motion vertex copies */
+    SCC_WS_SLOTS
+};
+
+typedef struct scc_ws_slot { void* p; size_t bytes; } scc_ws_slot;
+
+typedef struct scc_workspace {
+    const scc_allocator* alloc;
+    scc_ws_slot slot[SCC_WS_SLOTS];
+} scc_workspace;
+
+static inline void scc_ws_init(scc_workspace* ws, const scc_allocator* alloc)
+{
+    ws->alloc = alloc;
+    for (int i = 0; i < SCC_WS_SLOTS; ++i) {
+        ws->slot[i].p = NULL;
+        ws->slot[i].bytes = 0;
+    }
+}
+
+/* At least `bytes` of storage in `slot` (contents not kept when it grows); NULL on failure. */
+static inline void* scc_ws_get(scc_workspace* ws, int slot, size_t bytes)
+{
+    scc_ws_slot* s = &ws->slot[slot];
+    if (bytes <= s->bytes) return s->p;
+    size_t grown = s->bytes * 2 > bytes ? s->bytes * 2 : bytes;
+    void* p = scc_alloc(ws->alloc, grown);
+    if (!p) return NULL;
+    scc_free(ws->alloc, s->p, s->bytes);
+    s->p = p;
+    s->bytes = grown;
+    return p;
+}
+
+/* Hands a growable array (pointer and byte size, allocated with ws->alloc) back to a slot. */
+static inline void scc_ws_adopt(scc_workspace* ws, int slot, void* p, size_t bytes)
+{
+    ws->slot[slot].p = p;
+    ws->slot[slot].bytes = bytes;
+}
+
+static inline size_t scc_ws_bytes(const scc_workspace* ws)
+{
+    size_t n = 0;
+    for (int i = 0; i < SCC_WS_SLOTS; ++i) n += ws->slot[i].bytes;
+    return n;
+}
+
+static inline void scc_ws_release(scc_workspace* ws)
+{
+    for (int i = 0; i < SCC_WS_SLOTS; ++i) {
+        scc_free(ws->alloc, ws->slot[i].p, ws->slot[i].bytes);
+        ws->slot[i].p = NULL;
+        ws->slot[i].bytes = 0;
+    }
+}
+
+#endif
