@@ -216,6 +216,41 @@ SDFCCD_API sdfccd_Status sdfccd_query_mesh_linear_ws(sdfccd_Workspace* workspace
     double t1, const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
     sdfccd_QueryResult* out_result);
 
+/** Kinds of query in a batch (which fields of sdfccd_BatchQuery are read). */
+typedef enum sdfccd_BatchKind {
+    SDFCCD_BATCH_TRIANGLE = 0,     /**< sdfccd_query_triangle: `triangle` (3 local vertices), `motion`. */
+    SDFCCD_BATCH_TRIANGLE_LINEAR,  /**< sdfccd_query_triangle_linear: `triangle` (start), `triangle_end`. */
+    SDFCCD_BATCH_MESH,             /**< sdfccd_query_mesh: `mesh`, `motion`. */
+    SDFCCD_BATCH_MESH_LINEAR       /**< sdfccd_query_mesh_linear: `mesh`, `start`, `end`. */
+} sdfccd_BatchKind;
+
+/** One independent query of a batch: the arguments of the matching single query, and its status. */
+typedef struct sdfccd_BatchQuery {
+    sdfccd_BatchKind kind;
+    sdfccd_SdfId sdf;
+    const sdfccd_RigidMotion* sdf_motion;  /**< NULL: static SDF. */
+    sdfccd_MeshId mesh;                    /**< Mesh kinds. */
+    const sdfccd_Vec3* triangle;           /**< Triangle kinds: 3 vertices (local, or world start for linear). */
+    const sdfccd_Vec3* triangle_end;       /**< SDFCCD_BATCH_TRIANGLE_LINEAR: 3 world vertices at t1. */
+    const double* start;                   /**< SDFCCD_BATCH_MESH_LINEAR: 3 * vertex_count doubles at t0. */
+    const double* end;                     /**< SDFCCD_BATCH_MESH_LINEAR: 3 * vertex_count doubles at t1. */
+    const sdfccd_RigidMotion* motion;      /**< Rigid kinds. */
+    double t0, t1;
+    const sdfccd_QueryParams* params;
+    sdfccd_Contact* out_contacts;          /**< Each query needs its own output storage. */
+    int32_t capacity;
+    sdfccd_QueryResult* out_result;
+    sdfccd_Status status;                  /**< Out: the query's status. */
+} sdfccd_BatchQuery;
+
+/** Runs `count` independent queries on `threads` threads (the calling thread and threads - 1 POSIX
+ * threads started for the call, 1 <= threads <= 256; no busy-waiting). Results are bitwise
+ * identical to running the queries one by one, whatever the thread count. Every query's status
+ * is in its `status`; the return value is ::SDFCCD_OK when all succeeded, else the first failing
+ * query's status (with its message in sdfccd_last_error()). The queries' inputs may be shared
+ * (handles, params, motions) but not their outputs. */
+SDFCCD_API sdfccd_Status sdfccd_query_batch(sdfccd_BatchQuery* queries, int32_t count, int32_t threads);
+
 #ifdef __cplusplus
 }
 #endif
