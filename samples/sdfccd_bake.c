@@ -3,10 +3,11 @@
  *
  *   sdfccd_bake MESH -r N [-d "minx miny minz maxx maxy maxz" | --pad P] [--band W] [-t threads]
  *               [-i] [--allow-open] [--samples K] -o OUT.cdf
+ *   sdfccd_bake --version
  *
  * -r takes one count (N^3 cells) or three ("NX NY NZ" or NX,NY,NZ). Without -d the domain is
- * Discregrid's fitted box. Prints a progress bar when standard error is a terminal and a
- * summary: cells, nodes, bytes, build time, and the max / RMS error of the grid against the
+ * Discregrid's fitted box. Prints progress to standard error (a bar on a terminal, else a line
+ * per 10 %) and a summary: cells, nodes, bytes, build time, and the max / RMS error of the grid against the
  * exact mesh distance at K random points of the domain (default 20000).
  */
 #include <errno.h>
@@ -33,7 +34,8 @@ static void usage(FILE* f)
             "  -i            store -phi (positive inside), for containers\n"
             "  --allow-open  build even if the mesh is not closed (signs near holes are unreliable)\n"
             "  --samples K   random points for the error summary (default 20000, 0 to skip)\n"
-            "  -o OUT        output .cdf file\n");
+            "  -o OUT        output .cdf file\n"
+            "  --version     print the library version and configuration, then exit\n");
 }
 
 static int fail(const char* what, sdfccd_Status st)
@@ -61,16 +63,23 @@ static int parse_numbers(const char* s, double* out, int max)
 }
 
 static int s_tty = 0;
-static void progress(double f, void* user)
+static int s_last_tenth = -1; /* last 10 % step printed when stderr is not a terminal */
+static int32_t progress(double f, void* user)
 {
     (void)user;
-    if (!s_tty) return;
+    if (!s_tty) {
+        const int tenth = (int)floor(f * 10.0 + 1e-9);
+        while (s_last_tenth < tenth) fprintf(stderr, "  building: %d%%\n", 10 * ++s_last_tenth);
+        fflush(stderr);
+        return 0;
+    }
     const int width = 40, filled = (int)(f * width + 0.5);
     fprintf(stderr, "\r  building [");
     for (int i = 0; i < width; ++i) fputc(i < filled ? '#' : ' ', stderr);
     fprintf(stderr, "] %5.1f%%", 100.0 * f);
     if (f >= 1.0) fputc('\n', stderr);
     fflush(stderr);
+    return 0;
 }
 
 static double now(void)
@@ -89,6 +98,7 @@ int main(int argc, char** argv)
         const char* a = argv[i];
         const int has_next = i + 1 < argc;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) { usage(stdout); return 0; }
+        else if (!strcmp(a, "--version")) { printf("sdfccd_bake %s (%s)\n", sdfccd_version_string(), sdfccd_configuration_string()); return 0; }
         else if (!strcmp(a, "-r") && has_next) {
             double v[3];
             int n = parse_numbers(argv[++i], v, 3);

@@ -32,7 +32,15 @@ typedef struct runner {
     char dir[4096]; /* folder of the case file: relative paths resolve against it */
     sdfccd_Contact* contacts;
     int capacity;
+    int csv_header_printed; /* the CSV header goes out with the first result, never before an error */
 } runner;
+
+static void print_csv_header(runner* r)
+{
+    if (r->csv_header_printed) return;
+    printf("id,hit,toi,x,y,z,nx,ny,nz,triangles_tested,sdf_evals,micros\n");
+    r->csv_header_printed = 1;
+}
 
 static void usage(FILE* f)
 {
@@ -168,6 +176,7 @@ static int record_case(runner* r, int line, char** t, int n)
     m.linear_velocity = (sdfccd_Vec3){ v[8], v[9], v[10] };
     m.angular_velocity = (sdfccd_Vec3){ v[11], v[12], v[13] };
     sdfccd_QueryResult res;
+    print_csv_header(r);
     double t0 = now_micros();
     sdfccd_Status st = sdfccd_query_mesh(*sdf, NULL, *mesh, &m, 0.0, v[0], &r->params, r->contacts, r->capacity, &res);
     double micros = now_micros() - t0;
@@ -186,7 +195,6 @@ static int run_file(runner* r, FILE* f)
 {
     char buf[16384];
     int line = 0, header = 0, ok = 1;
-    printf("id,hit,toi,x,y,z,nx,ny,nz,triangles_tested,sdf_evals,micros\n");
     while (ok && fgets(buf, sizeof buf, f)) {
         ++line;
         if (!strchr(buf, '\n') && !feof(f)) return fail_line(r, line, "line too long", NULL);
@@ -212,6 +220,7 @@ static int run_file(runner* r, FILE* f)
         fflush(stdout);
     }
     if (ok && !header) return fail_line(r, line, "empty file (no 'sdfccd-cases 1' header)", NULL);
+    if (ok) print_csv_header(r); /* a file without cases still gives a (header-only) CSV */
     return ok;
 }
 

@@ -139,8 +139,8 @@ START_TEST(test_mesh_bad_inputs)
     ck_assert_int_eq(sdfccd_query_mesh(s, NULL, mesh, NULL, 0, DT, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
     sdfccd_MeshId as_mesh = { s.index1, s.generation }; /* an SDF handle is not a mesh */
     ck_assert_int_eq(sdfccd_query_mesh(s, NULL, as_mesh, &m, 0, DT, &p, NULL, 0, &r), SDFCCD_INVALID_HANDLE);
-    double start[12] = { 0 }, endp[12] = { 0 };
-    start[4] = NAN;
+    sdfccd_Vec3 start[4] = { { 0, 0, 0 } }, endp[4] = { { 0, 0, 0 } };
+    start[1].y = NAN;
     ck_assert_int_eq(sdfccd_query_mesh_linear(s, NULL, mesh, start, endp, 0, DT, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
     ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
     ck_assert_int_eq(sdfccd_query_mesh(s, NULL, stale, &m, 0, DT, &p, NULL, 0, &r), SDFCCD_INVALID_HANDLE);

@@ -68,12 +68,22 @@ START_TEST(test_sphere_convergence)
 END_TEST
 
 typedef struct progress_log { int calls; double last; int monotone; } progress_log;
-static void on_progress(double f, void* user)
+static int32_t on_progress(double f, void* user)
 {
     progress_log* p = user;
     if (f < p->last) p->monotone = 0;
     p->last = f;
     p->calls++;
+    return 0;
+}
+
+/* Cancels at the first report after `cancel_after` calls. */
+typedef struct cancel_log { int calls, cancel_after; double last; } cancel_log;
+static int32_t cancel_progress(double f, void* user)
+{
+    cancel_log* c = user;
+    c->last = f;
+    return ++c->calls > c->cancel_after;
 }
 
 /* 1 and 2 threads give bit-identical grids; progress rises to 1. */
@@ -106,6 +116,42 @@ START_TEST(test_threads_identical_and_progress)
     ck_assert_int_eq(sdfccd_destroy_sdf(a), SDFCCD_OK);
     ck_assert_int_eq(sdfccd_destroy_sdf(b), SDFCCD_OK);
     ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
+}
+END_TEST
+
+/* A progress callback that returns nonzero cancels the build: SDFCCD_CANCELLED, no handle, every
+ * byte freed (the memory fixture), on 1 and 2 threads, in the mesh and the SDF builders, dense and
+ * narrow band; the callback is not called again after it cancelled. */
+START_TEST(test_progress_cancels)
+{
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/torus_textured.obj");
+    sdfccd_SdfId sphere;
+    ck_assert_int_eq(sdfccd_create_sphere(0.5, &sphere), SDFCCD_OK);
+    for (int threads = 1; threads <= 2; ++threads)
+        for (int band = 0; band <= 1; ++band)
+            for (int after = 0; after <= 3; after += 3) {
+                sdfccd_GridDef def = sdfccd_default_grid_def();
+                def.resolution[0] = def.resolution[1] = def.resolution[2] = 24;
+                def.threads = threads;
+                def.band = band ? 0.05 : 0.0;
+                cancel_log c = { 0, after, -1.0 };
+                def.progress = cancel_progress;
+                def.progress_user = &c;
+                sdfccd_SdfId g = { 0, 0 };
+                ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &g), SDFCCD_CANCELLED);
+                ck_assert_uint_eq(g.index1, 0);
+                ck_assert_int_eq(c.calls, after + 1);
+                ck_assert(c.last < 1.0);
+                ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "cancelled"));
+                c.calls = 0;
+                def.fit_domain = 0;
+                def.domain = (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } };
+                ck_assert_int_eq(sdfccd_create_grid_from_sdf(sphere, &def, &g), SDFCCD_CANCELLED);
+                ck_assert_int_eq(c.calls, after + 1);
+            }
+    ck_assert_str_eq(sdfccd_status_string(SDFCCD_CANCELLED), "SDFCCD_CANCELLED");
+    sdfccd_destroy_sdf(sphere);
+    sdfccd_destroy_mesh(mesh);
 }
 END_TEST
 
@@ -665,6 +711,7 @@ int main(void)
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, test_sphere_convergence);
     tcase_add_test(tc, test_threads_identical_and_progress);
+    tcase_add_test(tc, test_progress_cancels);
     tcase_add_test(tc, test_narrow_band);
     tcase_add_test(tc, test_outside_domain);
     tcase_add_test(tc, test_lipschitz_bounds);

@@ -132,11 +132,11 @@ START_TEST(test_no_allocation_after_first_query)
     double* v = malloc(3 * (size_t)nv * sizeof *v);
     uint32_t* f = malloc(3 * (size_t)info.triangle_count * sizeof *f);
     ck_assert_int_eq(sdfccd_mesh_get_data(mesh, v, f), SDFCCD_OK);
-    double* s0 = malloc(3 * (size_t)nv * sizeof *s0);
-    double* s1 = malloc(3 * (size_t)nv * sizeof *s1);
+    sdfccd_Vec3* s0 = malloc((size_t)nv * sizeof *s0);
+    sdfccd_Vec3* s1 = malloc((size_t)nv * sizeof *s1);
     for (uint32_t i = 0; i < nv; ++i) {
-        s0[3 * i] = v[3 * i] + 0.2; s0[3 * i + 1] = v[3 * i + 1]; s0[3 * i + 2] = v[3 * i + 2];
-        s1[3 * i] = v[3 * i] + 0.1 + 0.3 * v[3 * i]; s1[3 * i + 1] = v[3 * i + 1]; s1[3 * i + 2] = v[3 * i + 2];
+        s0[i] = (sdfccd_Vec3){ v[3 * i] + 0.2, v[3 * i + 1], v[3 * i + 2] };
+        s1[i] = (sdfccd_Vec3){ v[3 * i] + 0.1 + 0.3 * v[3 * i], v[3 * i + 1], v[3 * i + 2] };
     }
     ck_assert_int_eq(sdfccd_query_mesh_linear_ws(ws, torus, NULL, mesh, s0, s1, 0.0, 1.0 / 60.0, &p, ca, 64, &ra), SDFCCD_OK);
     long before = cnt.allocs;

@@ -105,7 +105,7 @@ const char* sdfccd_status_string(sdfccd_Status status)
     static const char* const names[SDFCCD_STATUS_COUNT] = {
         "SDFCCD_OK", "SDFCCD_INVALID_ARGUMENT", "SDFCCD_INVALID_HANDLE", "SDFCCD_DEGENERATE",
         "SDFCCD_OUT_OF_MEMORY", "SDFCCD_IO_ERROR", "SDFCCD_FORMAT_ERROR", "SDFCCD_UNSUPPORTED",
-        "SDFCCD_BAD_STATE",
+        "SDFCCD_BAD_STATE", "SDFCCD_CANCELLED",
     };
     if ((int)status < 0 || status >= SDFCCD_STATUS_COUNT) return "SDFCCD_UNKNOWN_STATUS";
     return names[status];

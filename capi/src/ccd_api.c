@@ -397,7 +397,7 @@ sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf
 }
 
 static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
-                                       sdfccd_MeshId mesh, const double* start, const double* end, double t0, double t1,
+                                       sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
                                        const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
                                        sdfccd_QueryResult* out_result, const char* fn)
 {
@@ -412,9 +412,12 @@ static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId
     sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     uint32_t nv = m->mesh.vertex_count;
-    for (uint32_t i = 0; i < 3 * nv; ++i)
-        if (!(fabs(start[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE) || !(fabs(end[i]) <= SDFCCD_MAX_QUERY_MAGNITUDE))
-            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i / 3);
+    for (uint32_t i = 0; i < nv; ++i) {
+        const double c[6] = { start[i].x, start[i].y, start[i].z, end[i].x, end[i].y, end[i].z };
+        for (int k = 0; k < 6; ++k)
+            if (!(fabs(c[k]) <= SDFCCD_MAX_QUERY_MAGNITUDE))
+                return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i);
+    }
     scc_workspace tmp;
     scc_ws_init(&tmp, sdfccd__allocator());
     scc_workspace* ws = workspace ? &workspace->ws : &tmp;
@@ -424,8 +427,8 @@ static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId
         return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
     }
     for (uint32_t i = 0; i < nv; ++i) {
-        v[i] = scc_v3(start[3 * i], start[3 * i + 1], start[3 * i + 2]);
-        v[nv + i] = scc_v3(end[3 * i], end[3 * i + 1], end[3 * i + 2]);
+        v[i] = sdfccd__v(start[i]);
+        v[nv + i] = sdfccd__v(end[i]);
     }
     scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1 };
     st = run_mesh(&q, &mm, ws, out_contacts, capacity, out_result, fn);
@@ -434,7 +437,7 @@ static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId
 }
 
 sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
-                                       const double* start, const double* end, double t0, double t1,
+                                       const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
                                        const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
                                        sdfccd_QueryResult* out_result)
 {
@@ -443,7 +446,7 @@ sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotio
 }
 
 sdfccd_Status sdfccd_query_mesh_linear_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
-                                          sdfccd_MeshId mesh, const double* start, const double* end, double t0, double t1,
+                                          sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
                                           const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
                                           sdfccd_QueryResult* out_result)
 {

@@ -54,11 +54,13 @@ typedef struct pool_run {
     uint32_t count;
     atomic_uint next;
     atomic_uint done;
+    atomic_int stop;     /* set when the build is cancelled: no new tasks start */
 } pool_run;
 
 static void pool_work(pool_run* r)
 {
     for (;;) {
+        if (atomic_load(&r->stop)) return;
         const unsigned i = atomic_fetch_add(&r->next, 1u);
         if (i >= r->count) return;
         r->task(r->ctx, i);
@@ -93,10 +95,10 @@ void sdfccd__pool_init(sdfccd__pool* p, int threads, sdfccd_ProgressFcn* progres
 
 static void pool_report(sdfccd__pool* p, double f)
 {
-    if (!p->progress || f < p->last_reported) return;
+    if (!p->progress || p->cancelled || f < p->last_reported) return;
     if (f < 1.0 && f - p->last_reported < 0.005) return;
     p->last_reported = f;
-    p->progress(f, p->progress_user);
+    if (p->progress(f, p->progress_user) != 0) p->cancelled = 1;
 }
 
 int sdfccd__pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx)
@@ -109,6 +111,7 @@ int sdfccd__pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn
     r.count = count;
     atomic_init(&r.next, 0u);
     atomic_init(&r.done, 0u);
+    atomic_init(&r.stop, p->cancelled);
     int extra = p->threads - 1;
     if ((uint32_t)extra > count) extra = (int)count;
     pthread_t tids[256];
@@ -118,16 +121,17 @@ int sdfccd__pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn
         ++started;
     }
     /* The calling thread works too and is the only one that reports progress. */
-    for (;;) {
+    while (!p->cancelled) {
         const unsigned i = atomic_fetch_add(&r.next, 1u);
         if (i >= r.count) break;
         task(ctx, i);
         const unsigned done = atomic_fetch_add(&r.done, 1u) + 1u;
         if (count) pool_report(p, p->stage_base[st] + p->stage_weight[st] * (double)done / (double)count);
+        if (p->cancelled) atomic_store(&r.stop, 1);
     }
     for (int i = 0; i < started; ++i) pthread_join(tids[i], NULL);
     pool_report(p, st == SCC_GRID_STAGE_CELLS ? 1.0 : p->stage_base[st] + p->stage_weight[st]);
-    return 0;
+    return p->cancelled;
 }
 
 /* ---------------- defs ---------------- */
@@ -193,7 +197,7 @@ static sdfccd_Status build_status(scc_grid_build_status st, const char* fn)
     case SCC_GRID_BUILD_TOO_LARGE: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the grid needs more than 2^32 nodes", fn);
     case SCC_GRID_BUILD_EMPTY_BAND: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the band culled every cell (no surface inside the domain?)", fn);
     case SCC_GRID_BUILD_BAD_VALUE: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the source returned a non-finite value or one above 1e100 in magnitude at a node", fn);
-    case SCC_GRID_BUILD_CANCELLED: return sdfccd__error(SDFCCD_BAD_STATE, "%s: cancelled", fn);
+    case SCC_GRID_BUILD_CANCELLED: return sdfccd__error(SDFCCD_CANCELLED, "%s: cancelled by the progress callback", fn);
     }
     return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: unknown build failure", fn);
 }

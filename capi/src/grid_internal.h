@@ -21,6 +21,7 @@ typedef struct sdfccd__pool {
     void* progress_user;
     double stage_base[4], stage_weight[4]; /* progress mapping per stage (SCC_GRID_STAGE_*) */
     double last_reported;
+    int cancelled;       /* the progress callback asked to stop */
 } sdfccd__pool;
 void sdfccd__pool_init(sdfccd__pool* p, int threads, sdfccd_ProgressFcn* progress, void* user);
 int sdfccd__pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn* task, void* ctx);

@@ -46,6 +46,7 @@ typedef enum sdfccd_Status {
     SDFCCD_FORMAT_ERROR,       /**< A file was read but its content is invalid or truncated. */
     SDFCCD_UNSUPPORTED,        /**< A valid request this build or object cannot serve. */
     SDFCCD_BAD_STATE,          /**< The call is not allowed now (e.g. changing the allocator while memory is live). */
+    SDFCCD_CANCELLED,          /**< The caller cancelled the work (a progress callback returned nonzero). */
     SDFCCD_STATUS_COUNT
 } sdfccd_Status;
 

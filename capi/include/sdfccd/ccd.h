@@ -187,7 +187,7 @@ SDFCCD_API sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidM
 /** A deforming mesh: the mesh's topology with per-vertex world positions at t0 (`start`) and t1
  * (`end`), 3 * vertex_count doubles each, moving linearly. */
 SDFCCD_API sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
-    sdfccd_MeshId mesh, const double* start, const double* end, double t0, double t1,
+    sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
     const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
     sdfccd_QueryResult* out_result);
 
@@ -212,7 +212,7 @@ SDFCCD_API sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfcc
 
 /** sdfccd_query_mesh_linear with its scratch storage in `workspace` (not NULL); same results. */
 SDFCCD_API sdfccd_Status sdfccd_query_mesh_linear_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf,
-    const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh, const double* start, const double* end, double t0,
+    const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0,
     double t1, const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
     sdfccd_QueryResult* out_result);
 

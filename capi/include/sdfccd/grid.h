@@ -43,8 +43,9 @@ extern "C" {
 /** @name Building grids */
 
 /** Progress of a build: `fraction` in [0, 1], called from the calling thread only, at most about
- * 200 times per build. */
-typedef void sdfccd_ProgressFcn(double fraction, void* user);
+ * 200 times per build. Return 0 to go on, nonzero to cancel the build: it then stops soon (the
+ * tasks already running finish), frees everything and returns ::SDFCCD_CANCELLED. */
+typedef int32_t sdfccd_ProgressFcn(double fraction, void* user);
 
 /** How a grid is built. Initialise with sdfccd_default_grid_def(). */
 typedef struct sdfccd_GridDef {
