@@ -10,10 +10,10 @@ for m in fwgss certified dcd; do
   echo "== sdfccd_cases --method $m data/cases/example.cases"
   build/samples/sdfccd_cases --method "$m" data/cases/example.cases
 done
-echo "== full evaluation: sdfccd_bench report build/report (about 4 minutes; progress on stderr)"
+echo "== full evaluation: scripts/bench_report.sh build/report (each sdfccd_bench experiment to CSV, then sdfccd_bench_report)"
 # Reuse the committed data set and certified ground truth (recomputing them adds ~4 minutes).
 mkdir -p build/report
 cp -r samples/report/dataset build/report/
-build/samples/sdfccd_bench report build/report
+bash scripts/bench_report.sh build/report --build build
 echo "report: build/report/report.md (chart: build/report/speed_accuracy.png); the committed full run is samples/report/report.md"
 

@@ -1,0 +1,377 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd_bench_report: turns the CSV tables of sdfccd_bench's experiments (one file per
+ * experiment, NAME.csv, in one directory) into DIR/report.md, and the speed-versus-accuracy chart
+ * into DIR/speed_accuracy.png with gnuplot when it is installed. A missing table skips its section.
+ *   sdfccd_bench_report DIR
+ * No library calls: the experiments measured everything; this step only formats. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------ a small CSV table */
+
+typedef struct table {
+    int cols, rows;
+    char** head;
+    char*** cell; /* rows x cols */
+} table;
+
+static int split(char* line, char** out, int max)
+{
+    int n = 0;
+    line[strcspn(line, "\r\n")] = 0;
+    char* p = line;
+    while (n < max) {
+        out[n++] = p;
+        char* c = strchr(p, ',');
+        if (!c) break;
+        *c = 0;
+        p = c + 1;
+    }
+    return n;
+}
+
+static int load(const char* dir, const char* name, table* t)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s.csv", dir, name);
+    memset(t, 0, sizeof *t);
+    FILE* f = fopen(path, "r");
+    if (!f) return 0;
+    char line[4096];
+    char* tmp[64];
+    int cap = 0;
+    while (fgets(line, sizeof line, f)) {
+        if (line[0] == '#') continue;
+        int n = split(line, tmp, 64);
+        char** row = calloc(64, sizeof *row);
+        for (int i = 0; i < n; ++i) row[i] = strdup(tmp[i]);
+        for (int i = n; i < 64; ++i) row[i] = strdup("");
+        if (!t->head) {
+            t->head = row;
+            t->cols = n;
+            continue;
+        }
+        if (t->rows == cap) {
+            cap = cap ? 2 * cap : 256;
+            t->cell = realloc(t->cell, (size_t)cap * sizeof *t->cell);
+        }
+        t->cell[t->rows++] = row;
+    }
+    fclose(f);
+    return t->head != NULL && t->rows > 0;
+}
+
+static int col(const table* t, const char* name)
+{
+    for (int i = 0; i < t->cols; ++i)
+        if (!strcmp(t->head[i], name)) return i;
+    fprintf(stderr, "sdfccd_bench_report: no column %s\n", name);
+    exit(1);
+}
+static const char* S(const table* t, int r, const char* name) { return t->cell[r][col(t, name)]; }
+static double D(const table* t, int r, const char* name) { const char* s = S(t, r, name); return *s ? strtod(s, NULL) : NAN; }
+
+static int cmp_double(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return x < y ? -1 : (x > y);
+}
+static double median(double* v, int n)
+{
+    if (n == 0) return NAN;
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+#define TOI_TOL 1e-6 /* s: later than the certified bracket by more is a false negative */
+
+/* ------------------------------------------------------------------ sections */
+
+/* Accuracy of one method on one mesh ("" = both): false negatives/positives, |dTOI| (0 inside the bracket). */
+typedef struct acc { int n, fn, fp, both; double mean_abs, min, max, med, mean_us, evals; } acc;
+
+static acc accuracy_of(const table* t, const char* method, const char* mesh)
+{
+    acc a;
+    memset(&a, 0, sizeof a);
+    double* d = malloc((size_t)t->rows * sizeof *d);
+    a.min = INFINITY;
+    a.max = -INFINITY;
+    for (int r = 0; r < t->rows; ++r) {
+        if (strcmp(S(t, r, "method"), method) || (*mesh && strcmp(S(t, r, "mesh"), mesh))) continue;
+        int hit = (int)D(t, r, "hit"), gt = (int)D(t, r, "gt_hit");
+        double toi = D(t, r, "toi"), lo = D(t, r, "gt_lower"), hi = D(t, r, "gt_toi");
+        a.n++;
+        a.mean_us += D(t, r, "micros");
+        a.evals += D(t, r, "sdf_evals");
+        if (gt && (!hit || toi > hi + TOI_TOL)) a.fn++;
+        if (hit && (!gt || toi < lo - TOI_TOL)) a.fp++;
+        if (gt && hit) {
+            double x = toi - hi;
+            if (x < 0 && toi >= lo) x = 0;
+            d[a.both++] = x;
+            a.mean_abs += fabs(x);
+            a.min = fmin(a.min, x);
+            a.max = fmax(a.max, x);
+        }
+    }
+    if (a.both) a.mean_abs /= a.both;
+    a.med = median(d, a.both);
+    if (a.n) { a.mean_us /= a.n; a.evals /= a.n; }
+    free(d);
+    return a;
+}
+
+static void section_accuracy(FILE* md, const table* t)
+{
+    fprintf(md, "## 2. Accuracy (Tables 1 and 2)\n\n");
+    fprintf(md, "Against the certified ground truth, each method through `sdfccd_query_mesh` (broad phase on, as in the paper). "
+                "ΔTOI = method TOI − certified TOI (0 inside the certified bracket). **False negative**: no contact, or a TOI more than "
+                "1 µs after the bracket; **false positive**: a contact more than 1 µs before the certified lower bound. Times are single "
+                "runs on a shared machine (the `targets` table below has repeats). FWGSS-baseline: the previous defaults "
+                "(golden-section entry search, fixed spatial tolerance, no clear proof); FWGSS-paper: vertex trace 0, restarts 0.\n\n");
+    fprintf(md, "| method | mesh | cases | false neg. | false pos. | mean \\|ΔTOI\\| (s) | ΔTOI min | ΔTOI median | ΔTOI max | µs/query | SDF evals/query |\n");
+    fprintf(md, "|---|---|---|---|---|---|---|---|---|---|---|\n");
+    const char* methods[6] = { "DCD", "FW", "FWGSS", "FWGSS+subdivision", "FWGSS-baseline", "FWGSS-paper" };
+    const char* meshes[3] = { "triangle", "shuriken", "" };
+    for (int m = 0; m < 6; ++m)
+        for (int k = 0; k < 3; ++k) {
+            acc a = accuracy_of(t, methods[m], meshes[k]);
+            if (!a.n) continue;
+            fprintf(md, "| %s | %s | %d | %d (%.2f%%) | %d (%.2f%%) | %.3g | %+.2e | %+.2e | %+.2e | %.1f | %.0f |\n", methods[m], *meshes[k] ? meshes[k] : "all",
+                    a.n, a.fn, 100.0 * a.fn / a.n, a.fp, 100.0 * a.fp / a.n, a.mean_abs, a.min, a.med, a.max, a.mean_us, a.evals);
+        }
+    fprintf(md, "\nThe paper's FWGSS (Table 1, row All, against its brute-force ground truth): about 0.94%% false negatives and 0.98%% "
+                "false positives counted per triangle in contact, mean ΔTOI +6.09e-7 s. Per-case rows: `accuracy.csv`.\n\n");
+}
+
+static void section_front(FILE* md, const char* dir, const table* t)
+{
+    fprintf(md, "## 3. Speed versus accuracy\n\n");
+    fprintf(md, "On the first %s cases of the data set (both meshes): DCD, FW and the paper's FWGSS with the Frank-Wolfe cap 2..64 "
+                "(twice as many line-search iterations); today's FWGSS with restarts 0..2 and vertex trace 0..64 at the default caps; "
+                "the three FWGSS configurations as single points (defaults, previous defaults, the paper's: vertex trace 0, restarts 0); "
+                "certified with bracket widths 1e-3..1e-6 s. Log axes; a zero rate is drawn at the floor.\n\n",
+            S(t, 0, "cases"));
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && gnuplot -e \""
+             "set datafile separator ','; set terminal pngcairo size 1400,560 noenhanced font 'sans,11'; "
+             "set output 'speed_accuracy.png'; set multiplot layout 1,2; "
+             "set logscale xy; set grid; set key top right; set xlabel 'mean time per query (us)'; "
+             "set ylabel 'false-negative rate (floor 1e-4)'; set title 'speed vs misses'; "
+             "plot for [m in 'DCD FW FWGSS-paper FWGSS Certified FWGSS-defaults FWGSS-previous-defaults FWGSS-paper-config'] 'front.csv' "
+             "using (strcol(1) eq m ? \\$4 : 1/0):(\\$5 > 1e-4 ? \\$5 : 1e-4) with linespoints pointsize 1.5 title m; "
+             "set ylabel 'mean |dTOI| (s, floor 1e-10)'; set title 'speed vs TOI error'; "
+             "plot for [m in 'DCD FW FWGSS-paper FWGSS Certified FWGSS-defaults FWGSS-previous-defaults FWGSS-paper-config'] 'front.csv' "
+             "using (strcol(1) eq m ? \\$4 : 1/0):(\\$7 > 1e-10 ? \\$7 : 1e-10) with linespoints pointsize 1.5 title m; unset multiplot\" 2>&1",
+             dir);
+    int gp = system(cmd);
+    fprintf(md, "![speed versus accuracy](speed_accuracy.png)\n\n%s", gp == 0 ? "" : "(gnuplot failed or is missing: no chart.)\n\n");
+    fprintf(md, "| method | setting | µs/query | false-negative rate | false-positive rate | mean \\|ΔTOI\\| (s) | SDF evals/query |\n|---|---|---|---|---|---|---|\n");
+    for (int r = 0; r < t->rows; ++r)
+        if (!strncmp(S(t, r, "method"), "FWGSS", 5))
+            fprintf(md, "| %s | %s | %.1f | %.4f | %.4f | %.3g | %.0f |\n", S(t, r, "method"), S(t, r, "setting"), D(t, r, "mean_us"),
+                    D(t, r, "fn_rate"), D(t, r, "fp_rate"), D(t, r, "mean_abs_dtoi"), D(t, r, "sdf_evals"));
+    fprintf(md, "\nEvery point: `front.csv`.\n\n");
+}
+
+static void section_targets(FILE* md, const table* t)
+{
+    fprintf(md, "## 1. Issue 9 targets: FWGSS speed at the same accuracy\n\n");
+    fprintf(md, "Mesh query (`sdfccd_query_mesh_ws`), broad phase on, subdivision off; every configuration on every case, interleaved in "
+                "one process; per case the fastest of %s repeats, then the mean over cases. `new` = today's defaults; `baseline` = the "
+                "previous defaults' parameters (golden-section entry search, distance tolerance 1e-7 m, no clear proof) — the "
+                "closed-form motion and the interior spatial step are in both, so the baseline is already faster than the code before "
+                "issue 9 (see the closing note for before/after against that code); `paper` = vertex trace 0, restarts 0.\n\n",
+            S(t, 0, "repeats"));
+    fprintf(md, "| scene | config | cases | mean µs/query | median µs | SDF evals/query | false neg. | false pos. | mean \\|ΔTOI\\| (s) |\n|---|---|---|---|---|---|---|---|---|\n");
+    for (int r = 0; r < t->rows; ++r)
+        fprintf(md, "| %s | %s | %s | %.2f | %.2f | %.1f | %s | %s | %s |\n", S(t, r, "scene"), S(t, r, "config"), S(t, r, "cases"),
+                D(t, r, "mean_us"), D(t, r, "median_us"), D(t, r, "sdf_evals_per_query"), *S(t, r, "fn") ? S(t, r, "fn") : "n/a",
+                *S(t, r, "fp") ? S(t, r, "fp") : "n/a", *S(t, r, "mean_abs_dtoi") ? S(t, r, "mean_abs_dtoi") : "n/a");
+    fprintf(md, "\nThe grid scene has no ground truth of its own (the 32³ grid only approximates the torus), so no accuracy columns. "
+                "CSV: `targets.csv`.\n\n");
+    /* targets table */
+    double tri_us = NAN, tri_ev = NAN, shu_us = NAN, grid_us = NAN;
+    for (int r = 0; r < t->rows; ++r) {
+        if (strcmp(S(t, r, "config"), "new")) continue;
+        if (!strcmp(S(t, r, "scene"), "triangle")) { tri_us = D(t, r, "mean_us"); tri_ev = D(t, r, "sdf_evals_per_query"); }
+        if (!strcmp(S(t, r, "scene"), "shuriken")) shu_us = D(t, r, "mean_us");
+        if (!strcmp(S(t, r, "scene"), "triangle-grid32")) grid_us = D(t, r, "mean_us");
+    }
+    fprintf(md, "| target | measured | met |\n|---|---|---|\n");
+    fprintf(md, "| single triangle <= 8 µs | %.2f µs | %s |\n", tri_us, tri_us <= 8 ? "yes" : "**no**");
+    fprintf(md, "| single triangle <= 200 SDF evaluations | %.0f | %s |\n", tri_ev, tri_ev <= 200 ? "yes" : "**no**");
+    fprintf(md, "| shuriken <= 400 µs | %.1f µs | %s |\n", shu_us, shu_us <= 400 ? "yes" : "**no**");
+    fprintf(md, "| triangle vs 32³ torus grid <= 25 µs | %.2f µs | %s |\n\n", grid_us, grid_us <= 25 ? "yes" : "**no**");
+}
+
+static double median_total(const table* t, const char* tris, const char* method, const char* bp, int* n_out)
+{
+    double v[64];
+    int n = 0;
+    for (int r = 0; r < t->rows && n < 64; ++r)
+        if (!strcmp(S(t, r, "triangles"), tris) && !strcmp(S(t, r, "method"), method) && !strcmp(S(t, r, "broad_phase"), bp))
+            v[n++] = D(t, r, "total_ms");
+    if (n_out) *n_out = n;
+    return median(v, n);
+}
+
+static void section_scaling(FILE* md, const table* t)
+{
+    fprintf(md, "## 4. Scaling (Table 3)\n\n");
+    fprintf(md, "The armadillo (`data/libigl-tutorial-data/armadillo.obj`) decimated with meshoptimizer to about 1K and 10K triangles, "
+                "and to 25K then split 1-to-4 for 100K, falls (2 m/s, gravity, slow spin, 1/60 s steps) onto the spike grid "
+                "(20 × 20 cones, 10 cm apart, 10 cm tall; analytic, 1-Lipschitz) until the first step with a contact. Total = query "
+                "time summed over the steps (median of the repeats, configurations interleaved). Certified = the certified bracket of "
+                "the same scene (one run); ΔTOI = TOI − certified upper bound (0 inside the bracket).\n\n");
+    fprintf(md, "| Triangles | Method | Broad phase | Total (ms) | steps | TOI (s) | certified [lower, upper] (s) | ΔTOI (s) | tested | SDF evals |\n");
+    fprintf(md, "|---|---|---|---|---|---|---|---|---|---|\n");
+    const char* seen[8];
+    int ns = 0;
+    for (int r = 0; r < t->rows; ++r) {
+        int dup = 0;
+        for (int k = 0; k < ns; ++k) dup |= !strcmp(seen[k], S(t, r, "triangles"));
+        if (!dup && ns < 8) seen[ns++] = S(t, r, "triangles");
+    }
+    const char* methods[5] = { "Certified", "DCD", "FWGSS", "FWGSS-baseline", "FWGSS-paper" };
+    for (int L = 0; L < ns; ++L) {
+        double clo = NAN, chi = NAN;
+        for (int r = 0; r < t->rows; ++r)
+            if (!strcmp(S(t, r, "triangles"), seen[L]) && !strcmp(S(t, r, "method"), "Certified")) { clo = D(t, r, "toi_lower"); chi = D(t, r, "toi"); }
+        for (int bp = 1; bp >= 0; --bp)
+            for (int m = 0; m < 5; ++m) {
+                const char* bps = bp ? "1" : "0";
+                int n = 0;
+                double med = median_total(t, seen[L], methods[m], bps, &n);
+                if (!n) continue;
+                int r0 = -1;
+                for (int r = 0; r < t->rows && r0 < 0; ++r)
+                    if (!strcmp(S(t, r, "triangles"), seen[L]) && !strcmp(S(t, r, "method"), methods[m]) && !strcmp(S(t, r, "broad_phase"), bps)) r0 = r;
+                double toi = D(t, r0, "toi"), d = toi - chi;
+                if (d < 0 && toi >= clo) d = 0;
+                char dt[48];
+                if (!strcmp(methods[m], "DCD")) snprintf(dt, sizeof dt, "(end pose)");
+                else if (!strcmp(methods[m], "Certified")) snprintf(dt, sizeof dt, "reference");
+                else snprintf(dt, sizeof dt, "%+.3g%s", d, d <= 1e-6 && toi >= clo - 1e-6 ? "" : " **(> 1 µs)**");
+                fprintf(md, "| %s | %s | %s | %.2f | %s | %.9f | [%.9f, %.9f] | %s | %s | %s |\n", seen[L], methods[m], bp ? "BSH" : "none", med,
+                        S(t, r0, "steps"), toi, clo, chi, dt, S(t, r0, "tested"), S(t, r0, "sdf_evals"));
+            }
+    }
+    fprintf(md, "\nRatios (median total DCD / median total FWGSS, broad phase on, same run):\n\n| Triangles | DCD/FWGSS | DCD/FWGSS-baseline | DCD/FWGSS-paper |\n|---|---|---|---|\n");
+    for (int L = 0; L < ns; ++L) {
+        double dcd = median_total(t, seen[L], "DCD", "1", NULL);
+        fprintf(md, "| %s | %.2fx | %.2fx | %.2fx |\n", seen[L], dcd / median_total(t, seen[L], "FWGSS", "1", NULL),
+                dcd / median_total(t, seen[L], "FWGSS-baseline", "1", NULL), dcd / median_total(t, seen[L], "FWGSS-paper", "1", NULL));
+    }
+    fprintf(md, "\nThe paper reports FWGSS+BSH 3.5× faster than DCD+BSH at 100K (86.85 ms against 306.66 ms, 0.96 µs per tested "
+                "triangle, so some 90,000 narrow-phase tests). Here the hierarchy is tight (one triangle per leaf, padded only by the "
+                "motion's curvature), so only the few triangles that really reach a spike are tested, and those are the hard ones; "
+                "DCD pays a Frank-Wolfe descent per touching triangle at the end pose only, FWGSS a search over the whole step. "
+                "CSV: `scaling.csv` (every repeat).\n\n");
+}
+
+static void section_cost(FILE* md, const table* t)
+{
+    fprintf(md, "## 5. Cost per SDF evaluation\n\n");
+    fprintf(md, "Measured differentially through the public ABI: the torus as a user SDF that evaluates the field once or five times "
+                "per call; the extra time per extra evaluation is the field's cost, the rest is the motion (closed-form rigid motion, "
+                "cached sine and cosine), the solver and the dispatch. The last column uses the built-in torus.\n\n");
+    fprintf(md, "| mesh | SDF evals/query | ns per evaluation | field (ns) | motion + solver + dispatch (ns) | built-in torus (ns per evaluation) |\n|---|---|---|---|---|---|\n");
+    for (int r = 0; r < t->rows; ++r)
+        fprintf(md, "| %s | %.0f | %.1f | %.1f | %.1f | %.1f |\n", S(t, r, "mesh"), D(t, r, "evals_per_query"), D(t, r, "ns_per_evaluation"),
+                D(t, r, "ns_field"), D(t, r, "ns_motion_solver_dispatch"), D(t, r, "ns_per_evaluation_builtin_torus"));
+    fprintf(md, "\nThe shuriken's cost per evaluation includes the broad phase's sphere marching and the per-triangle setup. CSV: `cost.csv`.\n\n");
+}
+
+static void section_batch(FILE* md, const table* t)
+{
+    double one[64], many[64];
+    int n1 = 0, nm = 0, same = 1, th = 1;
+    for (int r = 0; r < t->rows && n1 < 64 && nm < 64; ++r) {
+        int k = (int)D(t, r, "threads");
+        same &= (int)D(t, r, "identical");
+        if (k == 1) one[n1++] = D(t, r, "wall_ms");
+        else { many[nm++] = D(t, r, "wall_ms"); th = k; }
+    }
+    double a = median(one, n1), b = median(many, nm);
+    fprintf(md, "## 6. Batches on several threads\n\n");
+    fprintf(md, "The data set's %s mesh queries as one `sdfccd_query_batch`, on 1 and on %d threads, alternating, %d repeats each "
+                "(median wall time). Results identical to the single-thread batch bit for bit: %s. The machine is shared: the "
+                "ratio is only meaningful when the other cores are idle.\n\n",
+            S(t, 0, "queries"), th, n1, same ? "yes" : "**no**");
+    fprintf(md, "| threads | median wall (ms) | speed-up |\n|---|---|---|\n| 1 | %.1f | 1.00x |\n| %d | %.1f | %.2fx |\n\n", a, th, b, a / b);
+}
+
+static void section_dataset(FILE* md, const table* t, const table* brute)
+{
+    fprintf(md, "## 7. Data set (Section 5.2) and ground truth\n\n");
+    fprintf(md, "- SDF: analytic torus, major radius 10 cm, minor radius 5 cm. Meshes: one equilateral triangle (about 10 cm) and a "
+                "procedural shuriken (%s triangles). Seed %s; configurations start 25-40 cm from the centre, aimed within 12 cm of it, "
+                "arriving within 0.5-1 step of 1/60 s, spinning up to 120 rad/s; kept when the certified method finds a contact.\n",
+            S(t, 1, "triangles"), S(t, 0, "seed"));
+    for (int r = 0; r < t->rows; ++r)
+        fprintf(md, "- %s: %s cases, certified ground truth %s regions and %.1f ms per case on average.\n", S(t, r, "mesh"), S(t, r, "cases"),
+                S(t, r, "mean_regions"), D(t, r, "mean_ground_truth_ms"));
+    fprintf(md, "- Files: `dataset/cases.txt` (case file v1, run one with `sdfccd_cases`), `dataset/ground_truth.csv`.\n\n");
+    if (brute) {
+        int n = 0, missed = 0, earlier = 0, far = 0;
+        for (int r = 0; r < brute->rows; ++r) {
+            double bf = D(brute, r, "brute_force_toi");
+            n++;
+            if (!isfinite(bf)) { missed++; continue; }
+            if (bf < D(brute, r, "certified_lower") - 1e-9) earlier++;
+            if (fabs(D(brute, r, "difference")) > 1e-6) far++;
+        }
+        fprintf(md, "Brute force (the paper's: 1 µs steps, DCD, then bracketing) on the first %d cases: found nothing %d times, "
+                    "earlier than the certified lower bound %d times (a certified miss would show here), more than 1 µs from the "
+                    "bracket %d times. CSV: `brute.csv`.\n\n",
+                n, missed, earlier, far);
+    }
+}
+
+int main(int argc, char** argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: %s DIR (with the experiments' NAME.csv files; writes DIR/report.md)\n", argv[0]);
+        return 2;
+    }
+    const char* dir = argv[1];
+    char path[1024];
+    snprintf(path, sizeof path, "%s/report.md", dir);
+    FILE* md = fopen(path, "w");
+    if (!md) {
+        perror(path);
+        return 1;
+    }
+    fprintf(md, "# sdfccd evaluation report\n\n");
+    fprintf(md, "Generated by `scripts/bench_report.sh` (each experiment `sdfccd_bench NAME > NAME.csv`, then "
+                "`sdfccd_bench_report DIR`). Re-creates the experiments of Section 5 of Pelletier-Guenette et al., *Real-Time "
+                "Triangle-SDF Continuous Collision Detection* (SCA 2025) against a certified ground truth. Accuracy figures are "
+                "deterministic (seeded); timings depend on the machine and its load.\n\n");
+    snprintf(path, sizeof path, "%s/machine.txt", dir);
+    FILE* mf = fopen(path, "r");
+    if (mf) {
+        char line[512];
+        while (fgets(line, sizeof line, mf)) fprintf(md, "- %s", line);
+        fclose(mf);
+        fprintf(md, "\n");
+    }
+    table t, b;
+    if (load(dir, "targets", &t)) section_targets(md, &t);
+    if (load(dir, "accuracy", &t)) section_accuracy(md, &t);
+    if (load(dir, "front", &t)) section_front(md, dir, &t);
+    if (load(dir, "scaling", &t)) section_scaling(md, &t);
+    if (load(dir, "cost", &t)) section_cost(md, &t);
+    if (load(dir, "batch", &t)) section_batch(md, &t);
+    int have_brute = load(dir, "brute", &b);
+    if (load(dir, "dataset", &t)) section_dataset(md, &t, have_brute ? &b : NULL);
+    fprintf(md, "## 8. Peers\n\nGImpact and FCL on the same cases: `sdfccd_peers` (needs the Bullet bridge and FCL), CSV `peers_cases.csv` "
+                "when present.\n");
+    fclose(md);
+    return 0;
+}

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The evaluation report: runs every sdfccd_bench experiment into OUTDIR/NAME.csv, then
+# sdfccd_bench_report OUTDIR writes OUTDIR/report.md (and the chart, with gnuplot).
+#   scripts/bench_report.sh OUTDIR [--quick|--smoke] [--build BUILDDIR] [--only "name ..."]
+# The data set and its certified ground truth are read from OUTDIR/dataset when present (copy
+# samples/report/dataset there to skip the ~4 minutes of ground truth), else computed there.
+# Every experiment interleaves the previous FWGSS defaults (--baseline) so ratios come from one run.
+set -euo pipefail
+out=${1:?usage: bench_report.sh OUTDIR [--quick|--smoke] [--build BUILDDIR] [--only "names"]}
+shift
+mode=""
+build="$(cd "$(dirname "$0")/.." && pwd)/build"
+only="dataset brute accuracy front targets scaling batch cost"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --quick|--smoke) mode="$1" ;;
+    --build) build="$2"; shift ;;
+    --only) only="$2"; shift ;;
+    *) echo "bench_report.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+  shift
+done
+bench="$build/samples/sdfccd_bench"
+mkdir -p "$out"
+{
+  echo "Machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'), $(nproc) logical CPUs, $(uname -sr); shared with other users: compare ratios from one run"
+  echo "Commit: $(git -C "$(dirname "$0")/.." rev-parse --short=12 HEAD 2>/dev/null || echo unknown)$(git -C "$(dirname "$0")/.." status --porcelain --untracked-files=no 2>/dev/null | grep -q . && echo ' (with uncommitted changes)'); date $(date -u '+%Y-%m-%d %H:%M UTC'); mode ${mode:-full}"
+} > "$out/machine.txt"
+for e in $only; do
+  echo "== sdfccd_bench $e $mode --baseline" >&2
+  "$bench" "$e" --dataset "$out/dataset" $mode --baseline > "$out/$e.csv.tmp"
+  mv "$out/$e.csv.tmp" "$out/$e.csv"
+done
+"$build/samples/sdfccd_bench_report" "$out"
+echo "report: $out/report.md" >&2
