@@ -33,8 +33,15 @@ static sdfccd_MeshId box_mesh(double h)
 typedef struct inputs {
     sdfccd_RigidMotion motion[N];
     sdfccd_Vec3 tri[N][3], tri_end[N][3];
-    double start[N][24], end[N][24];
+    sdfccd_Vec3 start[N][8], end[N][8];
 } inputs;
+
+static void set_coord(sdfccd_Vec3* v, int c, double x)
+{
+    if (c == 0) v->x = x;
+    else if (c == 1) v->y = x;
+    else v->z = x;
+}
 
 static void make_inputs(inputs* in)
 {
@@ -64,8 +71,8 @@ static void make_inputs(inputs* in)
                 double x = ((v >> c) & 1) ? 0.03 : -0.03;
                 double p0 = c == 0 ? m.pose.position.x : (c == 1 ? m.pose.position.y : m.pose.position.z);
                 double a = c == 0 ? aim.x : (c == 1 ? aim.y : aim.z);
-                in->start[i][3 * v + c] = p0 + x;
-                in->end[i][3 * v + c] = 0.08 * a + 1.2 * x;
+                set_coord(&in->start[i][v], c, p0 + x);
+                set_coord(&in->end[i][v], c, 0.08 * a + 1.2 * x);
             }
     }
 }

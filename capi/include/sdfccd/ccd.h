@@ -232,8 +232,8 @@ typedef struct sdfccd_BatchQuery {
     sdfccd_MeshId mesh;                    /**< Mesh kinds. */
     const sdfccd_Vec3* triangle;           /**< Triangle kinds: 3 vertices (local, or world start for linear). */
     const sdfccd_Vec3* triangle_end;       /**< SDFCCD_BATCH_TRIANGLE_LINEAR: 3 world vertices at t1. */
-    const double* start;                   /**< SDFCCD_BATCH_MESH_LINEAR: 3 * vertex_count doubles at t0. */
-    const double* end;                     /**< SDFCCD_BATCH_MESH_LINEAR: 3 * vertex_count doubles at t1. */
+    const sdfccd_Vec3* start;              /**< SDFCCD_BATCH_MESH_LINEAR: vertex_count world positions at t0. */
+    const sdfccd_Vec3* end;                /**< SDFCCD_BATCH_MESH_LINEAR: vertex_count world positions at t1. */
     const sdfccd_RigidMotion* motion;      /**< Rigid kinds. */
     double t0, t1;
     const sdfccd_QueryParams* params;
