@@ -7,6 +7,13 @@ function(sdfccd_target_defaults target)
       $<$<COMPILE_LANGUAGE:C>:-Wall -Wextra -Wshadow -Wno-unused-parameter>
       $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wno-unused-parameter>)
   endif()
+  if(SDFCCD_FUZZ)
+    # libFuzzer build: coverage instrumentation plus ASan and UBSan in every library target.
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+    if(_type STREQUAL "STATIC_LIBRARY")
+      target_link_options(${target} INTERFACE -fsanitize=address,undefined)
+    endif()
+  endif()
   if(SDFCCD_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
     if(_type STREQUAL "STATIC_LIBRARY")

@@ -104,7 +104,8 @@ typedef enum scc_grid_status {
     SCC_GRID_OUT_OF_MEMORY,
     SCC_GRID_EMPTY,           /* field 0 has no cell with values */
     SCC_GRID_CANCELLED,       /* parallel_for reported a cancel */
-    SCC_GRID_TOO_LARGE        /* more than 2^31 - 1 cells */
+    SCC_GRID_TOO_LARGE,       /* more than 2^31 - 1 cells */
+    SCC_GRID_STEEP            /* a cell's gradient bound overflows (values huge for the cell size) */
 } scc_grid_status;
 
 /* Computes the derived data of field 0 (grid_bounds.c): adopts the vertex-block layout for a

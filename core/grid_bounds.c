@@ -162,6 +162,7 @@ static scc_grid_status count_valued_cells(scc_grid* g)
         g->valued_cells++;
         if (g->cell_lipschitz[c] > g->lipschitz_max) g->lipschitz_max = g->cell_lipschitz[c];
     }
+    if (!isfinite(g->lipschitz_max)) return SCC_GRID_STEEP; /* per-cell bounds are floats: > 3.4e38 is inf */
     return g->valued_cells == 0 ? SCC_GRID_EMPTY : SCC_GRID_OK;
 }
 

@@ -228,6 +228,7 @@ scc_grid_build_status scc_grid_build(const scc_allocator* a, const scc_grid_buil
     case SCC_GRID_CANCELLED: scc_grid_destroy(g); return SCC_GRID_BUILD_CANCELLED;
     case SCC_GRID_EMPTY: scc_grid_destroy(g); return SCC_GRID_BUILD_EMPTY_BAND;
     case SCC_GRID_TOO_LARGE: scc_grid_destroy(g); return SCC_GRID_BUILD_TOO_LARGE;
+    case SCC_GRID_STEEP: scc_grid_destroy(g); return SCC_GRID_BUILD_BAD_VALUE;
     default: scc_grid_destroy(g); return SCC_GRID_BUILD_OUT_OF_MEMORY;
     }
     *out_grid = g;

@@ -5,7 +5,8 @@
  *
  * Output header: id,hit,toi,x,y,z,nx,ny,nz,triangles_tested,sdf_evals,micros
  * Errors (unreadable file, bad record, unknown name) go to stderr with the line number; the exit
- * status is 0 on success, 1 on a bad file, 2 on bad usage. */
+ * status is 0 on success, 1 on a bad file, 2 on bad usage.
+ * tests/fuzz/fuzz_cases.c includes this file with SDFCCD_CASES_NO_MAIN to fuzz run_file(). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -224,6 +225,7 @@ static int run_file(runner* r, FILE* f)
     return ok;
 }
 
+#ifndef SDFCCD_CASES_NO_MAIN
 int main(int argc, char** argv)
 {
     static runner r;
@@ -266,3 +268,4 @@ int main(int argc, char** argv)
     for (int i = 0; i < r.mesh_count; ++i) sdfccd_destroy_mesh(r.meshes[i].id);
     return ok ? 0 : 1;
 }
+#endif

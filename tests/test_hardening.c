@@ -360,6 +360,52 @@ START_TEST(test_cdf_overflow_and_files)
 }
 END_TEST
 
+static void write_file(const char* path, const char* text)
+{
+    FILE* f = fopen(path, "wb");
+    ck_assert_ptr_nonnull(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* Files: a directory is an I/O error, not an out-of-memory (.cdf) or a hang (mesh); callers can
+ * refuse formats and cap the file size; assimp validates its data before its asserting steps
+ * (an OFF file declaring 5 vertices but holding 4 aborted the process, found by fuzz_mesh). */
+START_TEST(test_mesh_files)
+{
+    sdfccd_MeshId m;
+    sdfccd_MeshLoadDef d = sdfccd_default_mesh_load_def();
+    ck_assert_int_eq(sdfccd_load_mesh(SDFCCD_DATA_DIR, &d, &m), SDFCCD_IO_ERROR);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "not a regular file"));
+    ck_assert_int_eq(sdfccd_load_mesh("/dev/zero", &d, &m), SDFCCD_IO_ERROR);
+    const char* obj = SDFCCD_TEST_TMP_DIR "/hardening_tri.obj";
+    write_file(obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    ck_assert_int_eq(sdfccd_load_mesh(obj, &d, &m), SDFCCD_OK);
+    sdfccd_destroy_mesh(m);
+    d.formats = "stl;OBJ";
+    ck_assert_int_eq(sdfccd_load_mesh(obj, &d, &m), SDFCCD_OK);
+    sdfccd_destroy_mesh(m);
+    d.formats = "stl;off";
+    ck_assert_int_eq(sdfccd_load_mesh(obj, &d, &m), SDFCCD_UNSUPPORTED);
+    d.formats = "ob";
+    ck_assert_int_eq(sdfccd_load_mesh(obj, &d, &m), SDFCCD_UNSUPPORTED);
+    d.formats = NULL;
+    d.max_file_bytes = 10;
+    ck_assert_int_eq(sdfccd_load_mesh(obj, &d, &m), SDFCCD_UNSUPPORTED);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "max_file_bytes"));
+    d.max_file_bytes = 0;
+    ck_assert_int_eq(sdfccd_load_mesh(obj, &d, &m), SDFCCD_INVALID_ARGUMENT);
+    remove(obj);
+    if (strstr(sdfccd_configuration_string(), "assimp=1")) {
+        const char* off = SDFCCD_TEST_TMP_DIR "/hardening_bad.off";
+        write_file(off, "OFF\n5 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+        d = sdfccd_default_mesh_load_def();
+        ck_assert_int_eq(sdfccd_load_mesh(off, &d, &m), SDFCCD_FORMAT_ERROR);
+        remove(off);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("hardening");
@@ -373,6 +419,7 @@ int main(void)
     tcase_add_test(tc, test_transform_scale_limits);
     tcase_add_test(tc, test_csg_nan_operand);
     tcase_add_test(tc, test_cdf_overflow_and_files);
+    tcase_add_test(tc, test_mesh_files);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

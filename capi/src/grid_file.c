@@ -138,6 +138,7 @@ static sdfccd_Status parse(const unsigned char* data, size_t size, sdfccd_SdfId*
     case SCC_GRID_OK: break;
     case SCC_GRID_EMPTY: st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: field 0 has no cell with values"); goto fail;
     case SCC_GRID_TOO_LARGE: st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: too many cells"); goto fail;
+    case SCC_GRID_STEEP: st = sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_grid: node values too large for the cell size (a gradient bound overflows)"); goto fail;
     default: st = sdfccd__oom("grid bounds"); goto fail;
     }
     return sdfccd__grid_register(g, out_grid);

@@ -4,8 +4,10 @@
  * node transforms; float positions), then exact-position vertex welding shared by both. */
 #include "mesh_import.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <stdio.h>
+#include <sys/stat.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,6 +27,8 @@ sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void)
     d.merge_vertices = 1;
     d.drop_degenerate = 1;
     d.internal_value = LOAD_DEF_MAGIC;
+    d.max_file_bytes = (int64_t)256 << 20;
+    d.formats = NULL;
     return d;
 }
 
@@ -102,6 +106,41 @@ static int has_obj_extension(const char* path)
     return e[0] == '.' && (e[1] == 'o' || e[1] == 'O') && (e[2] == 'b' || e[2] == 'B') && (e[3] == 'j' || e[3] == 'J');
 }
 
+/* 1 when the extension of `path` (after the last '.') is one of the ';'-separated `formats`. */
+static int format_allowed(const char* path, const char* formats)
+{
+    if (!formats) return 1;
+    const char* dot = strrchr(path, '.');
+    const char* slash = strrchr(path, '/');
+    if (!dot || (slash && dot < slash)) return 0;
+    const char* ext = dot + 1;
+    const size_t n = strlen(ext);
+    for (const char* s = formats; *s;) {
+        const char* e = strchr(s, ';');
+        const size_t len = e ? (size_t)(e - s) : strlen(s);
+        if (len == n && n > 0) {
+            size_t i = 0;
+            while (i < n && tolower((unsigned char)s[i]) == tolower((unsigned char)ext[i])) ++i;
+            if (i == n) return 1;
+        }
+        if (!e) break;
+        s = e + 1;
+    }
+    return 0;
+}
+
+/* A regular file of at most max_bytes (a directory or a device could hang or mislead a reader). */
+static sdfccd_Status check_file(const char* path, int64_t max_bytes)
+{
+    struct stat sb;
+    if (stat(path, &sb) != 0) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot open '%s': %s", path, strerror(errno));
+    if (!S_ISREG(sb.st_mode)) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: '%s' is not a regular file", path);
+    if ((int64_t)sb.st_size > max_bytes)
+        return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_load_mesh: '%s' has %lld bytes, above max_file_bytes (%lld)", path,
+                             (long long)sb.st_size, (long long)max_bytes);
+    return SDFCCD_OK;
+}
+
 sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, sdfccd_MeshId* out_mesh)
 {
     sdfccd_Status st;
@@ -111,6 +150,11 @@ sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, 
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: def was not initialised with sdfccd_default_mesh_load_def()");
     if (!isfinite(d.scale) || d.scale == 0.0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: scale = %g must be finite and non-zero", d.scale);
+    if (d.max_file_bytes < 1)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: max_file_bytes = %lld must be >= 1", (long long)d.max_file_bytes);
+    if (!format_allowed(path, d.formats))
+        return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_load_mesh: the format of '%s' is not among the accepted formats \"%s\"", path, d.formats);
+    if ((st = check_file(path, d.max_file_bytes))) return st;
     if (has_obj_extension(path)) return sdfccd__load_obj(path, &d, out_mesh);
 #if !SDFCCD_HAVE_ASSIMP
     return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_load_mesh: this build has no assimp (configure with SDFCCD_WITH_ASSIMP=ON); only .obj files load");
@@ -119,7 +163,9 @@ sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, 
     if (!probe) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_load_mesh: cannot open '%s': %s", path, strerror(errno));
     fclose(probe);
 
-    const struct aiScene* scene = aiImportFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices);
+    /* Validation first: assimp checks counts and indices before its other steps, whose asserts
+     * abort the process on inconsistent data. */
+    const struct aiScene* scene = aiImportFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_PreTransformVertices);
     if (!scene) return sdfccd__error(SDFCCD_FORMAT_ERROR, "sdfccd_load_mesh: assimp cannot read '%s': %s", path, aiGetErrorString());
     uint64_t nv = 0, nt = 0;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {

@@ -70,8 +70,10 @@ typedef struct sdfccd_QueryParams {
                                         ::SDFCCD_STATE_NOT_CONVERGED with the earliest contact witnessed so far
                                         (`hit` = 1) or none. The solvers check it once per iteration, so a query
                                         may exceed it by about one iteration (a few line searches). Default
-                                        SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS (about 0.5 s with an analytic SDF on a
-                                        2-core 2020s machine; slower SDFs take proportionally longer). */
+                                        SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS: on the 2-core machine of the README's
+                                        figures the slowest case, CERTIFIED, spends about 150 ns per evaluation
+                                        (0.8 s), FWGSS on an analytic SDF about 25 ns (0.13 s); SDFs slower to
+                                        evaluate take proportionally longer. */
     int32_t fwgss_secant_entry;    /**< FWGSS: once the current point is in contact at the iterate's time and not at the
                                         interval start, its entry time is found by regula falsi with the Illinois
                                         modification on that sign change (a handful of evaluations) instead of the
@@ -88,7 +90,7 @@ typedef struct sdfccd_QueryParams {
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
-#define SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS 16000000
+#define SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS 5000000
 /** Largest total rotation (rad) of a query's motions over [t0, t1] (sum of the angular speeds of the
  * body and the SDF times t1 - t0). Beyond it the rotation angle's rounding error exceeds about
  * 1e-10 rad and the motion model is no longer accurate: the query returns ::SDFCCD_INVALID_ARGUMENT. */

@@ -70,9 +70,17 @@ typedef struct sdfccd_MeshLoadDef {
      * sdfccd_MeshInfo::dropped_triangles. 0: they are an error (::SDFCCD_DEGENERATE). */
     int32_t drop_degenerate;
     int32_t internal_value;   /**< Set by sdfccd_default_mesh_load_def(); do not change. */
+    /** Largest file accepted (bytes, >= 1); a larger file gives ::SDFCCD_UNSUPPORTED before it is
+     * parsed. Default 256 MiB. */
+    int64_t max_file_bytes;
+    /** Formats the caller accepts: file extensions separated by ';' (case-insensitive, e.g. "obj;stl").
+     * A file with another extension gives ::SDFCCD_UNSUPPORTED without being opened. NULL (default):
+     * every format. Use it to keep hostile files away from assimp's readers: assimp 5.2.5's PLY reader
+     * can spin forever on a malformed 216-byte file, and no option of this call can bound that. */
+    const char* formats;
 } sdfccd_MeshLoadDef;
 
-/** Defaults: scale 1, merge_vertices 1, drop_degenerate 1. */
+/** Defaults: scale 1, merge_vertices 1, drop_degenerate 1, max_file_bytes 256 MiB, every format. */
 SDFCCD_API sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void);
 
 /** Loads a triangle mesh from any format assimp reads (OBJ, PLY, STL, OFF, glTF, ...). Polygons
@@ -83,7 +91,12 @@ SDFCCD_API sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void);
  * records only, polygons fan-triangulated, `i/t/n` and negative indices accepted, numbers parsed
  * with strtod (the C locale's '.' decimal point). Other formats go through assimp (float
  * positions).
- * Errors: ::SDFCCD_IO_ERROR when the file cannot be opened; ::SDFCCD_FORMAT_ERROR when it cannot
+ * assimp runs with its data-structure validation (aiProcess_ValidateDataStructure), so a file whose
+ * counts and indices disagree is refused instead of reaching assimp's asserts (an OFF file declaring
+ * more vertices than it holds aborted the process inside assimp's triangulation).
+ * Errors: ::SDFCCD_IO_ERROR when the file cannot be opened or is not a regular file (a directory,
+ * a device, a pipe); ::SDFCCD_UNSUPPORTED for a format not in `formats` or a file above
+ * `max_file_bytes`; ::SDFCCD_FORMAT_ERROR when it cannot
  * be parsed (a bad OBJ record with its line number, or assimp's message); ::SDFCCD_DEGENERATE when
  * it holds no triangle; ::SDFCCD_UNSUPPORTED for a non-OBJ file when the library was built without
  * assimp (SDFCCD_WITH_ASSIMP=OFF). */
