@@ -37,7 +37,7 @@ extern "C" {
 
 /** Status of a call. 0 is success; every other value comes with a message (sdfccd_last_error). */
 typedef enum sdfccd_Status {
-    SDFCCD_OK = 0,
+    SDFCCD_OK = 0,             /**< Success. */
     SDFCCD_INVALID_ARGUMENT,   /**< NULL pointer, NaN/Inf value, t1 < t0, bad parameter. */
     SDFCCD_INVALID_HANDLE,     /**< Unknown, destroyed or wrong-kind handle. */
     SDFCCD_DEGENERATE,         /**< Zero-area triangle, empty mesh, or other unusable geometry. */

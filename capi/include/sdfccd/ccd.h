@@ -228,8 +228,8 @@ typedef enum sdfccd_BatchKind {
 
 /** One independent query of a batch: the arguments of the matching single query, and its status. */
 typedef struct sdfccd_BatchQuery {
-    sdfccd_BatchKind kind;
-    sdfccd_SdfId sdf;
+    sdfccd_BatchKind kind;                 /**< Which single query this is. */
+    sdfccd_SdfId sdf;                      /**< The SDF queried. */
     const sdfccd_RigidMotion* sdf_motion;  /**< NULL: static SDF. */
     sdfccd_MeshId mesh;                    /**< Mesh kinds. */
     const sdfccd_Vec3* triangle;           /**< Triangle kinds: 3 vertices (local, or world start for linear). */
@@ -237,11 +237,12 @@ typedef struct sdfccd_BatchQuery {
     const sdfccd_Vec3* start;              /**< SDFCCD_BATCH_MESH_LINEAR: vertex_count world positions at t0. */
     const sdfccd_Vec3* end;                /**< SDFCCD_BATCH_MESH_LINEAR: vertex_count world positions at t1. */
     const sdfccd_RigidMotion* motion;      /**< Rigid kinds. */
-    double t0, t1;
-    const sdfccd_QueryParams* params;
+    double t0;                             /**< Start of the interval (s). */
+    double t1;                             /**< End of the interval (s), >= t0. */
+    const sdfccd_QueryParams* params;      /**< Query parameters (not NULL; sdfccd_default_query_params()). */
     sdfccd_Contact* out_contacts;          /**< Each query needs its own output storage. */
-    int32_t capacity;
-    sdfccd_QueryResult* out_result;
+    int32_t capacity;                      /**< Entries of out_contacts. */
+    sdfccd_QueryResult* out_result;        /**< The query's result (not NULL). */
     sdfccd_Status status;                  /**< Out: the query's status. */
 } sdfccd_BatchQuery;
 
