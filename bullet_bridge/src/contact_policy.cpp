@@ -5,10 +5,10 @@
 //     WHOLE contact set at the earliest time of impact is kept (the buffer grows to
 //     contacts_found; every triangle within the library's TOI window, with subdivision contacts),
 //     plus the vertices of those triangles within Config::vertex_distance of the surface then.
-//  2. Whenever the step has any contact, also when it STARTS in contact: two discrete queries,
-//     one at the start pose with the margin widened by the step's travel (every feature that
-//     can reach the surface during the step: phi is 1-Lipschitz), one at the predicted end pose;
-//     each feature they report is constrained by its own closest surface point at the START of
+//  2. Whenever the step has any contact, also when it STARTS in contact: discrete queries at the
+//     start pose with the margin widened by the step's travel (every feature that can reach the
+//     surface during the step: phi is 1-Lipschitz; moving steps only) and at the predicted end
+//     pose; each feature they report is constrained by its own closest surface point at the START of
 //     the step (the classic speculative-contact rule), so the rest of the motion (a rotation
 //     about a touching corner, a slide, a face landing after its first point) cannot push it in.
 //  3. Every candidate is expressed at the start of the step: point on the mesh, point on the SDF
@@ -33,7 +33,7 @@ static const double kSpreadShare = 0.95;
 
 // Adds points to `out` (up to k) maximising the spread of the projected points P.
 static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>& P, const btVector3& nref, int k, double tol,
-                   double depth_scale, std::vector<int>& out)
+                   double depth_scale, double d_max, std::vector<int>& out)
 {
     const int n = (int)c.size();
     std::vector<double> score(n, 0.0);
@@ -45,6 +45,7 @@ static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>
         double best = 0;
         for (int i = 0; i < n; ++i) {
             score[i] = -1;
+            if (!(c[i].d <= d_max)) continue;
             const btVector3& q = P[i];
             bool dup = false;
             for (int j : out) dup |= (double)(q - P[j]).length() <= tol;
@@ -83,7 +84,7 @@ static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>
     }
 }
 
-std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale)
+std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, double band)
 {
     std::vector<int> out;
     if (c.empty() || k <= 0) return out;
@@ -118,7 +119,11 @@ std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double t
         }
     }
     out.push_back(first);
-    spread(c, P, nref, k, tol, depth_scale, out);
+    // Optionally first among the points within `band` of the deepest (those in contact with it),
+    // then among all. (Off in the bridge: it helps piles of resting bodies but lets a body that
+    // lands on slanted points first slide between them.)
+    if (band >= 0) spread(c, P, nref, k, tol, depth_scale, d0 + band, out);
+    spread(c, P, nref, k, tol, depth_scale, INFINITY, out);
     return out;
 }
 
@@ -256,21 +261,35 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     if (out_radius) *out_radius = G.me->radius;
     G.M = motionOf(mw->getCollisionObject(), mw->getWorldTransform(), dt);
     G.S = motionOf(sw->getCollisionObject(), sw->getWorldTransform(), dt);
+    // A static SDF (the usual case): work in its frame, so the library evaluates the field without
+    // moving it (no pose per evaluation); the candidates go back to the world at the end.
+    const bool static_sdf = G.S.v.isZero() && G.S.w.isZero() && G.S.t0 == G.S.t1;
+    const btTransform sdf_world = G.S.t0;
+    if (static_sdf) {
+        const btTransform inv = sdf_world.inverse();
+        G.M.t0 = inv * G.M.t0;
+        G.M.t1 = inv * G.M.t1;
+        G.M.v = inv.getBasis() * G.M.v;
+        G.M.w = inv.getBasis() * G.M.w;
+        G.S.t0.setIdentity();
+        G.S.t1.setIdentity();
+    }
     G.margin = margin;
     G.out = &cands;
-    const sdfccd_RigidMotion mm = G.M.rigid(), sm = G.S.rigid();
+    const sdfccd_RigidMotion mm = G.M.rigid(), sm_value = G.S.rigid();
+    const sdfccd_RigidMotion* sm = static_sdf ? nullptr : &sm_value;
     sdfccd_QueryParams params = cfg.query;
     params.margin = margin;
     if (contacts.size() < 256) contacts.resize(256);
     sdfccd_QueryResult res;
     auto start = std::chrono::steady_clock::now();
-    sdfccd_Status status = sdfccd_query_mesh(G.sdf, &sm, G.me->id, &mm, 0.0, dt, &params, contacts.data(),
+    sdfccd_Status status = sdfccd_query_mesh(G.sdf, sm, G.me->id, &mm, 0.0, dt, &params, contacts.data(),
                                              (int32_t)contacts.size(), &res);
     if (status == SDFCCD_OK && res.contacts_found > res.contact_count) {
         // Keep the whole set: grow the buffer and ask again (rare once the buffer has grown).
         contacts.resize((size_t)res.contacts_found);
         stats.requeries++;
-        status = sdfccd_query_mesh(G.sdf, &sm, G.me->id, &mm, 0.0, dt, &params, contacts.data(), (int32_t)contacts.size(),
+        status = sdfccd_query_mesh(G.sdf, sm, G.me->id, &mm, 0.0, dt, &params, contacts.data(), (int32_t)contacts.size(),
                                    &res);
     }
     stats.query_seconds += seconds(start);
@@ -293,8 +312,8 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // point, or passes through a thin part of the SDF within the step, needs more: every feature
     // within the step's travel of the surface at the START of the step (the speculative-contact
     // rule: phi is 1-Lipschitz, so nothing else can reach the surface in the step), and every
-    // feature in contact at the predicted end pose, each constrained by its own closest surface
-    // point at the start of the step.
+    // feature in contact at the predicted end pose (the closest points of large triangles
+    // differ there), each constrained by its own closest surface point at the start of the step.
     auto discrete = [&](const btTransform& Mx, const btTransform& Sx, double dcd_margin) {
         sdfccd_RigidMotion m1 = sdfccd_default_rigid_motion(), s1 = sdfccd_default_rigid_motion();
         m1.pose = toPose(Mx);
@@ -304,12 +323,12 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         dcd.margin = dcd_margin;
         sdfccd_QueryResult r1;
         auto t_start = std::chrono::steady_clock::now();
-        sdfccd_Status st1 = sdfccd_query_mesh(G.sdf, &s1, G.me->id, &m1, 0.0, 0.0, &dcd, contacts.data(),
+        sdfccd_Status st1 = sdfccd_query_mesh(G.sdf, static_sdf ? nullptr : &s1, G.me->id, &m1, 0.0, 0.0, &dcd, contacts.data(),
                                               (int32_t)contacts.size(), &r1);
         if (st1 == SDFCCD_OK && r1.contacts_found > r1.contact_count) {
             contacts.resize((size_t)r1.contacts_found);
             stats.requeries++;
-            st1 = sdfccd_query_mesh(G.sdf, &s1, G.me->id, &m1, 0.0, 0.0, &dcd, contacts.data(), (int32_t)contacts.size(), &r1);
+            st1 = sdfccd_query_mesh(G.sdf, static_sdf ? nullptr : &s1, G.me->id, &m1, 0.0, 0.0, &dcd, contacts.data(), (int32_t)contacts.size(), &r1);
         }
         stats.query_seconds += seconds(t_start);
         stats.end_pose_queries++;
@@ -323,6 +342,12 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         if (res.toi > 0 || travel > margin) discrete(G.M.t0, G.S.t0, margin + travel);
         discrete(G.M.t1, G.S.t1, margin);
     }
+    if (static_sdf)
+        for (Candidate& c : cands) {
+            c.pA0 = sdf_world * c.pA0;
+            c.pB0 = sdf_world * c.pB0;
+            c.n0 = sdf_world.getBasis() * c.n0;
+        }
     stats.candidates += (int64_t)cands.size();
     return !cands.empty();
 }
@@ -345,7 +370,7 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     double radius = 0;
     const bool any = gather(mw, sw, dt, margin, scratch, &radius);
     std::vector<int> pick;
-    if (any) pick = reduceContacts(scratch, cfg.max_contacts, std::max(1e-6, 1e-3 * radius), cfg.spread_depth_scale);
+    if (any) pick = reduceContacts(scratch, cfg.max_contacts, std::max(1e-6, 1e-3 * radius), cfg.spread_depth_scale, -1);
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;

@@ -102,9 +102,10 @@ struct Candidate {
  * maximising the triangle's area, then the one adding most area to the polygon; distances and
  * areas between the SDF surface points, projected on the plane of the deepest point's normal,
  * each weighted by exp(-(gap - deepest gap) / depth_scale). Points closer than `tol` to a chosen
- * one are never chosen (no duplicates).
+ * one are never chosen (no duplicates). With band >= 0, points within `band` of the deepest gap
+ * are spread first and the others only fill what is left.
  * Ties go to the smaller gap, then to the lower index: deterministic for a given input. */
-std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale);
+std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, double band);
 
 class MeshSdfAlgorithm;
 
