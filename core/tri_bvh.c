@@ -146,12 +146,12 @@ int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* 
     bvh->tri_index = scc_alloc(a, (size_t)n * sizeof(uint32_t));
     bvh->tri_boxes = scc_alloc(a, (size_t)n * sizeof(scc_aabb));
     build_item* items = scc_alloc(a, (size_t)n * sizeof *items);
+    bvh->tri_count = n; /* before any failure: destroy frees the arrays with sizes from this count */
     if (!bvh->nodes || !bvh->tris || !bvh->tri_index || !bvh->tri_boxes || !items) {
         scc_free(a, items, (size_t)n * sizeof *items);
         scc_tri_bvh_destroy(bvh);
         return -1;
     }
-    bvh->tri_count = n;
     for (uint32_t t = 0; t < n; ++t) {
         scc_vec3 v[3];
         scc_mesh_triangle(mesh, t, v);
