@@ -4,8 +4,10 @@
 //   sdfccd_scenes --list
 //   sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]
 //                 [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]
-//                 [--margin M] [--data DIR] [--check KEY=LIMIT,...] [--quiet]
+//                 [--margin M] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]
 //
+// --table4 adds the paper's Table 4 figures (the CCD of the coming step through the C ABI, timed,
+// up to the first contact; see runner.h) as a "table4" line of the summary.
 // The Bullet build (float or double btScalar) is a separate library, so this program is built
 // twice: sdfccd_scenes (float Bullet) and sdfccd_scenes_f64 (double). --precision runs the
 // sibling executable with the same arguments when it names the other one.
@@ -46,7 +48,7 @@ void usage(std::FILE* f)
                  "usage: sdfccd_scenes --list\n"
                  "       sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]\n"
                  "                     [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]\n"
-                 "                     [--margin M] [--data DIR] [--check KEY=LIMIT,...] [--quiet]\n"
+                 "                     [--margin M] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
                  "check keys: max_pen min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
 }
 
@@ -118,6 +120,7 @@ int main(int argc, char** argv)
         else if (a == "--data") opt.data_dir = value("a folder");
         else if (a == "--check") check = value("limits");
         else if (a == "--quiet") quiet = true;
+        else if (a == "--table4") cfg.probe = true;
         else {
             std::fprintf(stderr, "sdfccd_scenes: unknown option '%s'\n", a.c_str());
             usage(stderr);
@@ -137,6 +140,8 @@ int main(int argc, char** argv)
     cfg.steps = steps > 0 ? steps : e->steps;
     cfg.dt = dt > 0 ? dt : e->dt;
     cfg.progress = !quiet;
+    cfg.probe_params.method = opt.method;
+    cfg.probe_params.subdivision = opt.subdivision ? 1 : 0;
     std::FILE* csv = nullptr;
     if (!cfg.csv.empty()) {
         csv = std::fopen(cfg.csv.c_str(), "w");

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages sdfccd needs, only those that are missing (needs root).
 set -euo pipefail
-PKGS="build-essential cmake pkg-config check libassimp-dev libbullet-dev gnuplot-nox libmeshoptimizer-dev libfcl-dev doxygen clang-14 libfuzzer-14-dev libclang-rt-14-dev valgrind"
+PKGS="build-essential cmake pkg-config check libassimp-dev libbullet-dev gnuplot-nox libmeshoptimizer-dev libfcl-dev doxygen clang-14 libfuzzer-14-dev libclang-rt-14-dev valgrind zlib1g-dev"
 need=""
 for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || need="$need $p"; done
 if [ -n "$need" ]; then

@@ -161,10 +161,10 @@ public:
         Collider& col = addStaticSdf("ramp_rail_ground", park, btVector3(0, 0, 0), btQuaternion::getIdentity(),
                                      sdfccd_Aabb{ { -4.1, -4.1, -0.6 }, { 4.1, 4.1, 1.2 } }, 160, park);
         col.killBelow(up, -0.1);
-        // Start 0.3 m up the slope from the ramp's low end, at rest, aligned with the slope.
-        const double s = 0.9; // local x on the ramp's top face
-        btVector3 pos((btScalar)(s * std::cos(th) + (0.05 + 0.03 + 0.002) * std::sin(th)), 0,
-                      (btScalar)(0.6 - s * std::sin(th) + (0.05 + 0.03 + 0.002) * std::cos(th)));
+        // Start 0.3 m up the slope from the ramp's low end, aligned with the slope, 5 cm above it
+        // (it lands on the ramp first: Table 4 measures up to that first contact).
+        const double s = 0.9, lift = 0.05 + 0.03 + 0.05; // local x on the ramp's top face; height above its centre plane
+        btVector3 pos((btScalar)(s * std::cos(th) + lift * std::sin(th)), 0, (btScalar)(0.6 - s * std::sin(th) + lift * std::cos(th)));
         btRigidBody* b = addMeshBody(board, 2, pos, axisAngle(0, 1, 0, th));
         b->setFriction(0.05f);
         b->setActivationState(DISABLE_DEACTIVATION);
@@ -365,6 +365,7 @@ public:
         m_params.method = opt.method;
         m_params.subdivision = opt.subdivision ? 1 : 0;
         m_params.margin = opt.margin >= 0 ? opt.margin : 1e-3; // the paper's 1 mm margin
+        ccd_margin = m_params.margin;
     }
     ~KinematicScene() override
     {

@@ -10,6 +10,7 @@ const std::vector<SceneEntry>& sceneTable()
     static const std::vector<SceneEntry> table = [] {
         std::vector<SceneEntry> t;
         appendPaperScenes(t);
+        appendClothScenes(t);
         appendBulletRecreations(t);
         return t;
     }();

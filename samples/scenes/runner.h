@@ -28,6 +28,13 @@ struct RunConfig {
     std::string csv;      /**< Per-step CSV file ("" = none). */
     std::string snapshot; /**< Folder of PNG snapshots ("" = none). */
     bool progress = true; /**< Progress line on stderr (about once per second of wall time). */
+    /** Table 4 probe: before every step up to the first contact, run the CCD of every body-collider
+     * pair through the C ABI on the motion the step will take (pose, v + g dt, w) with `probe_params`:
+     * once as a mesh query (the library's broad phase; total time, triangles tested) and once per
+     * triangle passing a conservative bounding-sphere test (per-triangle time statistics, each the
+     * fastest of 3 identical runs). */
+    bool probe = false;
+    sdfccd_QueryParams probe_params = sdfccd_default_query_params();
 };
 
 struct Summary {
@@ -55,6 +62,15 @@ struct Summary {
     int64_t ccd_queries = 0;
     int body_count = 0;
     int64_t deep_samples = 0;      /**< Sample-steps with phi < -1 mm. */
+    // Table 4 probe (RunConfig::probe), over the steps up to and including the first probe hit.
+    int probe_steps = 0;           /**< Steps probed (-1 when no hit within the run). */
+    double probe_total_ms = 0;     /**< Mesh queries: total time. */
+    int64_t probe_tri_tested = 0;  /**< Mesh queries: triangles that reached the narrow phase. */
+    double probe_step_ms = 0;      /**< Step wall time over the probed steps, minus the bridge's own CCD time. */
+    int64_t probe_tri_count = 0;   /**< Per-triangle queries made. */
+    double probe_tri_mean_us = 0, probe_tri_min_us = 0, probe_tri_max_us = 0, probe_tri_sd_us = 0;
+    double probe_tri_evals_mean = 0;   /**< SDF evaluations per triangle query (deterministic). */
+    int64_t probe_mesh_evals = 0;      /**< SDF evaluations of the mesh queries. */
 };
 
 /** Runs `scene` for cfg.steps steps of cfg.dt. `csv` (may be NULL) receives per-step rows. */

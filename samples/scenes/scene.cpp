@@ -29,20 +29,8 @@ void MeshData::finish(int density)
             std::fprintf(stderr, "sdfccd_scenes: mesh %s: %s\n", name.c_str(), sdfccd_last_error());
     }
     int nv = vertexCount();
-    samples = v;
-    if (density > 1) {
-        for (int t = 0; t < triangleCount(); ++t) {
-            const double* a = &v[3 * f[3 * t]];
-            const double* b = &v[3 * f[3 * t + 1]];
-            const double* c = &v[3 * f[3 * t + 2]];
-            for (int i = 0; i <= density; ++i)
-                for (int j = 0; i + j <= density; ++j) {
-                    int k = density - i - j;
-                    if ((i == density) || (j == density) || (k == density)) continue; // the vertices
-                    for (int d = 0; d < 3; ++d) samples.push_back((i * a[d] + j * b[d] + k * c[d]) / density);
-                }
-        }
-    }
+    this->density = density;
+    samplesFor(v.data(), samples);
     radius = 0;
     bounds.lo = sdfccd_Vec3{ 1e300, 1e300, 1e300 };
     bounds.hi = sdfccd_Vec3{ -1e300, -1e300, -1e300 };
@@ -57,6 +45,23 @@ void MeshData::finish(int density)
         bounds.hi.z = std::max(bounds.hi.z, p[2]);
     }
     half_thickness = 0.5 * std::min(bounds.hi.x - bounds.lo.x, std::min(bounds.hi.y - bounds.lo.y, bounds.hi.z - bounds.lo.z));
+}
+
+void MeshData::samplesFor(const double* x, std::vector<double>& out) const
+{
+    out.assign(x, x + v.size());
+    if (density <= 1) return;
+    for (int t = 0; t < triangleCount(); ++t) {
+        const double* a = &x[3 * f[3 * t]];
+        const double* b = &x[3 * f[3 * t + 1]];
+        const double* c = &x[3 * f[3 * t + 2]];
+        for (int i = 0; i <= density; ++i)
+            for (int j = 0; i + j <= density; ++j) {
+                int k = density - i - j;
+                if (i == density || j == density || k == density) continue; // the vertices
+                for (int d = 0; d < 3; ++d) out.push_back((i * a[d] + j * b[d] + k * c[d]) / density);
+            }
+    }
 }
 
 std::shared_ptr<MeshData> makeMesh(const std::string& name, std::vector<double> v, std::vector<uint32_t> f)

@@ -58,6 +58,9 @@ struct MeshData {
     int sampleCount() const { return (int)(samples.size() / 3); }
     /** Recomputes samples, radius, bounds, half_thickness. `density` lattice points per edge (1: vertices only). */
     void finish(int density = 1);
+    /** The samples for vertex positions `x` (3 per vertex; e.g. a deformed mesh's world positions). */
+    void samplesFor(const double* x, std::vector<double>& out) const;
+    int density = 1;
 };
 
 /** Loads an OBJ through sdfccd_load_mesh, scaled; returns null (message on stderr) on failure. */
@@ -143,6 +146,7 @@ public:
     std::vector<Collider> colliders;
     double up[3] = { 0, 0, 1 };  /**< Up axis (for kill planes and potential energy). */
     double gravity[3] = { 0, 0, 0 }; /**< m/s^2 (Table 4's probe predicts the motion with it). */
+    double ccd_margin = 0.01;        /**< Contact margin of the scene's CCD (m). */
     sdfccd_Aabb view{};          /**< Snapshot view box (world); empty (lo = hi) frames the bodies. */
 };
 

@@ -14,6 +14,8 @@ void appendBulletRecreations(std::vector<SceneEntry>& table);
 /** The paper's scenes: shuriken, torus-crossings, skateboard, pyramids, bunny, hoop, spikes,
  * triangle-flat, spin360 (paper_scenes.cpp); cloth (cloth.cpp). */
 void appendPaperScenes(std::vector<SceneEntry>& table);
+/** cloth, cloth-1ms (cloth.cpp). */
+void appendClothScenes(std::vector<SceneEntry>& table);
 
 } // namespace scenes
 

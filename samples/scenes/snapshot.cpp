@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// A small headless rasteriser: orthographic camera, z-buffer, flat Lambert shading, PNG output
-// written with uncompressed (stored) deflate blocks, so no imaging library is needed.
+// A small headless rasteriser: orthographic camera, z-buffer, flat Lambert shading; PNG output
+// (the format written here: IHDR, the "Sub" row filter, one zlib-compressed IDAT, IEND).
 #include "snapshot.h"
 
 #include <algorithm>
@@ -9,12 +9,13 @@
 #include <cstdio>
 #include <cstring>
 #include <sys/stat.h>
+#include <zlib.h>
 
 namespace scenes {
 
 namespace {
 
-const int kW = 800, kH = 600;
+const int kW = 640, kH = 480;
 
 uint32_t crc32(const unsigned char* p, size_t n, uint32_t crc = 0)
 {
@@ -61,31 +62,22 @@ bool writePng(const std::string& path, const std::vector<unsigned char>& rgb, in
     const unsigned char rest[5] = { 8, 2, 0, 0, 0 }; // 8-bit RGB
     ihdr.insert(ihdr.end(), rest, rest + 5);
     chunk(f, "IHDR", ihdr);
-    // Raw scanlines (filter 0), then a zlib stream of stored blocks.
+    // Scanlines with the Sub filter (each byte minus the same channel of the pixel to its left),
+    // which turns flat-shaded areas into runs of zeros, then zlib.
     std::vector<unsigned char> raw;
     raw.reserve((size_t)h * (3 * w + 1));
     for (int y = 0; y < h; ++y) {
-        raw.push_back(0);
-        raw.insert(raw.end(), rgb.begin() + (size_t)y * 3 * w, rgb.begin() + (size_t)(y + 1) * 3 * w);
+        raw.push_back(1);
+        const unsigned char* row = &rgb[(size_t)y * 3 * w];
+        for (int x = 0; x < 3 * w; ++x) raw.push_back((unsigned char)(row[x] - (x >= 3 ? row[x - 3] : 0)));
     }
-    std::vector<unsigned char> z = { 0x78, 0x01 };
-    size_t pos = 0;
-    do {
-        size_t n = std::min<size_t>(65535, raw.size() - pos);
-        z.push_back(pos + n == raw.size() ? 1 : 0);
-        z.push_back((unsigned char)(n & 0xff));
-        z.push_back((unsigned char)(n >> 8));
-        z.push_back((unsigned char)(~n & 0xff));
-        z.push_back((unsigned char)((~n >> 8) & 0xff));
-        z.insert(z.end(), raw.begin() + pos, raw.begin() + pos + n);
-        pos += n;
-    } while (pos < raw.size());
-    uint32_t a = 1, b = 0;
-    for (unsigned char c : raw) {
-        a = (a + c) % 65521;
-        b = (b + a) % 65521;
+    uLongf zlen = compressBound((uLong)raw.size());
+    std::vector<unsigned char> z(zlen);
+    if (compress2(z.data(), &zlen, raw.data(), (uLong)raw.size(), 9) != Z_OK) {
+        std::fclose(f);
+        return false;
     }
-    put32(z, (b << 16) | a);
+    z.resize(zlen);
     chunk(f, "IDAT", z);
     chunk(f, "IEND", std::vector<unsigned char>());
     bool ok = std::ferror(f) == 0;
