@@ -243,7 +243,12 @@ private:
             }
             sdfccd_QueryResult res;
             auto t0 = std::chrono::steady_clock::now();
-            sdfccd_Status st = sdfccd_query_mesh_linear(c.ccd, nullptr, mesh.handle, a.data(), b.data(), 0, dt, &params, nullptr, 0, &res);
+            std::vector<sdfccd_Vec3> va(a.size() / 3), vb(b.size() / 3);
+            for (size_t i = 0; i < va.size(); ++i) {
+                va[i] = sdfccd_Vec3{ a[3 * i], a[3 * i + 1], a[3 * i + 2] };
+                vb[i] = sdfccd_Vec3{ b[3 * i], b[3 * i + 1], b[3 * i + 2] };
+            }
+            sdfccd_Status st = sdfccd_query_mesh_linear(c.ccd, nullptr, mesh.handle, va.data(), vb.data(), 0, dt, &params, nullptr, 0, &res);
             ++m_cost.ccd_queries;
             if (st == SDFCCD_OK) m_cost.triangles_tested += res.triangles_tested;
             if (st != SDFCCD_OK || !res.hit) {
