@@ -9,7 +9,7 @@
 
 namespace scenes {
 
-const char* Scene::precision() const { return "double"; }
+const char* Scene::precision() const { return "n/a (no Bullet)"; }
 
 MeshData::~MeshData()
 {

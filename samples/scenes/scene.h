@@ -137,7 +137,7 @@ public:
     /** Largest penetration (m, >= 0) seen INSIDE steps along the motion the scene executed, for
      * kinematic scenes that know it (sampled along the executed path); 0 otherwise. */
     virtual double sweptPenetration() const { return 0; }
-    /** "float" or "double": the btScalar of the Bullet build (kinematic scenes: "double"). */
+    /** "float" or "double": the btScalar of the Bullet build ("n/a (no Bullet)" for the C ABI scenes). */
     virtual const char* precision() const;
     /** One-line description of the configuration actually built (bodies, variants). */
     virtual std::string describe() const = 0;
