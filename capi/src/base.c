@@ -3,6 +3,7 @@
  * generation-checked handle registry shared by SDFs and meshes, and SDF objects (mesh objects
  * are in mesh_api.c). */
 #include "capi_internal.h"
+#include "../../core/bsh.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -149,13 +150,23 @@ static pthread_mutex_t s_lock = PTHREAD_MUTEX_INITIALIZER;
 static slot* s_slots = NULL;
 static uint32_t s_slot_count = 0, s_slot_capacity = 0;
 static uint32_t s_free_head = UINT32_MAX;
+static uint32_t s_generation_floor = 0; /* new slots start above every generation handed out before */
 
-/* Registry storage is not counted in sdfccd_byte_count (it is released when the table empties). */
+/* The table comes from the user's allocator (counted in sdfccd_byte_count) and is freed when the
+ * last handle goes, so byte_count returns to 0 and the allocator can be changed again. */
 static void registry_maybe_shrink(void)
 {
-    for (uint32_t i = 0; i < s_slot_count; ++i)
+    uint32_t top = s_generation_floor;
+    for (uint32_t i = 0; i < s_slot_count; ++i) {
         if (s_slots[i].kind != SDFCCD__KIND_FREE) return;
+        if (s_slots[i].generation > top) top = s_slots[i].generation;
+    }
     /* Keep the generations growing across a reset so stale ids never match again. */
+    s_generation_floor = top;
+    sdfccd__free(s_slots, (size_t)s_slot_capacity * sizeof *s_slots);
+    s_slots = NULL;
+    s_slot_count = s_slot_capacity = 0;
+    s_free_head = UINT32_MAX;
 }
 
 int sdfccd__registry_add(void* obj, uint32_t kind, uint32_t* out_index1, uint32_t* out_generation)
@@ -168,13 +179,15 @@ int sdfccd__registry_add(void* obj, uint32_t kind, uint32_t* out_index1, uint32_
     } else {
         if (s_slot_count == s_slot_capacity) {
             uint32_t cap = s_slot_capacity ? 2 * s_slot_capacity : 64;
-            slot* n = realloc(s_slots, (size_t)cap * sizeof *n);
+            slot* n = sdfccd__alloc((size_t)cap * sizeof *n);
             if (!n) { pthread_mutex_unlock(&s_lock); return 0; }
+            if (s_slot_count) memcpy(n, s_slots, (size_t)s_slot_count * sizeof *n);
+            sdfccd__free(s_slots, (size_t)s_slot_capacity * sizeof *s_slots);
             s_slots = n;
             s_slot_capacity = cap;
         }
         i = s_slot_count++;
-        s_slots[i].generation = 0;
+        s_slots[i].generation = s_generation_floor;
     }
     s_slots[i].obj = obj;
     s_slots[i].kind = kind;
@@ -264,6 +277,72 @@ sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id)
     }
     *out_id = id;
     return SDFCCD_OK;
+}
+
+/* ---------------- references held by calls in flight ----------------
+ * A query or evaluation takes a reference on the objects it uses (acquire), recorded in a
+ * per-thread list, and drops them when it returns (release_to). A destroy that races it only
+ * drops the handle's reference, so the object is freed when the last call using it ends. */
+enum { HOLD_MAX = 16 };
+typedef struct held { void* obj; uint32_t kind; } held;
+static _Thread_local held s_held[HOLD_MAX];
+static _Thread_local int s_held_n = 0;
+
+int sdfccd__hold_mark(void) { return s_held_n; }
+
+void sdfccd__hold_release_to(int mark)
+{
+    while (s_held_n > mark) {
+        held h = s_held[--s_held_n];
+        if (h.kind == SDFCCD__KIND_SDF) sdfccd__sdf_release(h.obj);
+        else sdfccd__mesh_release(h.obj);
+    }
+}
+
+/* Looks up a live handle and, under the registry lock, takes a reference held until release_to. */
+static void* acquire(uint32_t index1, uint32_t generation, uint32_t kind)
+{
+    void* obj = NULL;
+    pthread_mutex_lock(&s_lock);
+    if (index1 >= 1 && index1 <= s_slot_count && s_held_n < HOLD_MAX) {
+        slot* s = &s_slots[index1 - 1];
+        if (s->kind == kind && s->generation == generation) {
+            obj = s->obj;
+            if (kind == SDFCCD__KIND_SDF) ((sdfccd__sdf*)obj)->refs++;
+            else ((sdfccd__mesh*)obj)->refs++;
+            s_held[s_held_n].obj = obj;
+            s_held[s_held_n].kind = kind;
+            ++s_held_n;
+        }
+    }
+    pthread_mutex_unlock(&s_lock);
+    return obj;
+}
+
+sdfccd__sdf* sdfccd__sdf_acquire(sdfccd_SdfId id)
+{
+    sdfccd__sdf* s = acquire(id.index1, id.generation, SDFCCD__KIND_SDF);
+    if (!s) sdfccd__error(SDFCCD_INVALID_HANDLE, "SDF handle {%u, %u} is not a live SDF", id.index1, id.generation);
+    return s;
+}
+
+sdfccd__mesh* sdfccd__mesh_acquire(sdfccd_MeshId id)
+{
+    sdfccd__mesh* m = acquire(id.index1, id.generation, SDFCCD__KIND_MESH);
+    if (!m) sdfccd__error(SDFCCD_INVALID_HANDLE, "mesh handle {%u, %u} is not a live mesh", id.index1, id.generation);
+    return m;
+}
+
+void sdfccd__mesh_release(sdfccd__mesh* m)
+{
+    if (!m) return;
+    pthread_mutex_lock(&s_lock);
+    uint32_t left = --m->refs;
+    pthread_mutex_unlock(&s_lock);
+    if (left) return;
+    scc_bsh_destroy(m->bsh, sdfccd__allocator());
+    sdfccd__free(m->block, m->block_size);
+    sdfccd__free(m, sizeof *m);
 }
 
 sdfccd__sdf* sdfccd__sdf_lookup(sdfccd_SdfId id)

@@ -87,6 +87,17 @@ sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count,
                                   uint32_t triangle_count, int drop_degenerate, const char* what,
                                sdfccd_MeshId* out_mesh);
 sdfccd__mesh* sdfccd__mesh_lookup(sdfccd_MeshId id);
+/* Drops one reference; frees the mesh at zero. */
+void sdfccd__mesh_release(sdfccd__mesh* m);
+
+/* ---- references held by a call in flight (safe concurrent destroy) ----
+ * acquire looks up a live handle and takes a reference recorded in a per-thread list; a public
+ * call takes mark = sdfccd__hold_mark() on entry and calls sdfccd__hold_release_to(mark) on
+ * every return, so a concurrent destroy frees the object only after the call ends. */
+sdfccd__sdf* sdfccd__sdf_acquire(sdfccd_SdfId id);   /* NULL with an INVALID_HANDLE message */
+sdfccd__mesh* sdfccd__mesh_acquire(sdfccd_MeshId id); /* NULL with an INVALID_HANDLE message */
+int sdfccd__hold_mark(void);
+void sdfccd__hold_release_to(int mark);
 /* DEGENERATE with a message when the topology cannot give correct signs, else OK. */
 struct scc_mesh_topology;
 sdfccd_Status sdfccd__mesh_topology_message(const struct scc_mesh_topology* t, const char* fn);

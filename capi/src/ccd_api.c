@@ -174,7 +174,17 @@ static sdfccd_Status check_interval(double t0, double t1, const char* fn)
     return SDFCCD_OK;
 }
 
-/* Common prologue: out_result, params, interval, SDF handle and SDF motion. */
+/* Runs a query body and drops the references it acquired (sdfccd__sdf_acquire/mesh_acquire), so
+ * an SDF or mesh destroyed by another thread during the call is freed only when it returns. */
+#define HELD_CALL(body)                                   \
+    do {                                                  \
+        const int mark_ = sdfccd__hold_mark();            \
+        const sdfccd_Status st_ = (body);                 \
+        sdfccd__hold_release_to(mark_);                   \
+        return st_;                                       \
+    } while (0)
+
+/* Common prologue: out_result, params, interval, SDF handle (acquired) and SDF motion. */
 typedef struct query_setup {
     scc_params p;
     sdfccd__sdf* sdf;
@@ -199,7 +209,7 @@ static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motio
         if ((st = convert_motion(sdf_motion, t0, t1, what, &q->sdf_motion))) return st;
         q->sdf_motion_ptr = &q->sdf_motion;
     }
-    q->sdf = sdfccd__sdf_lookup(sdf);
+    q->sdf = sdfccd__sdf_acquire(sdf); /* held until the public call returns (HELD_CALL) */
     if (!q->sdf) return SDFCCD_INVALID_HANDLE;
     return SDFCCD_OK;
 }
@@ -258,7 +268,7 @@ static sdfccd_Status run_triangle(const query_setup* q, const scc_tri_motion* m,
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3],
+static sdfccd_Status query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3],
                                     const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
                                     sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
@@ -286,7 +296,7 @@ sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* 
     return run_triangle(&q, &m, t0, t1, out_contacts, capacity, out_result, fn);
 }
 
-sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3],
+static sdfccd_Status query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3],
                                            const sdfccd_Vec3 end[3], double t0, double t1, const sdfccd_QueryParams* params,
                                            sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
@@ -317,6 +327,20 @@ sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
 struct sdfccd_Workspace {
     scc_workspace ws;
 };
+
+sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3],
+                                    const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
+                                    sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
+{
+    HELD_CALL(query_triangle(sdf, sdf_motion, triangle, motion, t0, t1, params, out_contacts, capacity, out_result));
+}
+
+sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3],
+                                           const sdfccd_Vec3 end[3], double t0, double t1, const sdfccd_QueryParams* params,
+                                           sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
+{
+    HELD_CALL(query_triangle_linear(sdf, sdf_motion, start, end, t0, t1, params, out_contacts, capacity, out_result));
+}
 
 sdfccd_Status sdfccd_create_workspace(sdfccd_Workspace** out_workspace)
 {
@@ -368,7 +392,7 @@ static sdfccd_Status query_mesh(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, c
     scc_rigid body;
     if ((st = convert_motion(motion, t0, t1, what, &body))) return st;
     if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
+    sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     if ((st = check_mesh_bounds(m, fn))) return st;
     scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1 };
@@ -384,7 +408,7 @@ sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_
                                 const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
                                 sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
-    return query_mesh(NULL, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh");
+    HELD_CALL(query_mesh(NULL, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh"));
 }
 
 sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
@@ -393,7 +417,7 @@ sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_mesh_ws: workspace"))) return st;
-    return query_mesh(workspace, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh_ws");
+    HELD_CALL(query_mesh(workspace, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh_ws"));
 }
 
 static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
@@ -409,7 +433,7 @@ static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId
     if ((st = sdfccd__check_ptr(start, what))) return st;
     snprintf(what, sizeof what, "%s: end", fn);
     if ((st = sdfccd__check_ptr(end, what))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
+    sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     uint32_t nv = m->mesh.vertex_count;
     for (uint32_t i = 0; i < nv; ++i) {
@@ -441,8 +465,8 @@ sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotio
                                        const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
                                        sdfccd_QueryResult* out_result)
 {
-    return query_mesh_linear(NULL, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
-                             "sdfccd_query_mesh_linear");
+    HELD_CALL(query_mesh_linear(NULL, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
+                                "sdfccd_query_mesh_linear"));
 }
 
 sdfccd_Status sdfccd_query_mesh_linear_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
@@ -452,6 +476,6 @@ sdfccd_Status sdfccd_query_mesh_linear_ws(sdfccd_Workspace* workspace, sdfccd_Sd
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_mesh_linear_ws: workspace"))) return st;
-    return query_mesh_linear(workspace, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
-                             "sdfccd_query_mesh_linear_ws");
+    HELD_CALL(query_mesh_linear(workspace, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
+                                "sdfccd_query_mesh_linear_ws"));
 }

@@ -101,9 +101,7 @@ sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId id)
 {
     sdfccd__mesh* m = sdfccd__registry_remove(id.index1, id.generation, SDFCCD__KIND_MESH);
     if (!m) return sdfccd__error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_mesh: handle {%u, %u} is not a live mesh", id.index1, id.generation);
-    scc_bsh_destroy(m->bsh, sdfccd__allocator());
-    sdfccd__free(m->block, m->block_size);
-    sdfccd__free(m, sizeof *m);
+    sdfccd__mesh_release(m); /* freed now, or when the last query using it returns */
     return SDFCCD_OK;
 }
 

@@ -268,11 +268,13 @@ sdfccd_Status sdfccd_sdf_eval(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(out_value, "sdfccd_sdf_eval: out_value")) || (st = sdfccd__check_vec(p, "sdfccd_sdf_eval: p"))) return st;
-    sdfccd__sdf* s = sdfccd__sdf_lookup(sdf);
+    const int mark = sdfccd__hold_mark();
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf); /* a concurrent destroy frees it after this call */
     if (!s) return SDFCCD_INVALID_HANDLE;
     scc_vec3 g;
     *out_value = scc_sdf_eval(s->sdf, sdfccd__v(p), out_grad ? &g : NULL);
     if (out_grad) *out_grad = sdfccd__pv(g);
+    sdfccd__hold_release_to(mark);
     return SDFCCD_OK;
 }
 
