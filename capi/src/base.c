@@ -101,6 +101,12 @@ sdfccd_Status sdfccd__check_vec(sdfccd_Vec3 v, const char* what)
 
 const char* sdfccd_last_error(void) { return s_message; }
 
+sdfccd_Status sdfccd__check_def(int32_t internal_value, const char* fn, const char* what, const char* default_fn)
+{
+    if (internal_value == SDFCCD__DEF_COOKIE) return SDFCCD_OK;
+    return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %s not initialised with %s()", fn, what, default_fn);
+}
+
 const char* sdfccd_status_string(sdfccd_Status status)
 {
     static const char* const names[SDFCCD_STATUS_COUNT] = {

@@ -38,6 +38,12 @@ static inline sdfccd_Vec3 sdfccd__pv(scc_vec3 v) { sdfccd_Vec3 r = { v.x, v.y, v
 static inline scc_aabb sdfccd__box(sdfccd_Aabb b) { scc_aabb r = { sdfccd__v(b.lo), sdfccd__v(b.hi) }; return r; }
 static inline sdfccd_Aabb sdfccd__pbox(scc_aabb b) { sdfccd_Aabb r = { sdfccd__pv(b.lo), sdfccd__pv(b.hi) }; return r; }
 
+/* ---- defs: every sdfccd_default_*() sets internal_value to this cookie; a def without it was
+ * not initialised by its default function ---- */
+#define SDFCCD__DEF_COOKIE 0x5DFCCD01
+/* OK, or INVALID_ARGUMENT "FN: WHAT was not initialised with DEFAULT_FN()" when the cookie is missing. */
+sdfccd_Status sdfccd__check_def(int32_t internal_value, const char* fn, const char* what, const char* default_fn);
+
 /* ---- the handle registry (base.c), shared by SDF and mesh objects ---- */
 enum { SDFCCD__KIND_FREE = 0, SDFCCD__KIND_SDF = 1, SDFCCD__KIND_MESH = 2 };
 /* Adds `obj` under a new generation-checked id; 0 when the table cannot grow. */

@@ -7,7 +7,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#define DEF_COOKIE 0x5DFCCD01
 
 sdfccd_QueryParams sdfccd_default_query_params(void)
 {
@@ -30,7 +29,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.certified_time_tolerance = 1e-7;
     p.certified_max_regions = 2000000;
     p.broad_phase = 1;
-    p.internal_value = DEF_COOKIE;
+    p.internal_value = SDFCCD__DEF_COOKIE;
     p.max_sdf_evaluations = SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS;
     p.fwgss_secant_entry = 1;
     p.fwgss_speed_tolerance = 1;
@@ -48,9 +47,9 @@ sdfccd_RigidMotion sdfccd_default_rigid_motion(void)
 
 sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* fn, scc_params* out)
 {
+    sdfccd_Status st;
     if (!in) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
-    if (in->internal_value != DEF_COOKIE)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params were not initialised with sdfccd_default_query_params()", fn);
+    if ((st = sdfccd__check_def(in->internal_value, fn, "params were", "sdfccd_default_query_params"))) return st;
     if ((int)in->method < 0 || in->method >= SDFCCD_METHOD_COUNT)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: unknown method %d", fn, (int)in->method);
 #define POS(f) if (!isfinite(in->f) || !(in->f > 0.0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->" #f " must be finite and > 0 (got %g)", fn, in->f)

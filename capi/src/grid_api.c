@@ -10,7 +10,6 @@
 
 #include "../../core/mesh_distance.h"
 
-#define GRID_DEF_MAGIC 0x5DFCCD31
 
 /* ---------------- handles ---------------- */
 
@@ -144,15 +143,15 @@ sdfccd_GridDef sdfccd_default_grid_def(void)
     d.fit_domain = 1;
     d.band = 0.0;
     d.threads = 0;
-    d.internal_value = GRID_DEF_MAGIC;
+    d.internal_value = SDFCCD__DEF_COOKIE;
     return d;
 }
 
 static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
 {
+    sdfccd_Status st;
     if (!def) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: def is NULL", fn);
-    if (def->internal_value != GRID_DEF_MAGIC)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: def was not initialised with sdfccd_default_grid_def()", fn);
+    if ((st = sdfccd__check_def(def->internal_value, fn, "def was", "sdfccd_default_grid_def"))) return st;
     for (int i = 0; i < 3; ++i)
         if (def->resolution[i] < 1)
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: resolution[%d] = %d must be >= 1", fn, i, def->resolution[i]);
@@ -161,7 +160,6 @@ static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: resolution %d x %d x %d needs more than 2^32 nodes", fn,
                              def->resolution[0], def->resolution[1], def->resolution[2]);
     if (!def->fit_domain) {
-        sdfccd_Status st;
         if ((st = sdfccd__check_vec(def->domain.lo, "domain.lo")) || (st = sdfccd__check_vec(def->domain.hi, "domain.hi"))) return st;
         if (!(def->domain.lo.x < def->domain.hi.x && def->domain.lo.y < def->domain.hi.y && def->domain.lo.z < def->domain.hi.z))
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: domain.lo must be below domain.hi on every axis", fn);

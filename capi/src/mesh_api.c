@@ -109,7 +109,7 @@ sdfccd_MeshDef sdfccd_default_mesh_def(void)
 {
     sdfccd_MeshDef d;
     memset(&d, 0, sizeof d);
-    d.internal_value = 0x5DFCCD01;
+    d.internal_value = SDFCCD__DEF_COOKIE;
     return d;
 }
 
@@ -118,8 +118,7 @@ sdfccd_Status sdfccd_create_mesh(const sdfccd_MeshDef* def, sdfccd_MeshId* out_m
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(def, "sdfccd_create_mesh: def")) || (st = sdfccd__check_ptr(out_mesh, "sdfccd_create_mesh: out_mesh")))
         return st;
-    if (def->internal_value != 0x5DFCCD01)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_mesh: def was not initialised with sdfccd_default_mesh_def()");
+    if ((st = sdfccd__check_def(def->internal_value, "sdfccd_create_mesh", "def was", "sdfccd_default_mesh_def"))) return st;
     return sdfccd__mesh_create(def->vertices, def->vertex_count, def->indices, def->triangle_count,
                                def->drop_degenerate, "sdfccd_create_mesh", out_mesh);
 }

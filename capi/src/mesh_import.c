@@ -17,7 +17,6 @@
 #include <assimp/scene.h>
 #endif
 
-#define LOAD_DEF_MAGIC 0x5DFCCD32
 
 sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void)
 {
@@ -26,7 +25,7 @@ sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void)
     d.scale = 1.0;
     d.merge_vertices = 1;
     d.drop_degenerate = 1;
-    d.internal_value = LOAD_DEF_MAGIC;
+    d.internal_value = SDFCCD__DEF_COOKIE;
     d.max_file_bytes = (int64_t)256 << 20;
     d.formats = NULL;
     return d;
@@ -146,8 +145,7 @@ sdfccd_Status sdfccd_load_mesh(const char* path, const sdfccd_MeshLoadDef* def, 
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(path, "sdfccd_load_mesh: path")) || (st = sdfccd__check_ptr(out_mesh, "sdfccd_load_mesh: out_mesh"))) return st;
     sdfccd_MeshLoadDef d = def ? *def : sdfccd_default_mesh_load_def();
-    if (d.internal_value != LOAD_DEF_MAGIC)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: def was not initialised with sdfccd_default_mesh_load_def()");
+    if ((st = sdfccd__check_def(d.internal_value, "sdfccd_load_mesh", "def was", "sdfccd_default_mesh_load_def"))) return st;
     if (!isfinite(d.scale) || d.scale == 0.0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_load_mesh: scale = %g must be finite and non-zero", d.scale);
     if (d.max_file_bytes < 1)

@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#define DEF_COOKIE 0x5DFCCD01
 
 static sdfccd_Status positive(double v, const char* what)
 {
@@ -122,7 +121,7 @@ sdfccd_SpikeGridDef sdfccd_default_spike_grid_def(void)
     d.base_radius = 0.05;
     d.height = 0.1;
     d.count_x = d.count_y = 20;
-    d.internal_value = DEF_COOKIE;
+    d.internal_value = SDFCCD__DEF_COOKIE;
     return d;
 }
 
@@ -131,8 +130,7 @@ sdfccd_Status sdfccd_create_spike_grid(const sdfccd_SpikeGridDef* def, sdfccd_Sd
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(def, "sdfccd_create_spike_grid: def")) || (st = sdfccd__check_ptr(out_sdf, "sdfccd_create_spike_grid: out_sdf")))
         return st;
-    if (def->internal_value != DEF_COOKIE)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_spike_grid: def was not initialised with sdfccd_default_spike_grid_def()");
+    if ((st = sdfccd__check_def(def->internal_value, "sdfccd_create_spike_grid", "def was", "sdfccd_default_spike_grid_def"))) return st;
     if ((st = positive(def->spacing, "spike grid spacing")) || (st = positive(def->base_radius, "spike grid base_radius")) ||
         (st = positive(def->height, "spike grid height")))
         return st;
@@ -231,7 +229,7 @@ sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void)
     d.lipschitz = 1.0;
     d.bounds.lo.x = d.bounds.lo.y = d.bounds.lo.z = -INFINITY;
     d.bounds.hi.x = d.bounds.hi.y = d.bounds.hi.z = INFINITY;
-    d.internal_value = DEF_COOKIE;
+    d.internal_value = SDFCCD__DEF_COOKIE;
     return d;
 }
 
@@ -240,8 +238,7 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(def, "sdfccd_create_callback_sdf: def")) || (st = sdfccd__check_ptr(out_sdf, "sdfccd_create_callback_sdf: out_sdf")))
         return st;
-    if (def->internal_value != DEF_COOKIE)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def was not initialised with sdfccd_default_callback_sdf_def()");
+    if ((st = sdfccd__check_def(def->internal_value, "sdfccd_create_callback_sdf", "def was", "sdfccd_default_callback_sdf_def"))) return st;
     if (!def->eval) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def->eval is NULL");
     if ((st = positive(def->lipschitz, "sdfccd_create_callback_sdf: lipschitz"))) return st;
     if (isnan(def->bounds.lo.x) || isnan(def->bounds.lo.y) || isnan(def->bounds.lo.z) || isnan(def->bounds.hi.x) ||
