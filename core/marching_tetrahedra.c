@@ -7,27 +7,6 @@
 #include <float.h>
 #include <string.h>
 
-/* ---- growable arrays through the allocator ---- */
-
-static int grow(const scc_allocator* a, void** data, size_t* cap, size_t elem, size_t need)
-{
-    if (need <= *cap) return 1;
-    size_t ncap = *cap ? *cap : 256;
-    while (ncap < need) {
-        if (ncap > SIZE_MAX / 2 / elem) return 0;
-        ncap *= 2;
-    }
-    void* nd = scc_alloc(a, ncap * elem);
-    if (!nd) return 0;
-    if (*data) {
-        memcpy(nd, *data, *cap * elem);
-        scc_free(a, *data, *cap * elem);
-    }
-    *data = nd;
-    *cap = ncap;
-    return 1;
-}
-
 /* ---- edge -> vertex map (open addressing; key 0 means empty) ---- */
 
 typedef struct edge_map {
@@ -178,7 +157,7 @@ static uint32_t edge_vertex(mc_ctx* c, const mc_corner* a, const mc_corner* b)
     if (c->map.keys[s]) return c->map.values[s];
     scc_isosurface* o = c->out;
     if (o->vertex_count == UINT32_MAX - 1) { c->fail = SCC_MT_TOO_LARGE; return UINT32_MAX; }
-    if (!grow(c->a, (void**)&o->vertices, &o->vertex_capacity, sizeof(scc_vec3), (size_t)o->vertex_count + 1)) {
+    if (!scc_array_reserve(c->a, (void**)&o->vertices, &o->vertex_capacity, sizeof(scc_vec3), (size_t)o->vertex_count + 1, 256)) {
         c->fail = SCC_MT_OUT_OF_MEMORY;
         return UINT32_MAX;
     }
@@ -195,7 +174,7 @@ static void emit(mc_ctx* c, uint32_t a, uint32_t b, uint32_t d, scc_vec3 outward
     if (c->fail) return;
     scc_isosurface* o = c->out;
     if (o->triangle_count == UINT32_MAX / 3) { c->fail = SCC_MT_TOO_LARGE; return; }
-    if (!grow(c->a, (void**)&o->indices, &o->index_capacity, sizeof(uint32_t), 3 * ((size_t)o->triangle_count + 1))) {
+    if (!scc_array_reserve(c->a, (void**)&o->indices, &o->index_capacity, sizeof(uint32_t), 3 * ((size_t)o->triangle_count + 1), 256)) {
         c->fail = SCC_MT_OUT_OF_MEMORY;
         return;
     }

@@ -20,15 +20,9 @@ typedef struct contact_buf {
 
 static int buf_push(contact_buf* b, const scc_contact* c)
 {
-    if (b->n == b->cap) {
-        size_t cap = b->cap ? 2 * b->cap : 32;
-        scc_contact* na = scc_alloc(b->alloc, cap * sizeof *na);
-        if (!na) return 0;
-        for (size_t i = 0; i < b->n; ++i) na[i] = b->a[i];
-        scc_free(b->alloc, b->a, b->cap * sizeof *b->a);
-        b->a = na;
-        b->cap = cap;
-    }
+    void* data = b->a;
+    if (!scc_array_reserve(b->alloc, &data, &b->cap, sizeof *b->a, b->n + 1, 32)) return 0;
+    b->a = data;
     b->a[b->n++] = *c;
     return 1;
 }

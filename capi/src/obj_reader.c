@@ -12,19 +12,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A growable array of `elem`-byte records (core/alloc.h's scc_array_reserve, counted allocator). */
 typedef struct growbuf { void* p; size_t used, cap, elem; } growbuf;
 
 static int grow_push(growbuf* b, const void* v)
 {
-    if (b->used == b->cap) {
-        size_t nc = b->cap ? 2 * b->cap : 1024;
-        void* np = sdfccd__alloc(nc * b->elem);
-        if (!np) return 0;
-        if (b->p) memcpy(np, b->p, b->used * b->elem);
-        sdfccd__free(b->p, b->cap * b->elem);
-        b->p = np;
-        b->cap = nc;
-    }
+    if (!scc_array_reserve(sdfccd__allocator(), &b->p, &b->cap, b->elem, b->used + 1, 1024)) return 0;
     memcpy((char*)b->p + b->used * b->elem, v, b->elem);
     b->used++;
     return 1;
