@@ -32,4 +32,13 @@ static inline double scc_triangle_area2(scc_vec3 a, scc_vec3 b, scc_vec3 c)
     return scc_len(scc_cross(scc_sub(b, a), scc_sub(c, a)));
 }
 
+/* The one zero-area test (mesh creation and the triangle queries): true when twice the area is at
+ * most 1e-12 times the larger squared edge from a (so the test does not depend on the unit), when
+ * a coincides with b and c, or when a coordinate is NaN. */
+static inline int scc_triangle_is_degenerate(scc_vec3 a, scc_vec3 b, scc_vec3 c)
+{
+    const double scale = fmax(scc_len2(scc_sub(b, a)), scc_len2(scc_sub(c, a)));
+    return scale == 0.0 || !(scc_triangle_area2(a, b, c) > 1e-12 * scale);
+}
+
 #endif

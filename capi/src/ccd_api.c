@@ -250,12 +250,6 @@ static void write_result(const query_setup* q, double t0, double t1, const scc_q
     }
 }
 
-static int degenerate(const scc_vec3 v[3])
-{
-    double scale = fmax(scc_len2(scc_sub(v[1], v[0])), scc_len2(scc_sub(v[2], v[0])));
-    return scale == 0.0 || !(scc_triangle_area2(v[0], v[1], v[2]) > 1e-12 * scale);
-}
-
 static sdfccd_Status run_triangle(const query_setup* q, const scc_tri_motion* m, double t0, double t1,
                                   sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result, const char* fn)
 {
@@ -284,7 +278,7 @@ static sdfccd_Status query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* 
         if ((st = check_magnitude(triangle[i], "sdfccd_query_triangle: triangle vertex"))) return st;
         m.local[i] = sdfccd__v(triangle[i]);
     }
-    if (degenerate(m.local)) return sdfccd__error(SDFCCD_DEGENERATE, "%s: the triangle has zero area", fn);
+    if (scc_triangle_is_degenerate(m.local[0], m.local[1], m.local[2])) return sdfccd__error(SDFCCD_DEGENERATE, "%s: the triangle has zero area", fn);
     if ((st = convert_motion(motion, t0, t1, "sdfccd_query_triangle: motion", &body))) return st;
     if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
     m.kind = SCC_TRI_RIGID;
@@ -314,7 +308,7 @@ static sdfccd_Status query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
         m.start[i] = sdfccd__v(start[i]);
         m.end[i] = sdfccd__v(end[i]);
     }
-    if (degenerate(m.start)) return sdfccd__error(SDFCCD_DEGENERATE, "%s: the triangle has zero area at t0", fn);
+    if (scc_triangle_is_degenerate(m.start[0], m.start[1], m.start[2])) return sdfccd__error(SDFCCD_DEGENERATE, "%s: the triangle has zero area at t0", fn);
     m.kind = SCC_TRI_LINEAR;
     m.sdf = q.sdf_motion_ptr;
     m.t0 = t0;

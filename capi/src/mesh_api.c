@@ -30,8 +30,7 @@ sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count,
         scc_vec3 a = { vertices[3 * f[0]], vertices[3 * f[0] + 1], vertices[3 * f[0] + 2] };
         scc_vec3 b = { vertices[3 * f[1]], vertices[3 * f[1] + 1], vertices[3 * f[1] + 2] };
         scc_vec3 c = { vertices[3 * f[2]], vertices[3 * f[2] + 1], vertices[3 * f[2] + 2] };
-        double scale = fmax(scc_len2(scc_sub(b, a)), scc_len2(scc_sub(c, a)));
-        int degenerate = !(scc_triangle_area2(a, b, c) > 1e-12 * scale) || scale == 0.0;
+        const int degenerate = scc_triangle_is_degenerate(a, b, c);
         if (degenerate && !drop_degenerate)
             return sdfccd__error(SDFCCD_DEGENERATE, "%s: triangle %u (vertices %u %u %u) has zero area", what, t, f[0], f[1], f[2]);
         kept += !degenerate;
@@ -58,8 +57,7 @@ sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count,
     uint32_t k = 0;
     for (uint32_t t = 0; t < triangle_count; ++t) {
         const uint32_t* f = indices + 3 * t;
-        double scale = fmax(scc_len2(scc_sub(v[f[1]], v[f[0]])), scc_len2(scc_sub(v[f[2]], v[f[0]])));
-        if (!(scc_triangle_area2(v[f[0]], v[f[1]], v[f[2]]) > 1e-12 * scale) || scale == 0.0) continue;
+        if (scc_triangle_is_degenerate(v[f[0]], v[f[1]], v[f[2]])) continue;
         idx[3 * k] = f[0]; idx[3 * k + 1] = f[1]; idx[3 * k + 2] = f[2];
         ++k;
     }
