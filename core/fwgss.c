@@ -149,7 +149,10 @@ static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 
     double len = scc_dist(end, xn);
     if (!(len > s->dist_tol)) return 0.0;
     space_ctx k = { s, xn, end, { s->b[0], s->b[1], s->b[2] }, { bb[0], bb[1], bb[2] }, t };
-    scc_gss_result sp = scc_gss_minimize(0.0, 1.0, s->dist_tol / len, p->max_ls_iter, phi_on_segment, &k);
+    /* Brent's parabolic steps (ours) converge superlinearly where phi is smooth along the segment;
+     * golden section (Algorithm 1) otherwise. */
+    scc_gss_result sp = p->fwgss_brent_spatial ? scc_brent_minimize(0.0, 1.0, s->dist_tol / len, p->max_ls_iter, phi_on_segment, &k)
+                                               : scc_gss_minimize(0.0, 1.0, s->dist_tol / len, p->max_ls_iter, phi_on_segment, &k);
     for (int j = 0; j < 3; ++j) s->b[j] = fmax((1.0 - sp.l) * s->b[j] + sp.l * bb[j], 0.0);
     return sp.l * len;
 }

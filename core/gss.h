@@ -18,4 +18,8 @@ typedef struct scc_gss_result {
  * Returns the best of the final bracket's ends and its midpoint, as Algorithm 1 does. */
 scc_gss_result scc_gss_minimize(double a, double b, double tol, int max_iter, scc_gss_fn* f, void* ctx);
 
+/* Brent's minimiser over [a, b] (a <= b): parabolic steps safeguarded by golden section; the same
+ * result struct. Converges superlinearly near a smooth minimum. */
+scc_gss_result scc_brent_minimize(double a, double b, double tol, int max_iter, scc_gss_fn* f, void* ctx);
+
 #endif

@@ -49,6 +49,28 @@ START_TEST(test_gss_known_minima)
 }
 END_TEST
 
+/* Brent's minimiser (the FWGSS option fwgss_brent_spatial): same minima, far fewer evaluations on
+ * a smooth function, still converges on a kink and at an interval end, and reports its cap. */
+START_TEST(test_brent_known_minima)
+{
+    double m = 0.3;
+    scc_gss_result r = scc_brent_minimize(0.0, 1.0, 1e-9, 200, quad, &m);
+    ck_assert_double_near(r.l, 0.3, 1e-8);
+    ck_assert(r.converged);
+    ck_assert_int_le(r.evals, 10); /* a parabola: exact after one parabolic step, then the stopping steps */
+    r = scc_brent_minimize(0.0, 1.0, 1e-9, 200, vee, NULL);
+    ck_assert_double_near(r.l, 0.7, 1e-8);
+    ck_assert(r.converged);
+    r = scc_brent_minimize(2.0, 5.0, 1e-10, 200, cosine, NULL);
+    ck_assert_double_near(r.l, M_PI, 5e-8);
+    r = scc_brent_minimize(-1.0, 1.0, 1e-9, 200, rising, NULL);
+    ck_assert_double_near(r.l, -1.0, 1e-8);
+    r = scc_brent_minimize(0.0, 1.0, 1e-12, 3, vee, NULL);
+    ck_assert(!r.converged);
+    ck_assert_int_eq(r.evals, 4);
+}
+END_TEST
+
 static scc_params default_params(void)
 {
     scc_params p = { 0 };
@@ -122,6 +144,7 @@ int main(void)
     Suite* s = suite_create("solvers");
     TCase* g = tcase_create("gss");
     tcase_add_test(g, test_gss_known_minima);
+    tcase_add_test(g, test_brent_known_minima);
     suite_add_tcase(s, g);
     TCase* d = tcase_create("dcd");
     tcase_add_test(d, test_dcd_deepest_vertex);

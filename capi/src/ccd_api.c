@@ -34,6 +34,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.fwgss_secant_entry = 1;
     p.fwgss_speed_tolerance = 1;
     p.fwgss_clear_proof = 64;
+    p.fwgss_brent_spatial = 0;
     return p;
 }
 
@@ -100,6 +101,7 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     out->max_evals = in->max_sdf_evaluations;
     out->fwgss_secant = in->fwgss_secant_entry != 0;
     out->fwgss_speed_tol = in->fwgss_speed_tolerance != 0;
+    out->fwgss_brent_spatial = in->fwgss_brent_spatial != 0;
     if (in->fwgss_clear_proof < 0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_clear_proof must be >= 0 (got %d)", fn, in->fwgss_clear_proof);
     out->fwgss_clear_budget = in->fwgss_clear_proof;
