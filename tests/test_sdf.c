@@ -37,6 +37,45 @@ static void check_gradient(sdfccd_SdfId s, test_rng* rng, double extent)
     ck_assert_int_ge(checked, 300);
 }
 
+/* sdfccd_sdf_eval_batch gives sdfccd_sdf_eval's values and gradients bit for bit (analytic and
+ * CSG shapes at seeded random points), checks every point first, and rejects bad arguments. */
+START_TEST(test_eval_batch_matches_eval)
+{
+    sdfccd_SdfId torus, box, diff;
+    ck_assert_int_eq(sdfccd_create_torus(0.4, 0.1, &torus), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.3, 0.2, 0.1 }, &box), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_DIFFERENCE, torus, box, &diff), SDFCCD_OK);
+    enum { N = 257 };
+    sdfccd_Vec3 p[N], g[N];
+    double v[N];
+    test_rng r = { 42 };
+    for (int i = 0; i < N; ++i) p[i] = (sdfccd_Vec3){ test_rng_uniform(&r, -1, 1), test_rng_uniform(&r, -1, 1), test_rng_uniform(&r, -1, 1) };
+    const sdfccd_SdfId shapes[3] = { torus, box, diff };
+    for (int k = 0; k < 3; ++k) {
+        ck_assert_int_eq(sdfccd_sdf_eval_batch(shapes[k], p, N, v, g), SDFCCD_OK);
+        for (int i = 0; i < N; ++i) {
+            double v1;
+            sdfccd_Vec3 g1;
+            ck_assert_int_eq(sdfccd_sdf_eval(shapes[k], p[i], &v1, &g1), SDFCCD_OK);
+            ck_assert(v1 == v[i] && g1.x == g[i].x && g1.y == g[i].y && g1.z == g[i].z);
+        }
+        ck_assert_int_eq(sdfccd_sdf_eval_batch(shapes[k], p, N, v, NULL), SDFCCD_OK);
+    }
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(torus, p, 0, NULL, NULL), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(torus, p, -1, v, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(torus, NULL, 3, v, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(torus, p, 3, NULL, NULL), SDFCCD_INVALID_ARGUMENT);
+    v[1] = 123.0;
+    p[2].y = NAN;
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(torus, p, 3, v, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(v[1] == 123.0); /* nothing written before the check failed */
+    sdfccd_destroy_sdf(diff);
+    sdfccd_destroy_sdf(box);
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(box, p, 1, v, NULL), SDFCCD_INVALID_HANDLE);
+    sdfccd_destroy_sdf(torus);
+}
+END_TEST
+
 START_TEST(test_sphere)
 {
     sdfccd_SdfId s;
@@ -288,6 +327,7 @@ int main(void)
     tcase_add_test(tc, test_csg_and_transform);
     tcase_add_test(tc, test_callback);
     tcase_add_test(tc, test_bad_parameters);
+    tcase_add_test(tc, test_eval_batch_matches_eval);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

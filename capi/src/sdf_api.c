@@ -275,6 +275,28 @@ sdfccd_Status sdfccd_sdf_eval(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value
     return SDFCCD_OK;
 }
 
+sdfccd_Status sdfccd_sdf_eval_batch(sdfccd_SdfId sdf, const sdfccd_Vec3* points, int32_t count, double* out_values,
+                                     sdfccd_Vec3* out_grads)
+{
+    sdfccd_Status st;
+    if (count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_sdf_eval_batch: count = %d < 0", (int)count);
+    if (count > 0 && ((st = sdfccd__check_ptr(points, "sdfccd_sdf_eval_batch: points")) ||
+                      (st = sdfccd__check_ptr(out_values, "sdfccd_sdf_eval_batch: out_values"))))
+        return st;
+    for (int32_t i = 0; i < count; ++i)
+        if ((st = sdfccd__check_vec(points[i], "sdfccd_sdf_eval_batch: a point"))) return st;
+    const int mark = sdfccd__hold_mark();
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf); /* a concurrent destroy frees it after this call */
+    if (!s) return SDFCCD_INVALID_HANDLE;
+    for (int32_t i = 0; i < count; ++i) {
+        scc_vec3 g;
+        out_values[i] = scc_sdf_eval(s->sdf, sdfccd__v(points[i]), out_grads ? &g : NULL);
+        if (out_grads) out_grads[i] = sdfccd__pv(g);
+    }
+    sdfccd__hold_release_to(mark);
+    return SDFCCD_OK;
+}
+
 sdfccd_Status sdfccd_sdf_get_info(sdfccd_SdfId sdf, sdfccd_SdfInfo* out_info)
 {
     sdfccd_Status st;

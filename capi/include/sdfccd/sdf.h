@@ -118,6 +118,12 @@ SDFCCD_API sdfccd_Status sdfccd_destroy_sdf(sdfccd_SdfId sdf);
 /** Value (and gradient when out_grad is not NULL) at p, in the SDF's local frame. */
 SDFCCD_API sdfccd_Status sdfccd_sdf_eval(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad);
 
+/** sdfccd_sdf_eval() at `count` points with one handle lookup (the same values bit for bit):
+ * `out_values[i]` (and `out_grads[i]` when out_grads is not NULL) for `points[i]`. Every point is
+ * checked before any is evaluated (::SDFCCD_INVALID_ARGUMENT names the first non-finite one). */
+SDFCCD_API sdfccd_Status sdfccd_sdf_eval_batch(sdfccd_SdfId sdf, const sdfccd_Vec3* points, int32_t count, double* out_values,
+                                               sdfccd_Vec3* out_grads);
+
 /** What sdfccd_sdf_get_info() reports. */
 typedef struct sdfccd_SdfInfo {
     sdfccd_SdfKind kind;  /**< What created the SDF. */
