@@ -69,10 +69,10 @@ static void topology_from_edges(const scc_mesh* mesh, const edge_rec* e, scc_mes
 int scc_mesh_topology_check(const scc_allocator* a, const scc_mesh* mesh, scc_mesh_topology* out)
 {
     edge_rec* e = sorted_edges(a, mesh);
-    if (!e && mesh->triangle_count) return -1;
+    if (!e && mesh->triangle_count) return 0;
     topology_from_edges(mesh, e, out);
     scc_free(a, e, (size_t)mesh->triangle_count * 3 * sizeof *e);
-    return 0;
+    return 1;
 }
 
 static double mesh_sdf_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
@@ -99,10 +99,10 @@ int scc_mesh_sdf_init(scc_mesh_sdf* m, const scc_allocator* a, const scc_mesh* m
     m->edge_normal = scc_alloc(a, (size_t)nt * 3 * sizeof(scc_vec3));
     m->vertex_normal = scc_alloc(a, (size_t)nv * sizeof(scc_vec3));
     edge_rec* e = sorted_edges(a, mesh);
-    if (!m->face_normal || !m->edge_normal || !m->vertex_normal || !e || scc_tri_bvh_build(&m->bvh, a, mesh) != 0) {
+    if (!m->face_normal || !m->edge_normal || !m->vertex_normal || !e || !scc_tri_bvh_build(&m->bvh, a, mesh)) {
         scc_free(a, e, (size_t)nt * 3 * sizeof *e);
         scc_mesh_sdf_destroy(m);
-        return -1;
+        return 0;
     }
     topology_from_edges(mesh, e, &m->topology);
 
@@ -142,7 +142,7 @@ int scc_mesh_sdf_init(scc_mesh_sdf* m, const scc_allocator* a, const scc_mesh* m
     m->base.kind = SCC_SDF_CALLBACK;
     m->base.convex = 0; /* a mesh is not known to be convex */
     m->base.convex_in = NULL;
-    return 0;
+    return 1;
 }
 
 void scc_mesh_sdf_destroy(scc_mesh_sdf* m)

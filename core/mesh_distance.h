@@ -30,7 +30,7 @@ typedef struct scc_mesh_sdf {
 } scc_mesh_sdf;
 
 /* Builds the BVH, the pseudonormals and the topology report. The sign is only meaningful when
- * topology.closed is set; the caller decides what to do otherwise. 0 on success, -1 on OOM. */
+ * topology.closed is set; the caller decides what to do otherwise. 1 on success, 0 on OOM. */
 int scc_mesh_sdf_init(scc_mesh_sdf* m, const scc_allocator* a, const scc_mesh* mesh);
 void scc_mesh_sdf_destroy(scc_mesh_sdf* m);
 size_t scc_mesh_sdf_memory(const scc_mesh_sdf* m);
@@ -52,7 +52,7 @@ void scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, 
  * searching further than cap. */
 double scc_mesh_sdf_distance_capped(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, double cap);
 
-/* Only the topology report (no BVH). 0 on success, -1 on OOM. */
+/* Only the topology report (no BVH). 1 on success, 0 on OOM. */
 int scc_mesh_topology_check(const scc_allocator* a, const scc_mesh* mesh, scc_mesh_topology* out);
 
 #endif

@@ -139,7 +139,7 @@ int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* 
     memset(bvh, 0, sizeof *bvh);
     bvh->allocator = *a;
     const uint32_t n = mesh->triangle_count;
-    if (n == 0) return 0;
+    if (n == 0) return 1;
     bvh->node_capacity = 2 * n;
     bvh->nodes = scc_alloc(a, (size_t)bvh->node_capacity * sizeof *bvh->nodes);
     bvh->tris = scc_alloc(a, (size_t)n * 3 * sizeof(scc_vec3));
@@ -150,7 +150,7 @@ int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* 
     if (!bvh->nodes || !bvh->tris || !bvh->tri_index || !bvh->tri_boxes || !items) {
         scc_free(a, items, (size_t)n * sizeof *items);
         scc_tri_bvh_destroy(bvh);
-        return -1;
+        return 0;
     }
     for (uint32_t t = 0; t < n; ++t) {
         scc_vec3 v[3];
@@ -167,7 +167,7 @@ int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* 
         bvh->tri_boxes[i] = tri_box(mesh, items[i].tri);
     }
     scc_free(a, items, (size_t)n * sizeof *items);
-    return 0;
+    return 1;
 }
 
 void scc_tri_bvh_destroy(scc_tri_bvh* bvh)

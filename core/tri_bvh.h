@@ -38,7 +38,7 @@ typedef struct scc_tri_bvh {
 } scc_tri_bvh;
 
 /* Builds the hierarchy (median split on the longest axis of the centroid box, leaves of up
- * to 8 triangles). Returns 0 on success, -1 when out of memory. */
+ * to 8 triangles). Returns 1 on success, 0 when out of memory. */
 int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* mesh);
 void scc_tri_bvh_destroy(scc_tri_bvh* bvh);
 size_t scc_tri_bvh_memory(const scc_tri_bvh* bvh);

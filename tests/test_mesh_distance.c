@@ -79,7 +79,7 @@ START_TEST(test_bvh_vs_brute_force)
         sdfccd_MeshId id = test_load_mesh(meshes[mi]);
         const scc_mesh* m = &sdfccd__mesh_lookup(id)->mesh;
         scc_tri_bvh bvh;
-        ck_assert_int_eq(scc_tri_bvh_build(&bvh, sdfccd__allocator(), m), 0);
+        ck_assert_int_eq(scc_tri_bvh_build(&bvh, sdfccd__allocator(), m), 1);
         const scc_vec3 c = scc_scale(scc_add(m->bounds.lo, m->bounds.hi), 0.5), e = scc_sub(m->bounds.hi, m->bounds.lo);
         for (int it = 0; it < 2000; ++it) {
             const double s = it < 1000 ? 0.6 : 2.0; /* near and far */
@@ -102,7 +102,7 @@ START_TEST(test_bvh_vs_brute_force)
         scc_tri_bvh_destroy(&bvh);
         /* capped signed distance: exact below the cap, the cap above it */
         scc_mesh_sdf ms;
-        ck_assert_int_eq(scc_mesh_sdf_init(&ms, sdfccd__allocator(), m), 0);
+        ck_assert_int_eq(scc_mesh_sdf_init(&ms, sdfccd__allocator(), m), 1);
         uint32_t hint = UINT32_MAX, hint2 = UINT32_MAX;
         for (int it = 0; it < 500; ++it) {
             scc_vec3 p = scc_v3(c.x + e.x * test_rng_uniform(&rng, -1, 1), c.y + e.y * test_rng_uniform(&rng, -1, 1), c.z + e.z * test_rng_uniform(&rng, -1, 1));

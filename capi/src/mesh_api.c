@@ -170,7 +170,7 @@ sdfccd_Status sdfccd_mesh_get_topology(sdfccd_MeshId mesh, sdfccd_MeshTopology* 
     sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_topology t;
-    if (scc_mesh_topology_check(sdfccd__allocator(), &m->mesh, &t) != 0) return sdfccd__oom("a topology check");
+    if (!scc_mesh_topology_check(sdfccd__allocator(), &m->mesh, &t)) return sdfccd__oom("a topology check");
     out_topology->boundary_edges = t.boundary_edges;
     out_topology->nonmanifold_edges = t.nonmanifold_edges;
     out_topology->inconsistent_edges = t.inconsistent_edges;
@@ -192,7 +192,7 @@ sdfccd_Status sdfccd_mesh_signed_distance(sdfccd_MeshId mesh, const sdfccd_Vec3*
     sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_sdf ms;
-    if (scc_mesh_sdf_init(&ms, sdfccd__allocator(), &m->mesh) != 0) return sdfccd__oom("a mesh distance structure");
+    if (!scc_mesh_sdf_init(&ms, sdfccd__allocator(), &m->mesh)) return sdfccd__oom("a mesh distance structure");
     if (!allow_open && (st = sdfccd__mesh_topology_message(&ms.topology, "sdfccd_mesh_signed_distance"))) {
         scc_mesh_sdf_destroy(&ms);
         return st;
