@@ -2,6 +2,7 @@
  * sdfccd core: bounding-sphere hierarchy and padded sphere tracing (Section 4.6 of
  * Pelletier-Guenette et al., SCA 2025). The contract and the padding argument are in bsh.h. */
 #include "bsh.h"
+#include "select_kth.h"
 #include "min_heap.h"
 
 #include <string.h>
@@ -55,29 +56,6 @@ typedef struct build_ctx {
     uint32_t next;        /* next free node index */
 } build_ctx;
 
-static double axis_of(scc_vec3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
-
-/* Partially sorts order[lo, hi) so that order[k] holds the k-th smallest key (quickselect with
- * a three-way partition, so equal keys always make progress). */
-static void select_kth(uint32_t* order, const scc_vec3* centroid, int axis, uint32_t lo, uint32_t hi, uint32_t k)
-{
-    while (hi - lo > 1) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        double a = axis_of(centroid[order[lo]], axis), b = axis_of(centroid[order[mid]], axis), c = axis_of(centroid[order[hi - 1]], axis);
-        double pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-        uint32_t lt = lo, i = lo, gt = hi; /* [lo,lt) < pivot, [lt,i) == pivot, [gt,hi) > pivot */
-        while (i < gt) {
-            double v = axis_of(centroid[order[i]], axis);
-            if (v < pivot) { uint32_t tmp = order[i]; order[i] = order[lt]; order[lt] = tmp; ++lt; ++i; }
-            else if (v > pivot) { --gt; uint32_t tmp = order[i]; order[i] = order[gt]; order[gt] = tmp; }
-            else ++i;
-        }
-        if (k < lt) hi = lt;
-        else if (k >= gt) lo = gt;
-        else return;
-    }
-}
-
 static void build_node(build_ctx* b, uint32_t index, uint32_t lo, uint32_t hi)
 {
     scc_bsh_node* node = &b->nodes[index];
@@ -106,7 +84,7 @@ static void build_node(build_ctx* b, uint32_t index, uint32_t lo, uint32_t hi)
     scc_vec3 ext = scc_sub(cb.hi, cb.lo);
     int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     uint32_t mid = lo + (hi - lo) / 2;
-    select_kth(b->order, b->centroid, axis, lo, hi, mid);
+    scc_select_kth(b->order, b->centroid, axis, lo, hi, mid);
     uint32_t left = b->next;
     b->next += 2;
     node->first = left;

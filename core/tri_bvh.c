@@ -4,6 +4,7 @@
  * median-split AABB hierarchy over triangles with a best-first nearest query.
  */
 #include "tri_bvh.h"
+#include "select_kth.h"
 
 #include <string.h>
 
@@ -66,35 +67,10 @@ done:
 
 /* ---- build ---- */
 
-typedef struct build_item { scc_vec3 centroid; uint32_t tri; } build_item;
-
-static double axis_of(scc_vec3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
-
-/* Quickselect: reorders items[lo..hi) so the k-th smallest along `axis` sits at k. */
-static void select_kth(build_item* items, uint32_t lo, uint32_t hi, uint32_t k, int axis)
-{
-    while (hi - lo > 1) {
-        const uint32_t mid = lo + (hi - lo) / 2;
-        /* median of three pivot */
-        double a = axis_of(items[lo].centroid, axis), b = axis_of(items[mid].centroid, axis), c = axis_of(items[hi - 1].centroid, axis);
-        double pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-        /* three-way partition: [lo,lt) < pivot, [lt,gt) == pivot, [gt,hi) > pivot */
-        uint32_t lt = lo, i = lo, gt = hi;
-        while (i < gt) {
-            const double v = axis_of(items[i].centroid, axis);
-            if (v < pivot) { build_item t = items[lt]; items[lt] = items[i]; items[i] = t; ++lt; ++i; }
-            else if (v > pivot) { --gt; build_item t = items[gt]; items[gt] = items[i]; items[i] = t; }
-            else ++i;
-        }
-        if (k < lt) hi = lt;
-        else if (k >= gt) lo = gt;
-        else return;
-    }
-}
-
 typedef struct build_state {
     scc_tri_bvh* bvh;
-    build_item* items;
+    uint32_t* order;     /* mesh triangles, permuted by the build */
+    scc_vec3* centroid;  /* per mesh triangle */
     const scc_mesh* mesh;
 } build_state;
 
@@ -109,12 +85,12 @@ static scc_aabb tri_box(const scc_mesh* m, uint32_t t)
 static void build_node(build_state* s, uint32_t node, uint32_t lo, uint32_t hi)
 {
     scc_tri_bvh* bvh = s->bvh;
-    scc_aabb box = tri_box(s->mesh, s->items[lo].tri);
-    scc_aabb cbox = { s->items[lo].centroid, s->items[lo].centroid };
+    scc_aabb box = tri_box(s->mesh, s->order[lo]);
+    scc_aabb cbox = { s->centroid[s->order[lo]], s->centroid[s->order[lo]] };
     for (uint32_t i = lo + 1; i < hi; ++i) {
-        scc_aabb tb = tri_box(s->mesh, s->items[i].tri);
+        scc_aabb tb = tri_box(s->mesh, s->order[i]);
         box.lo = scc_vmin(box.lo, tb.lo); box.hi = scc_vmax(box.hi, tb.hi);
-        cbox.lo = scc_vmin(cbox.lo, s->items[i].centroid); cbox.hi = scc_vmax(cbox.hi, s->items[i].centroid);
+        cbox.lo = scc_vmin(cbox.lo, s->centroid[s->order[i]]); cbox.hi = scc_vmax(cbox.hi, s->centroid[s->order[i]]);
     }
     bvh->nodes[node].box = box;
     if (hi - lo <= 8) {
@@ -125,7 +101,7 @@ static void build_node(build_state* s, uint32_t node, uint32_t lo, uint32_t hi)
     const scc_vec3 ext = scc_sub(cbox.hi, cbox.lo);
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     const uint32_t mid = lo + (hi - lo) / 2;
-    select_kth(s->items, lo, hi, mid, axis);
+    scc_select_kth(s->order, s->centroid, axis, lo, hi, mid);
     const uint32_t left = bvh->node_count;
     bvh->node_count += 2;
     bvh->nodes[node].first = left;
@@ -145,28 +121,31 @@ int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* 
     bvh->tris = scc_alloc(a, (size_t)n * 3 * sizeof(scc_vec3));
     bvh->tri_index = scc_alloc(a, (size_t)n * sizeof(uint32_t));
     bvh->tri_boxes = scc_alloc(a, (size_t)n * sizeof(scc_aabb));
-    build_item* items = scc_alloc(a, (size_t)n * sizeof *items);
+    uint32_t* order = scc_alloc(a, (size_t)n * sizeof *order);
+    scc_vec3* centroid = scc_alloc(a, (size_t)n * sizeof *centroid);
     bvh->tri_count = n; /* before any failure: destroy frees the arrays with sizes from this count */
-    if (!bvh->nodes || !bvh->tris || !bvh->tri_index || !bvh->tri_boxes || !items) {
-        scc_free(a, items, (size_t)n * sizeof *items);
+    if (!bvh->nodes || !bvh->tris || !bvh->tri_index || !bvh->tri_boxes || !order || !centroid) {
+        scc_free(a, order, (size_t)n * sizeof *order);
+        scc_free(a, centroid, (size_t)n * sizeof *centroid);
         scc_tri_bvh_destroy(bvh);
         return 0;
     }
     for (uint32_t t = 0; t < n; ++t) {
         scc_vec3 v[3];
         scc_mesh_triangle(mesh, t, v);
-        items[t].centroid = scc_scale(scc_add(v[0], scc_add(v[1], v[2])), 1.0 / 3.0);
-        items[t].tri = t;
+        centroid[t] = scc_scale(scc_add(v[0], scc_add(v[1], v[2])), 1.0 / 3.0);
+        order[t] = t;
     }
-    build_state s = { bvh, items, mesh };
+    build_state s = { bvh, order, centroid, mesh };
     bvh->node_count = 1;
     build_node(&s, 0, 0, n);
     for (uint32_t i = 0; i < n; ++i) {
-        bvh->tri_index[i] = items[i].tri;
-        scc_mesh_triangle(mesh, items[i].tri, bvh->tris + 3 * (size_t)i);
-        bvh->tri_boxes[i] = tri_box(mesh, items[i].tri);
+        bvh->tri_index[i] = order[i];
+        scc_mesh_triangle(mesh, order[i], bvh->tris + 3 * (size_t)i);
+        bvh->tri_boxes[i] = tri_box(mesh, order[i]);
     }
-    scc_free(a, items, (size_t)n * sizeof *items);
+    scc_free(a, order, (size_t)n * sizeof *order);
+    scc_free(a, centroid, (size_t)n * sizeof *centroid);
     return 1;
 }
 
