@@ -134,7 +134,7 @@ for scene in $bullet_scenes; do
     label=${v%%:*}; args=${v#*:}
     # shellcheck disable=SC2086
     run "$scene" $args
-    ccd=$(awk '$1=="ccd_ms" {print $2 " " $3; exit}' "$TMP/last")
+    ccd=$(awk '$1=="ccd_ms" {print $2 " " $3 ")"; exit}' "$TMP/last")
     echo "| $scene | $label | $(mm "$(val max_penetration_m)") | $(val tunnelled) | $(moving) | $(val rest_speed_mps) | $(val step_ms) | $ccd |" >> "$MD"
   done
 done

@@ -81,7 +81,13 @@ void measure(Scene& scene, Measure& m)
             size_t n = pts.size() / 3;
             double lc[3];
             c.frame.applyInverse(&pts[3 * (n - 1)], lc);
-            if (dot3(&pts[3 * (n - 1)], c.kill_normal) > c.kill_offset) m.tunnelled[bi] = 1;
+            // Past the kill plane counts only over the collider's footprint (a body that leaves a
+            // floor over its edge and falls has not tunnelled).
+            bool over = true;
+            const double blo[3] = { c.bounds.lo.x, c.bounds.lo.y, c.bounds.lo.z }, bhi[3] = { c.bounds.hi.x, c.bounds.hi.y, c.bounds.hi.z };
+            for (int k = 0; k < 3; ++k)
+                if (std::fabs(c.kill_normal[k]) < 0.5 && (lc[k] < blo[k] || lc[k] > bhi[k])) over = false;
+            if (over && dot3(&pts[3 * (n - 1)], c.kill_normal) > c.kill_offset) m.tunnelled[bi] = 1;
             double reach = b.deformable ? 1e300 : b.mesh->radius;
             if (boxDistance(c.bounds, lc) > reach + 0.05) continue;
             owner.push_back(std::make_pair(bi, batch.size()));
