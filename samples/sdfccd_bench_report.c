@@ -64,6 +64,22 @@ static int load(const char* dir, const char* name, table* t)
     return t->head != NULL && t->rows > 0;
 }
 
+/* Frees what load() allocated (also after a failed load). */
+static void unload(table* t)
+{
+    const int width = 64;
+    for (int r = 0; r < t->rows; ++r) {
+        for (int i = 0; i < width; ++i) free(t->cell[r][i]);
+        free(t->cell[r]);
+    }
+    free(t->cell);
+    if (t->head) {
+        for (int i = 0; i < width; ++i) free(t->head[i]);
+        free(t->head);
+    }
+    memset(t, 0, sizeof *t);
+}
+
 static int col(const table* t, const char* name)
 {
     for (int i = 0; i < t->cols; ++i)
@@ -363,13 +379,21 @@ int main(int argc, char** argv)
     }
     table t, b;
     if (load(dir, "targets", &t)) section_targets(md, &t);
+    unload(&t);
     if (load(dir, "accuracy", &t)) section_accuracy(md, &t);
+    unload(&t);
     if (load(dir, "front", &t)) section_front(md, dir, &t);
+    unload(&t);
     if (load(dir, "scaling", &t)) section_scaling(md, &t);
+    unload(&t);
     if (load(dir, "cost", &t)) section_cost(md, &t);
+    unload(&t);
     if (load(dir, "batch", &t)) section_batch(md, &t);
+    unload(&t);
     int have_brute = load(dir, "brute", &b);
     if (load(dir, "dataset", &t)) section_dataset(md, &t, have_brute ? &b : NULL);
+    unload(&t);
+    unload(&b);
     fprintf(md, "## 8. Peers\n\nGImpact and FCL on the same cases: `sdfccd_peers` (needs the Bullet bridge and FCL), CSV `peers_cases.csv` "
                 "when present.\n");
     fclose(md);
