@@ -491,6 +491,33 @@ START_TEST(test_registry_in_user_allocator)
 }
 END_TEST
 
+/* Finding "memory": a 849^3 grid made one 32.7 GB request and extraction at resolution 1024 asked
+ * for 8.3 GB. Both now compare the size they need with a limit first. */
+START_TEST(test_memory_limits)
+{
+    sdfccd_SdfId s, g;
+    sdfccd_MeshId m;
+    ck_assert_int_eq(sdfccd_create_sphere(0.5, &s), SDFCCD_OK);
+    sdfccd_GridDef d = sdfccd_default_grid_def();
+    d.resolution[0] = d.resolution[1] = d.resolution[2] = 849;
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(s, &d, &g), SDFCCD_OUT_OF_MEMORY);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "max_bytes"));
+    d.resolution[0] = d.resolution[1] = d.resolution[2] = 8;
+    d.max_bytes = 1000;
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(s, &d, &g), SDFCCD_OUT_OF_MEMORY);
+    d.max_bytes = 0;
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(s, &d, &g), SDFCCD_INVALID_ARGUMENT);
+    d.max_bytes = 1 << 20;
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(s, &d, &g), SDFCCD_OK);
+    sdfccd_destroy_sdf(g);
+    sdfccd_Aabb box = { { -1, -1, -1 }, { 1, 1, 1 } };
+    ck_assert_int_eq(sdfccd_extract_isosurface(s, box, 1024, &m), SDFCCD_OUT_OF_MEMORY);
+    ck_assert_int_eq(sdfccd_extract_isosurface(s, box, 16, &m), SDFCCD_OK);
+    sdfccd_destroy_mesh(m);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("hardening");
@@ -507,6 +534,7 @@ int main(void)
     tcase_add_test(tc, test_mesh_files);
     tcase_add_test(tc, test_destroy_while_querying);
     tcase_add_test(tc, test_registry_in_user_allocator);
+    tcase_add_test(tc, test_memory_limits);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -17,6 +17,11 @@ sdfccd_Status sdfccd_extract_isosurface(sdfccd_SdfId sdf, sdfccd_Aabb box, int32
     if (resolution < 1 || resolution > SCC_MT_MAX_RESOLUTION)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_extract_isosurface: resolution %d is outside [1, %d]",
                              (int)resolution, SCC_MT_MAX_RESOLUTION);
+    /* About 8 bytes per lattice point (resolution 1024 asked for 8.3 GB): checked before allocating. */
+    const double need = 8.0 * ((double)resolution + 1.0) * ((double)resolution + 1.0) * ((double)resolution + 1.0);
+    if (need > SDFCCD_EXTRACT_MAX_BYTES)
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "sdfccd_extract_isosurface: resolution %d needs about %.4g bytes, above SDFCCD_EXTRACT_MAX_BYTES (%.4g)",
+                             (int)resolution, need, (double)SDFCCD_EXTRACT_MAX_BYTES);
 
     scc_isosurface iso;
     scc_mt_status ms = scc_marching_tetrahedra(s->sdf, sdfccd__box(box), resolution, 0.0, sdfccd__allocator(), &iso);

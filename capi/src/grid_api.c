@@ -144,6 +144,7 @@ sdfccd_GridDef sdfccd_default_grid_def(void)
     d.band = 0.0;
     d.threads = 0;
     d.internal_value = SDFCCD__DEF_COOKIE;
+    d.max_bytes = (int64_t)4 << 30;
     return d;
 }
 
@@ -159,6 +160,14 @@ static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
     if (n > 0x7FFFFFFEull || scc_grid_dense_node_count((const uint32_t[3]){ (uint32_t)def->resolution[0], (uint32_t)def->resolution[1], (uint32_t)def->resolution[2] }) >= 0xFFFFFFFFull)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: resolution %d x %d x %d needs more than 2^32 nodes", fn,
                              def->resolution[0], def->resolution[1], def->resolution[2]);
+    if (def->max_bytes < 1) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: max_bytes = %lld must be >= 1", fn, (long long)def->max_bytes);
+    {
+        const uint64_t nodes = scc_grid_dense_node_count((const uint32_t[3]){ (uint32_t)def->resolution[0], (uint32_t)def->resolution[1], (uint32_t)def->resolution[2] });
+        const double need = 8.0 * (double)nodes + 8.0 * (double)n;
+        if (need > (double)def->max_bytes)
+            return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: a %d x %d x %d grid needs about %.4g bytes (nodes and cell tables), above max_bytes (%lld)",
+                                 fn, def->resolution[0], def->resolution[1], def->resolution[2], need, (long long)def->max_bytes);
+    }
     if (!def->fit_domain) {
         if ((st = sdfccd__check_vec(def->domain.lo, "domain.lo")) || (st = sdfccd__check_vec(def->domain.hi, "domain.hi"))) return st;
         if (!(def->domain.lo.x < def->domain.hi.x && def->domain.lo.y < def->domain.hi.y && def->domain.lo.z < def->domain.hi.z))

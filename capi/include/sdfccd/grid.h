@@ -72,6 +72,12 @@ typedef struct sdfccd_GridDef {
     sdfccd_ProgressFcn* progress; /**< May be NULL. */
     void* progress_user;    /**< Passed to `progress`. */
     int32_t internal_value; /**< Set by sdfccd_default_grid_def(); do not change. */
+    /** Memory limit of the build (bytes, >= 1). Before allocating, the build computes what the dense
+     * node array and the per-cell tables need (8 bytes per node, 8 per cell) and returns
+     * ::SDFCCD_OUT_OF_MEMORY with that figure when it exceeds the limit (a 849^3 grid asked for
+     * 32.7 GB in one request). A narrow band still samples the dense array first, so the same
+     * figure applies to it. Default 4 GiB. */
+    int64_t max_bytes;
 } sdfccd_GridDef;
 
 /** Defaults: 32^3 cells, fitted domain without padding, dense, all cores, not inverted, closed meshes only, no progress. */
