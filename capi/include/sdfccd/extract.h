@@ -15,6 +15,10 @@
 extern "C" {
 #endif
 
+/** Memory limit of sdfccd_extract_isosurface (bytes): about 8 (resolution + 1)^3 bytes are needed,
+ * checked before allocating (::SDFCCD_OUT_OF_MEMORY with the figure); 1 GiB allows resolution 511. */
+#define SDFCCD_EXTRACT_MAX_BYTES 1073741824.0
+
 /** Extracts the surface phi = 0 of `sdf` inside `box` (SDF local frame, metres) into a new mesh.
  *
  * `resolution` (1..1024) is the number of grid cells along the box's longest axis; cells are
@@ -30,9 +34,6 @@ extern "C" {
  * contains no surface; ::SDFCCD_OUT_OF_MEMORY. On success the caller owns `*out_mesh`
  * (sdfccd_destroy_mesh). Near-degenerate slivers that the mesh validation rejects are dropped
  * and counted in sdfccd_MeshInfo::dropped_triangles (0 in the tests' scenes). */
-/** Memory limit of sdfccd_extract_isosurface (bytes): about 8 (resolution + 1)^3 bytes are needed,
- * checked before allocating (::SDFCCD_OUT_OF_MEMORY with the figure); 1 GiB allows resolution 511. */
-#define SDFCCD_EXTRACT_MAX_BYTES 1073741824.0
 SDFCCD_API sdfccd_Status sdfccd_extract_isosurface(sdfccd_SdfId sdf, sdfccd_Aabb box, int32_t resolution,
                                                    sdfccd_MeshId* out_mesh);
 
