@@ -4,7 +4,7 @@
 //   sdfccd_scenes --list
 //   sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]
 //                 [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]
-//                 [--margin M] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]
+//                 [--margin M] [--patch-band B] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]
 //
 // --table4 adds the paper's Table 4 figures (the CCD of the coming step through the C ABI, timed,
 // up to the first contact; see runner.h) as a "table4" line of the summary.
@@ -48,7 +48,7 @@ void usage(std::FILE* f)
                  "usage: sdfccd_scenes --list\n"
                  "       sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]\n"
                  "                     [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]\n"
-                 "                     [--margin M] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
+                 "                     [--margin M] [--patch-band B] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
                  "check keys: max_pen min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
 }
 
@@ -117,6 +117,7 @@ int main(int argc, char** argv)
         else if (a == "--stock") opt.stock = true;
         else if (a == "--quick") opt.quick = true;
         else if (a == "--margin") opt.margin = std::atof(value("metres"));
+        else if (a == "--patch-band") opt.patch_band = std::atof(value("metres"));
         else if (a == "--data") opt.data_dir = value("a folder");
         else if (a == "--check") check = value("limits");
         else if (a == "--quiet") quiet = true;

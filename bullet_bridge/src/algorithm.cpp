@@ -42,6 +42,12 @@ public:
     ~MeshSdfAlgorithm() override
     {
         if (m_manifold && m_own) m_dispatcher->releaseManifold(m_manifold);
+        if (m_patch) {
+            // Its points never fire started/ended (the first manifold speaks for the pair).
+            for (int i = 0; i < m_patch->getNumContacts(); ++i) m_patch->clearUserCache(m_patch->getContactPoint(i));
+            m_patch->setNumContacts(0);
+            m_dispatcher->releaseManifold(m_patch);
+        }
     }
 
     void processCollision(const btCollisionObjectWrapper* body0Wrap, const btCollisionObjectWrapper* body1Wrap,
@@ -57,8 +63,10 @@ public:
             m_manifold = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
             m_own = true;
         }
+        if (!m_patch && !m_closest && m_bridge->cfg.patch_band >= 0 && m_bridge->cfg.max_contacts >= MANIFOLD_CACHE_SIZE)
+            m_patch = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
         resultOut->setPersistentManifold(m_manifold);
-        m_bridge->process(mw, sw, dispatchInfo, resultOut, m_manifold, m_closest);
+        m_bridge->process(mw, sw, dispatchInfo, resultOut, m_manifold, m_patch, m_closest);
     }
 
     btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1, const btDispatcherInfo& dispatchInfo,
@@ -71,11 +79,13 @@ public:
     void getAllContactManifolds(btManifoldArray& manifoldArray) override
     {
         if (m_manifold && m_own) manifoldArray.push_back(m_manifold);
+        if (m_patch) manifoldArray.push_back(m_patch);
     }
 
 private:
     BridgeImpl* m_bridge;
     btPersistentManifold* m_manifold;
+    btPersistentManifold* m_patch = nullptr; // the contact patch's 4 more points (Config::patch_band)
     bool m_own;
     bool m_mesh_is_body1;
     bool m_closest;

@@ -352,46 +352,40 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     return !cands.empty();
 }
 
-void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
-                         btManifoldResult* out, btPersistentManifold* manifold, bool closest)
+namespace {
+
+// Writes the candidates `pick` into `manifold` (A = mesh, B = SDF) the way btManifoldResult and
+// btPersistentManifold::refreshContactPoints do it: a point of the same material point as one of
+// the last step keeps its warm start and lifetime; added / processed callbacks fire for every
+// point, started when the manifold gains its first point (primary manifold only: the patch
+// manifold never fires started or ended, the first one speaks for the pair).
+void writeManifold(btPersistentManifold* manifold, const std::vector<Candidate>& cands, const std::vector<int>& pick,
+                   const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, bool primary, Stats& stats)
 {
     const btCollisionObject* mo = mw->getCollisionObject();
     const btCollisionObject* so = sw->getCollisionObject();
-    const double dt = closest ? 0.0 : (double)info.m_timeStep;
-    const double margin = closest ? std::max(0.0, (double)out->m_closestPointDistanceThreshold) : cfg.contact_margin;
-    if (!closest && clamp_world) {
-        PairRecord r;
-        r.mesh = mo;
-        r.sdf = so;
-        r.child = mo->getWorldTransform().inverseTimes(mw->getWorldTransform());
-        r.shape = mw->getCollisionShape();
-        pairs.push_back(r);
-    }
-    double radius = 0;
-    const bool any = gather(mw, sw, dt, margin, scratch, &radius);
-    std::vector<int> pick;
-    if (any) pick = reduceContacts(scratch, cfg.max_contacts, std::max(1e-6, 1e-3 * radius), cfg.spread_depth_scale, -1);
-    if (closest) {
-        for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
-        return;
-    }
-    if (pick.empty()) {
-        manifold->clearManifold(); // fires the contact-ended callback if it had points
+    const int n_old = manifold->getNumContacts();
+    const int n = std::min((int)pick.size(), (int)MANIFOLD_CACHE_SIZE);
+    if (n == 0) {
+        if (primary) {
+            manifold->clearManifold(); // fires the contact-ended callback if it had points
+        } else {
+            for (int i = 0; i < n_old; ++i) manifold->clearUserCache(manifold->getContactPoint(i));
+            manifold->setNumContacts(0);
+        }
         return;
     }
     // The new points, in the manifold's order (A = mesh, B = SDF) and its bodies' frames.
     const btTransform& worldA = mo->getWorldTransform();
     const btTransform& worldB = so->getWorldTransform();
-    const int n_old = manifold->getNumContacts();
     btManifoldPoint old[MANIFOLD_CACHE_SIZE];
     for (int i = 0; i < n_old; ++i) old[i] = manifold->getContactPoint(i);
     bool matched[MANIFOLD_CACHE_SIZE] = { false, false, false, false };
     const btScalar match = manifold->getContactBreakingThreshold();
     btManifoldPoint pts[MANIFOLD_CACHE_SIZE];
-    const int n = std::min((int)pick.size(), (int)MANIFOLD_CACHE_SIZE);
     const int flags = mo->getCollisionFlags() | so->getCollisionFlags();
     for (int k = 0; k < n; ++k) {
-        const Candidate& c = scratch[pick[k]];
+        const Candidate& c = cands[pick[k]];
         btManifoldPoint pt(worldA.invXform(c.pA0), worldB.invXform(c.pB0), c.n0, (btScalar)c.d);
         pt.m_positionWorldOnA = c.pA0;
         pt.m_positionWorldOnB = c.pB0;
@@ -441,10 +435,57 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         for (int k = 0; k < n; ++k)
             gContactAddedCallback(manifold->getContactPoint(k), mw, pts[k].m_partId0, pts[k].m_index0, sw, pts[k].m_partId1,
                                   pts[k].m_index1);
-    if (gContactStartedCallback && n_old == 0) gContactStartedCallback(manifold);
+    if (primary && gContactStartedCallback && n_old == 0) gContactStartedCallback(manifold);
     if (gContactProcessedCallback)
         for (int k = 0; k < n; ++k)
             gContactProcessedCallback(manifold->getContactPoint(k), (void*)manifold->getBody0(), (void*)manifold->getBody1());
+}
+
+} // namespace
+
+void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
+                         btManifoldResult* out, btPersistentManifold* manifold, btPersistentManifold* patch, bool closest)
+{
+    const btCollisionObject* mo = mw->getCollisionObject();
+    const btCollisionObject* so = sw->getCollisionObject();
+    const double dt = closest ? 0.0 : (double)info.m_timeStep;
+    const double margin = closest ? std::max(0.0, (double)out->m_closestPointDistanceThreshold) : cfg.contact_margin;
+    if (!closest && clamp_world) {
+        PairRecord r;
+        r.mesh = mo;
+        r.sdf = so;
+        r.child = mo->getWorldTransform().inverseTimes(mw->getWorldTransform());
+        r.shape = mw->getCollisionShape();
+        pairs.push_back(r);
+    }
+    double radius = 0;
+    const bool any = gather(mw, sw, dt, margin, scratch, &radius);
+    const double tol = std::max(1e-6, 1e-3 * radius);
+    std::vector<int> pick;
+    if (any) pick = reduceContacts(scratch, cfg.max_contacts, tol, cfg.spread_depth_scale, -1);
+    // The contact patch: the candidates within patch_band of the deepest gap that are not within
+    // tol of a point already picked, spread over 4 more points.
+    std::vector<int> pick2;
+    if (any && patch && cfg.patch_band >= 0 && !pick.empty()) {
+        const double d0 = scratch[pick[0]].d;
+        std::vector<Candidate> sub;
+        std::vector<int> from;
+        for (int i = 0; i < (int)scratch.size(); ++i) {
+            if (!(scratch[i].d <= d0 + cfg.patch_band)) continue;
+            bool near = false;
+            for (int j : pick) near |= (double)(scratch[i].pB0 - scratch[j].pB0).length() <= tol;
+            if (near) continue;
+            sub.push_back(scratch[i]);
+            from.push_back(i);
+        }
+        for (int i : reduceContacts(sub, (int)MANIFOLD_CACHE_SIZE, tol, cfg.spread_depth_scale, -1)) pick2.push_back(from[i]);
+    }
+    if (closest) {
+        for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
+        return;
+    }
+    writeManifold(manifold, scratch, pick, mw, sw, true, stats);
+    if (patch) writeManifold(patch, scratch, pick2, mw, sw, false, stats);
 }
 
 double BridgeImpl::timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt)

@@ -128,7 +128,7 @@ public:
     bool gather(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin,
                 std::vector<detail::Candidate>& cands, double* out_radius);
     void process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
-                 btManifoldResult* out, btPersistentManifold* manifold, bool closest);
+                 btManifoldResult* out, btPersistentManifold* manifold, btPersistentManifold* patch, bool closest);
     double timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt);
 
     // hard_clamp.cpp

@@ -51,6 +51,7 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     cfg.query.method = opt.method;
     cfg.query.subdivision = opt.subdivision ? 1 : 0;
     if (opt.margin >= 0) cfg.contact_margin = opt.margin;
+    cfg.patch_band = opt.patch_band;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
     m_config.reset(new btDefaultCollisionConfiguration());

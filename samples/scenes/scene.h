@@ -34,6 +34,7 @@ struct Options {
     bool stock = false;   /**< Bullet scenes: the SDF surfaces as btBvhTriangleMeshShape (no bridge). */
     bool quick = false;   /**< Fewer bodies where a scene is large (the ctest variants; documented per scene). */
     double margin = -1;   /**< Contact margin (m) of the bridge / queries; < 0: the scene's default. */
+    double patch_band = -1; /**< Bullet scenes: the bridge's Config::patch_band (< 0: off, the default). */
     std::string data_dir; /**< The project's data/ folder. */
 };
 
