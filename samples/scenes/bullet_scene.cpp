@@ -154,15 +154,12 @@ Collider& BulletScene::addStaticSdf(const std::string& name, sdfccd_SdfId sdf, c
         std::unique_ptr<StockMesh> sm(new StockMesh);
         sdfccd_MeshId id{};
         sdfccd_Status st = sdfccd_extract_isosurface(sdf, bounds, stock_resolution, &id);
+        sdfccd_MeshInfo info;
+        std::vector<double> v;
+        std::vector<uint32_t> f;
         if (st != SDFCCD_OK) {
             std::fprintf(stderr, "sdfccd_scenes: isosurface of %s failed: %s\n", name.c_str(), sdfccd_last_error());
-        } else {
-            sdfccd_MeshInfo info;
-            sdfccd_mesh_get_info(id, &info);
-            std::vector<double> v(3 * (size_t)info.vertex_count);
-            std::vector<uint32_t> f(3 * (size_t)info.triangle_count);
-            sdfccd_mesh_get_data(id, v.data(), f.data());
-            sdfccd_destroy_mesh(id);
+        } else if (takeMeshArrays(id, v, f, info)) {
             sm->v.assign(v.begin(), v.end());
             sm->f.assign(f.begin(), f.end());
             sm->tiva.reset(new btTriangleIndexVertexArray((int)info.triangle_count, sm->f.data(), 3 * (int)sizeof(int),

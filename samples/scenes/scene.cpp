@@ -74,6 +74,19 @@ std::shared_ptr<MeshData> makeMesh(const std::string& name, std::vector<double> 
     return m;
 }
 
+bool takeMeshArrays(sdfccd_MeshId id, std::vector<double>& v, std::vector<uint32_t>& f, sdfccd_MeshInfo& info)
+{
+    bool ok = sdfccd_mesh_get_info(id, &info) == SDFCCD_OK;
+    if (ok) {
+        v.assign(3 * (size_t)info.vertex_count, 0.0);
+        f.assign(3 * (size_t)info.triangle_count, 0u);
+        ok = sdfccd_mesh_get_data(id, v.data(), f.data()) == SDFCCD_OK;
+    }
+    if (!ok) std::fprintf(stderr, "sdfccd_scenes: cannot read a mesh: %s\n", sdfccd_last_error());
+    sdfccd_destroy_mesh(id);
+    return ok;
+}
+
 std::shared_ptr<MeshData> loadMesh(const std::string& path, double scale)
 {
     sdfccd_MeshLoadDef def = sdfccd_default_mesh_load_def();
@@ -84,11 +97,9 @@ std::shared_ptr<MeshData> loadMesh(const std::string& path, double scale)
         return nullptr;
     }
     sdfccd_MeshInfo info;
-    sdfccd_mesh_get_info(id, &info);
-    std::vector<double> v(3 * (size_t)info.vertex_count);
-    std::vector<uint32_t> f(3 * (size_t)info.triangle_count);
-    sdfccd_mesh_get_data(id, v.data(), f.data());
-    sdfccd_destroy_mesh(id);
+    std::vector<double> v;
+    std::vector<uint32_t> f;
+    if (!takeMeshArrays(id, v, f, info)) return nullptr;
     // Body frame = the centre of the mesh's box (Bullet puts the centre of mass at the body origin).
     double c[3] = { 0.5 * (info.bounds.lo.x + info.bounds.hi.x), 0.5 * (info.bounds.lo.y + info.bounds.hi.y),
                     0.5 * (info.bounds.lo.z + info.bounds.hi.z) };

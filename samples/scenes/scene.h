@@ -66,6 +66,9 @@ struct MeshData {
 
 /** Loads an OBJ through sdfccd_load_mesh, scaled; returns null (message on stderr) on failure. */
 std::shared_ptr<MeshData> loadMesh(const std::string& path, double scale);
+/** Copies a mesh handle's vertices (3 per vertex) and triangles (3 per triangle) out, with its info,
+ * and destroys the handle. False (message on stderr; the handle still destroyed) on failure. */
+bool takeMeshArrays(sdfccd_MeshId id, std::vector<double>& v, std::vector<uint32_t>& f, sdfccd_MeshInfo& info);
 /** A mesh from arrays. */
 std::shared_ptr<MeshData> makeMesh(const std::string& name, std::vector<double> v, std::vector<uint32_t> f);
 

@@ -264,11 +264,9 @@ void Snapshotter::write(Scene& scene, const std::vector<std::vector<double>>& sa
         sdfccd_Aabb box{ { llo[0], llo[1], llo[2] }, { lhi[0], lhi[1], lhi[2] } };
         if (sdfccd_extract_isosurface(sdf, box, 96, &mesh) != SDFCCD_OK) continue;
         sdfccd_MeshInfo info;
-        sdfccd_mesh_get_info(mesh, &info);
-        std::vector<double> v(3 * (size_t)info.vertex_count);
-        std::vector<uint32_t> f(3 * (size_t)info.triangle_count);
-        sdfccd_mesh_get_data(mesh, v.data(), f.data());
-        sdfccd_destroy_mesh(mesh);
+        std::vector<double> v;
+        std::vector<uint32_t> f;
+        if (!takeMeshArrays(mesh, v, f, info)) continue;
         std::vector<V3> wv(info.vertex_count);
         for (uint32_t i = 0; i < info.vertex_count; ++i) {
             double w[3];
