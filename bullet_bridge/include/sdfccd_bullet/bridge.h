@@ -90,6 +90,7 @@ const char* statusString(Status s);
  * float64 builds; a static_assert keeps it within that), and from btAlignedAlloc otherwise. */
 std::size_t collisionAlgorithmSize();
 
+/** Options of a Bridge, fixed at construction (defaults as stated per field). */
 struct Config {
     /** Shape type id of SdfShape bodies (default 23, FAST_CONCAVE_MESH_PROXYTYPE). */
     int sdf_shape_type = kDefaultSdfShapeType;
@@ -132,6 +133,7 @@ struct Config {
      * feature within the step's travel catches what a restart would correct, for about 20% fewer
      * SDF evaluations per query (landscape scene). */
     sdfccd_QueryParams query;
+    /** The defaults stated above. */
     Config() : query(sdfccd_default_query_params()) { query.fwgss_restarts = 0; }
 };
 
@@ -168,7 +170,9 @@ class BridgeImpl;
 class Bridge
 {
 public:
+    /** A bridge with `config` (not registered anywhere yet: see registerWith()). */
     explicit Bridge(const Config& config = Config());
+    /** Frees the bridge's caches; never touches the dispatcher (see the class's lifetime note). */
     ~Bridge();
     Bridge(const Bridge&) = delete;
     Bridge& operator=(const Bridge&) = delete;
@@ -213,6 +217,7 @@ public:
      * the clamp's: check() reports ClampDisplaced). Costs one extra query per mesh-SDF pair and
      * step. AlreadyRegistered: another bridge clamps this world. */
     Status setHardClamp(btDiscreteDynamicsWorld* world, bool on, double tolerance = 1e-3);
+    /** True while setHardClamp() has the clamp on for a world. */
     bool hardClampEnabled() const;
 
     /** Time of impact of `mesh_body` moving from its world transform to its interpolation
@@ -224,10 +229,15 @@ public:
      * before deleting the shape if another shape may be created at the same address. */
     void invalidateShape(const btCollisionShape* shape);
 
+    /** The configuration the bridge was made with. */
     const Config& config() const;
+    /** The counters since construction or the last resetStats(). */
     Stats stats() const;
+    /** Sets every counter of stats() back to its initial value. */
     void resetStats();
 
+    /** The implementation object (internal: for the bridge's own algorithm and tests; its type
+     * is not part of the installed headers). */
     BridgeImpl* impl() { return m_impl; }
 
 private:

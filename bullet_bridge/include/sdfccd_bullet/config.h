@@ -21,9 +21,13 @@
 #  define SDFCCD_BULLET_PRECISION_NAME "double"
 #  define SDFCCD_BULLET_NAMESPACE_BEGIN namespace sdfccd_bullet { inline namespace f64 {
 #else
+/** "float" or "double": the btScalar these headers were compiled with (for reports and CSV). */
 #  define SDFCCD_BULLET_PRECISION_NAME "float"
+/** Opens namespace sdfccd_bullet and its precision's inline namespace (f32, or f64 with
+ * BT_USE_DOUBLE_PRECISION). */
 #  define SDFCCD_BULLET_NAMESPACE_BEGIN namespace sdfccd_bullet { inline namespace f32 {
 #endif
+/** Closes what SDFCCD_BULLET_NAMESPACE_BEGIN opened. */
 #define SDFCCD_BULLET_NAMESPACE_END } }
 
 #if defined(SDFCCD_BULLET_SCALAR_BYTES)

@@ -30,9 +30,17 @@ const int kDefaultSdfShapeType = FAST_CONCAVE_MESH_PROXYTYPE;
 
 namespace detail {
 /** User data of the non-uniform scaling callback SDF (internal). */
-struct StretchData { sdfccd_SdfId child; double s[3]; double smin; };
+struct StretchData {
+    sdfccd_SdfId child; /**< The wrapped (unscaled) SDF. */
+    double s[3];        /**< Local scaling along x, y, z. */
+    double smin;        /**< min(s): the factor that keeps the stretched distance a lower bound. */
+};
 }
 
+/** A static or moving Bullet shape whose surface is the zero level set of an sdfccd SDF (any
+ * analytic, CSG, grid or callback SDF). Collides with GImpact meshes, convex shapes and other
+ * SdfShapes through the bridge's CCD once Bridge::registerWith() was called; with everything else
+ * through its cached triangulation. */
 class SdfShape : public btConcaveShape
 {
 public:
@@ -66,12 +74,15 @@ public:
      * with phi <= 0), intersected with its domain. Unbounded SDFs (a half-space) need
      * setLocalBounds(), otherwise the box is +-BT_LARGE_FLOAT and no triangulation is built. */
     void setLocalBounds(const btVector3& lo, const btVector3& hi);
+    /** The local box (unscaled) into `lo` and `hi`. */
     void getLocalBounds(btVector3& lo, btVector3& hi) const;
+    /** False when the local box is unbounded (+-BT_LARGE_FLOAT), e.g. a half-space without setLocalBounds(). */
     bool hasFiniteBounds() const;
 
     /** Cells along the longest axis of the triangulation grid (default 48). Changing it drops
      * the cached triangulation. */
     void setTriangulationResolution(int cells);
+    /** Cells along the longest axis of the triangulation grid. */
     int getTriangulationResolution() const { return m_resolution; }
     /** Builds the triangulation now (it is otherwise built on the first processAllTriangles).
      * Returns the number of triangles (0 when there is no finite box or no surface in it). */
@@ -82,19 +93,26 @@ public:
      * and three vertex indices per triangle. The bridge samples a moving SdfShape with it
      * against another SDF. */
     const std::vector<btScalar>& triangulationVertices() const { return m_vertices; }
+    /** Three indices into triangulationVertices() per triangle. */
     const std::vector<int>& triangulationIndices() const { return m_indices; }
 
     // ---- btCollisionShape ----
     /** Local box scaled component-wise by the local scaling, padded by the margin, then
      * transformed by `t` (the box of the rotated box). */
     void getAabb(const btTransform& t, btVector3& aabbMin, btVector3& aabbMax) const override;
+    /** Scales the shape about its local origin, component-wise by |scaling| (a zero or NaN component
+     * counts as 1); querySdf() then gives the scaled field. */
     void setLocalScaling(const btVector3& scaling) override;
+    /** The local scaling (default 1, 1, 1). */
     const btVector3& getLocalScaling() const override { return m_scaling; }
     /** Inertia of a solid box filling the scaled local bounds (zero when they are infinite).
      * Bullet only calls this for dynamic bodies; pass your own inertia if you know better. */
     void calculateLocalInertia(btScalar mass, btVector3& inertia) const override;
+    /** "sdfccd_SdfShape" (Bullet's serializer and debug output). */
     const char* getName() const override { return "sdfccd_SdfShape"; }
+    /** Collision margin (m) added to the box; the bridge's contact margin is Config::contact_margin. */
     void setMargin(btScalar margin) override { m_margin = margin; }
+    /** The collision margin set with setMargin(). */
     btScalar getMargin() const override { return m_margin; }
 
     // ---- btConcaveShape ----
