@@ -238,9 +238,12 @@ static scc_grid_status compute_block_bounds(scc_grid* g)
     return SCC_GRID_OK;
 }
 
-/* Job 6a: every node on the domain boundary is >= 0 (and no inside hole touches it), i.e. the
- * sampled surface lies inside the box (sets outside_positive). */
-static int boundary_nodes_nonnegative(const scc_grid* g)
+/* Job 6: is phi >= 0 on the whole domain boundary? Each boundary cell's 32 values go to a
+ * per-cell test of its boundary faces; a cell without values fails when an inside hole reaches
+ * it, and is skipped otherwise. */
+typedef int boundary_face_test(const double v[32], const int lo_face[3], const int hi_face[3], const bern_tables* bt);
+
+static int boundary_cells_pass(const scc_grid* g, boundary_face_test* test, const bern_tables* bt)
 {
     const scc_grid_field* fd = &g->fields[0];
     for (uint64_t l = 0; l < g->n_cells; ++l) {
@@ -254,43 +257,39 @@ static int boundary_nodes_nonnegative(const scc_grid* g)
         }
         double v[32];
         gather_cell(g, fd, c, ijk, v);
-        for (int slot = 0; slot < 32; ++slot) {
-            const scc_vec3 xi = scc_cell_node_local(slot);
-            const double x[3] = { xi.x, xi.y, xi.z };
-            for (int d = 0; d < 3; ++d)
-                if ((lo_face[d] && x[d] == -1.0) || (hi_face[d] && x[d] == 1.0))
-                    if (v[slot] < 0.0) return 0;
-        }
+        if (!test(v, lo_face, hi_face, bt)) return 0;
     }
     return 1;
 }
 
-/* Job 6b: phi >= 0 on the whole domain boundary, proved with each boundary face's Bernstein
+/* Job 6a, per cell: every node on the cell's boundary faces is >= 0, i.e. the sampled surface
+ * lies inside the box (sets outside_positive). */
+static int nodes_nonnegative(const double v[32], const int lo_face[3], const int hi_face[3], const bern_tables* bt)
+{
+    (void)bt;
+    for (int slot = 0; slot < 32; ++slot) {
+        const scc_vec3 xi = scc_cell_node_local(slot);
+        const double x[3] = { xi.x, xi.y, xi.z };
+        for (int d = 0; d < 3; ++d)
+            if ((lo_face[d] && x[d] == -1.0) || (hi_face[d] && x[d] == 1.0))
+                if (v[slot] < 0.0) return 0;
+    }
+    return 1;
+}
+
+/* Job 6b, per cell: phi >= 0 on the cell's boundary faces, proved with each face's Bernstein
  * coefficients (the face restriction of the cell's tensor Bernstein form), which enclose the
  * interpolant on the face. */
-static int boundary_faces_nonnegative(const scc_grid* g, const bern_tables* bt)
+static int bernstein_nonnegative(const double v[32], const int lo_face[3], const int hi_face[3], const bern_tables* bt)
 {
-    const scc_grid_field* fd = &g->fields[0];
-    for (uint64_t l = 0; l < g->n_cells; ++l) {
-        uint32_t ijk[3];
-        int lo_face[3], hi_face[3];
-        if (!boundary_cell(g, l, ijk, lo_face, hi_face)) continue;
-        const uint32_t c = fd->map[l];
-        if (c == SCC_GRID_NO_CELL || g->cell_lipschitz[c] < 0.0f) {
-            if (g->hole_source[l] & 0x80000000u) return 0;
-            continue;
-        }
-        double v[32];
-        gather_cell(g, fd, c, ijk, v);
-        for (int s = 0; s < 64; ++s) {
-            const int idx[3] = { s % 4, (s / 4) % 4, s / 16 };
-            int on_face = 0;
-            for (int d = 0; d < 3; ++d) on_face |= (lo_face[d] && idx[d] == 0) || (hi_face[d] && idx[d] == 3);
-            if (!on_face) continue;
-            double acc = 0.0;
-            for (int k = 0; k < 32; ++k) acc += bt->val[s][k] * v[k];
-            if (acc < 0.0) return 0;
-        }
+    for (int s = 0; s < 64; ++s) {
+        const int idx[3] = { s % 4, (s / 4) % 4, s / 16 };
+        int on_face = 0;
+        for (int d = 0; d < 3; ++d) on_face |= (lo_face[d] && idx[d] == 0) || (hi_face[d] && idx[d] == 3);
+        if (!on_face) continue;
+        double acc = 0.0;
+        for (int k = 0; k < 32; ++k) acc += bt->val[s][k] * v[k];
+        if (acc < 0.0) return 0;
     }
     return 1;
 }
@@ -334,8 +333,8 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     if (st == SCC_GRID_OK) st = find_hole_sources(g);
     if (st == SCC_GRID_OK) st = compute_block_bounds(g);
     if (st == SCC_GRID_OK) {
-        g->outside_positive = boundary_nodes_nonnegative(g);
-        fill_sdf_interface(g, g->outside_positive || boundary_faces_nonnegative(g, bt));
+        g->outside_positive = boundary_cells_pass(g, nodes_nonnegative, bt);
+        fill_sdf_interface(g, g->outside_positive || boundary_cells_pass(g, bernstein_nonnegative, bt));
     }
     scc_free(a, bt, sizeof *bt);
     return st;
