@@ -14,12 +14,6 @@
 extern "C" {
 #endif
 
-/** Handle to a mesh. Generation-checked; a null handle has index1 == 0. */
-typedef struct sdfccd_MeshId {
-    uint32_t index1;     /**< Slot + 1; 0 is the null handle. */
-    uint32_t generation; /**< Generation of the slot when the handle was made. */
-} sdfccd_MeshId;
-
 /** Describes a mesh to create. Must be initialised with sdfccd_default_mesh_def(). */
 typedef struct sdfccd_MeshDef {
     const double* vertices;   /**< 3 * vertex_count coordinates, x y z per vertex, local frame. */

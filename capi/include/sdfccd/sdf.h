@@ -18,12 +18,6 @@
 extern "C" {
 #endif
 
-/** Handle to an SDF. Generation-checked: a stale handle gives ::SDFCCD_INVALID_HANDLE. */
-typedef struct sdfccd_SdfId {
-    uint32_t index1;     /**< Slot + 1; 0 is the null handle. */
-    uint32_t generation; /**< Generation of the slot when the handle was made. */
-} sdfccd_SdfId;
-
 /** Kinds of SDF, as reported by sdfccd_sdf_get_info(). */
 typedef enum sdfccd_SdfKind {
     SDFCCD_SDF_SPHERE,      /**< sdfccd_create_sphere() */

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/** @file types.h  Plain value types shared by the whole ABI. All scalars are double, metres and seconds. */
+/** @file types.h  Plain value types shared by the whole ABI (vectors, poses, boxes, and the handles
+ * of SDFs and meshes). All scalars are double, metres and seconds. */
 #ifndef SDFCCD_TYPES_H
 #define SDFCCD_TYPES_H
 
@@ -36,6 +37,23 @@ typedef struct sdfccd_Aabb {
     sdfccd_Vec3 lo; /**< Lower corner (min x, y, z). */
     sdfccd_Vec3 hi; /**< Upper corner (max x, y, z). */
 } sdfccd_Aabb;
+
+/* Handles: the objects the library makes are named by these values, one type per kind of
+ * object so that they cannot be mixed up. Each is generation-checked (a handle of a destroyed
+ * object gives ::SDFCCD_INVALID_HANDLE, even when its slot is reused); a null handle has
+ * index1 == 0 (zero-initialise to get one). */
+
+/** Handle to an SDF (sdf.h). */
+typedef struct sdfccd_SdfId {
+    uint32_t index1;     /**< Slot + 1; 0 is the null handle. */
+    uint32_t generation; /**< Generation of the slot when the handle was made. */
+} sdfccd_SdfId;
+
+/** Handle to a triangle mesh (mesh.h). */
+typedef struct sdfccd_MeshId {
+    uint32_t index1;     /**< Slot + 1; 0 is the null handle. */
+    uint32_t generation; /**< Generation of the slot when the handle was made. */
+} sdfccd_MeshId;
 
 /** The identity pose. */
 SDFCCD_API sdfccd_Pose sdfccd_pose_identity(void);
