@@ -9,6 +9,7 @@
 #define SDFCCD_CAPI_INTERNAL_H
 
 #include <stdarg.h>
+#include <string.h>
 #include "sdfccd/sdfccd.h"
 #include "../../core/alloc.h"
 #include "../../core/mesh.h"
@@ -43,6 +44,19 @@ static inline sdfccd_Aabb sdfccd__pbox(scc_aabb b) { sdfccd_Aabb r = { sdfccd__p
 #define SDFCCD__DEF_COOKIE 0x5DFCCD01
 /* OK, or INVALID_ARGUMENT "FN: WHAT was not initialised with DEFAULT_FN()" when the cookie is missing. */
 sdfccd_Status sdfccd__check_def(int32_t internal_value, const char* fn, const char* what, const char* default_fn);
+/* How every sdfccd_default_*() starts its def `d`: every field zero, then the cookie. */
+#define SDFCCD__DEF_BEGIN(d) (memset(&(d), 0, sizeof(d)), (d).internal_value = SDFCCD__DEF_COOKIE)
+/* The opening checks of every create function that takes a def: FN's `def` and `out` (named
+ * OUT_NAME in the message) are not NULL and def was initialised by DEFAULT_FN. */
+#define SDFCCD__CHECK_DEF_ARGS(fn, def, out, out_name, default_fn) \
+    sdfccd__check_def_args((fn), (def), (def) ? (def)->internal_value : 0, (out), (out_name), (default_fn))
+static inline sdfccd_Status sdfccd__check_def_args(const char* fn, const void* def, int32_t internal_value, const void* out,
+                                                   const char* out_name, const char* default_fn)
+{
+    if (!def) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: def is NULL", fn);
+    if (!out) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %s is NULL", fn, out_name);
+    return sdfccd__check_def(internal_value, fn, "def was", default_fn);
+}
 
 /* ---- the handle registry (base.c), shared by SDF and mesh objects ---- */
 enum { SDFCCD__KIND_FREE = 0, SDFCCD__KIND_SDF = 1, SDFCCD__KIND_MESH = 2 };

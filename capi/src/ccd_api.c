@@ -11,7 +11,7 @@
 sdfccd_QueryParams sdfccd_default_query_params(void)
 {
     sdfccd_QueryParams p;
-    memset(&p, 0, sizeof p);
+    SDFCCD__DEF_BEGIN(p);
     p.method = SDFCCD_METHOD_FWGSS;
     p.margin = 0.0;
     p.time_tolerance = 1e-7;
@@ -29,7 +29,6 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.certified_time_tolerance = 1e-7;
     p.certified_max_regions = 2000000;
     p.broad_phase = 1;
-    p.internal_value = SDFCCD__DEF_COOKIE;
     p.max_sdf_evaluations = SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS;
     p.fwgss_secant_entry = 1;
     p.fwgss_speed_tolerance = 1;

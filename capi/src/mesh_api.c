@@ -106,17 +106,14 @@ sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId id)
 sdfccd_MeshDef sdfccd_default_mesh_def(void)
 {
     sdfccd_MeshDef d;
-    memset(&d, 0, sizeof d);
-    d.internal_value = SDFCCD__DEF_COOKIE;
+    SDFCCD__DEF_BEGIN(d);
     return d;
 }
 
 sdfccd_Status sdfccd_create_mesh(const sdfccd_MeshDef* def, sdfccd_MeshId* out_mesh)
 {
     sdfccd_Status st;
-    if ((st = sdfccd__check_ptr(def, "sdfccd_create_mesh: def")) || (st = sdfccd__check_ptr(out_mesh, "sdfccd_create_mesh: out_mesh")))
-        return st;
-    if ((st = sdfccd__check_def(def->internal_value, "sdfccd_create_mesh", "def was", "sdfccd_default_mesh_def"))) return st;
+    if ((st = SDFCCD__CHECK_DEF_ARGS("sdfccd_create_mesh", def, out_mesh, "out_mesh", "sdfccd_default_mesh_def"))) return st;
     return sdfccd__mesh_create(def->vertices, def->vertex_count, def->indices, def->triangle_count,
                                def->drop_degenerate, "sdfccd_create_mesh", out_mesh);
 }

@@ -21,11 +21,10 @@
 sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void)
 {
     sdfccd_MeshLoadDef d;
-    memset(&d, 0, sizeof d);
+    SDFCCD__DEF_BEGIN(d);
     d.scale = 1.0;
     d.merge_vertices = 1;
     d.drop_degenerate = 1;
-    d.internal_value = SDFCCD__DEF_COOKIE;
     d.max_file_bytes = (int64_t)256 << 20;
     d.formats = NULL;
     return d;

@@ -116,21 +116,18 @@ sdfccd_Status sdfccd_create_half_space(sdfccd_Vec3 normal, double offset, sdfccd
 sdfccd_SpikeGridDef sdfccd_default_spike_grid_def(void)
 {
     sdfccd_SpikeGridDef d;
-    memset(&d, 0, sizeof d);
+    SDFCCD__DEF_BEGIN(d);
     d.spacing = 0.1;
     d.base_radius = 0.05;
     d.height = 0.1;
     d.count_x = d.count_y = 20;
-    d.internal_value = SDFCCD__DEF_COOKIE;
     return d;
 }
 
 sdfccd_Status sdfccd_create_spike_grid(const sdfccd_SpikeGridDef* def, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = sdfccd__check_ptr(def, "sdfccd_create_spike_grid: def")) || (st = sdfccd__check_ptr(out_sdf, "sdfccd_create_spike_grid: out_sdf")))
-        return st;
-    if ((st = sdfccd__check_def(def->internal_value, "sdfccd_create_spike_grid", "def was", "sdfccd_default_spike_grid_def"))) return st;
+    if ((st = SDFCCD__CHECK_DEF_ARGS("sdfccd_create_spike_grid", def, out_sdf, "out_sdf", "sdfccd_default_spike_grid_def"))) return st;
     if ((st = positive(def->spacing, "spike grid spacing")) || (st = positive(def->base_radius, "spike grid base_radius")) ||
         (st = positive(def->height, "spike grid height")))
         return st;
@@ -225,20 +222,17 @@ static double callback_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void)
 {
     sdfccd_CallbackSdfDef d;
-    memset(&d, 0, sizeof d);
+    SDFCCD__DEF_BEGIN(d);
     d.lipschitz = 1.0;
     d.bounds.lo.x = d.bounds.lo.y = d.bounds.lo.z = -INFINITY;
     d.bounds.hi.x = d.bounds.hi.y = d.bounds.hi.z = INFINITY;
-    d.internal_value = SDFCCD__DEF_COOKIE;
     return d;
 }
 
 sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
-    if ((st = sdfccd__check_ptr(def, "sdfccd_create_callback_sdf: def")) || (st = sdfccd__check_ptr(out_sdf, "sdfccd_create_callback_sdf: out_sdf")))
-        return st;
-    if ((st = sdfccd__check_def(def->internal_value, "sdfccd_create_callback_sdf", "def was", "sdfccd_default_callback_sdf_def"))) return st;
+    if ((st = SDFCCD__CHECK_DEF_ARGS("sdfccd_create_callback_sdf", def, out_sdf, "out_sdf", "sdfccd_default_callback_sdf_def"))) return st;
     if (!def->eval) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def->eval is NULL");
     if ((st = positive(def->lipschitz, "sdfccd_create_callback_sdf: lipschitz"))) return st;
     if (isnan(def->bounds.lo.x) || isnan(def->bounds.lo.y) || isnan(def->bounds.lo.z) || isnan(def->bounds.hi.x) ||
