@@ -55,11 +55,9 @@ public:
     bool build()
     {
         const Options& o = options();
-        std::shared_ptr<MeshData> torus = loadMesh(o.data_dir + "/bullet3/torus_textured.obj", 2.0);
-        std::shared_ptr<MeshData> bunny = loadMesh(o.data_dir + "/bullet3/bunny.obj", 1.0);
+        std::shared_ptr<MeshData> torus = loadDataMesh(o, "bullet3/torus_textured.obj", 2.0, "torus");
+        std::shared_ptr<MeshData> bunny = loadDataMesh(o, "bullet3/bunny.obj", 1.0, "bunny");
         if (!torus || !bunny) return false;
-        torus->name = "torus";
-        bunny->name = "bunny";
 
         // Floor: a 60 x 2 x 60 m box, top at y = -9.
         sdfccd_SdfId floor;
@@ -74,15 +72,8 @@ public:
                      sdfccd_Aabb{ { -2.6, -2.6, -0.6 }, { 2.6, 2.6, 0.6 } }, 64, ring);
         // The bunny as a grid SDF, sitting on the floor; measured against the exact mesh distance.
         sdfccd_MeshId bunny_mesh = createMesh(*bunny);
-        sdfccd_GridDef gd = sdfccd_default_grid_def();
-        gd.resolution[0] = gd.resolution[1] = gd.resolution[2] = 32;
-        gd.padding = 0.3;
-        gd.threads = 2;
-        sdfccd_SdfId grid{};
-        if (sdfccd_create_grid_from_mesh(bunny_mesh, &gd, &grid) != SDFCCD_OK) {
-            std::fprintf(stderr, "sdfccd_scenes: bunny grid: %s\n", sdfccd_last_error());
-            return false;
-        }
+        sdfccd_SdfId grid = gridFromMesh(bunny_mesh, 32, 0.3, "bunny grid");
+        if (grid.index1 == 0) return false;
         sdfccd_GridInfo gi;
         sdfccd_grid_get_info(grid, &gi);
         addStaticSdf("bunny_grid", grid, btVector3(6, (btScalar)(-9 - bunny->bounds.lo.y), 0), btQuaternion::getIdentity(), gi.domain,
@@ -128,15 +119,7 @@ private:
     btVector3 m_target = btVector3(-6, -8.5, 0); // the lying torus's centre
 };
 
-template <int kShot> Scene* createGImpactDemo(const Options& opt)
-{
-    GImpactDemo* s = new GImpactDemo(opt, kShot);
-    if (!s->build()) {
-        delete s;
-        return nullptr;
-    }
-    return s;
-}
+template <int kShot> Scene* createGImpactDemo(const Options& opt) { return built(new GImpactDemo(opt, kShot)); }
 
 // ---------------------------------------------------------------------------------------------
 enum SdfBoxVariant { kOurShape, kBtSdfShape, kTorusAlone };
@@ -163,13 +146,10 @@ public:
             c = &addStaticSdf("concave_box", grid, btVector3(0, 0, 0), btQuaternion::getIdentity(), gi.domain, 96, grid);
         }
         c->killBelow(up, -0.2); // the tray is |z| <= 0.1
-        std::shared_ptr<MeshData> torus = loadMesh(o.data_dir + "/bullet3/torus_textured.obj", 0.06);
-        std::shared_ptr<MeshData> bunny = loadMesh(o.data_dir + "/bullet3/bunny.obj", 0.05);
-        std::shared_ptr<MeshData> cube = loadMesh(o.data_dir + "/bullet3/cube.obj", 0.08);
+        std::shared_ptr<MeshData> torus = loadDataMesh(o, "bullet3/torus_textured.obj", 0.06, "torus9cm");
+        std::shared_ptr<MeshData> bunny = loadDataMesh(o, "bullet3/bunny.obj", 0.05, "bunny");
+        std::shared_ptr<MeshData> cube = loadDataMesh(o, "bullet3/cube.obj", 0.08, "cube8cm");
         if (!torus || !bunny || !cube) return false;
-        torus->name = "torus9cm";
-        bunny->name = "bunny";
-        cube->name = "cube8cm";
         btRigidBody* t = addMeshBody(torus, 0.1, btVector3(0.5f, 0, 0.5f), axisAngle(1, 0.3, 0, 0.7));
         t->setActivationState(DISABLE_DEACTIVATION);
         if (m_variant != kTorusAlone) {
@@ -187,15 +167,7 @@ private:
     SdfBoxVariant m_variant;
 };
 
-template <SdfBoxVariant kV> Scene* createSdfBox(const Options& opt)
-{
-    SdfBox* s = new SdfBox(opt, kV);
-    if (!s->build()) {
-        delete s;
-        return nullptr;
-    }
-    return s;
-}
+template <SdfBoxVariant kV> Scene* createSdfBox(const Options& opt) { return built(new SdfBox(opt, kV)); }
 
 // ---------------------------------------------------------------------------------------------
 // The landscape: the normalised height-field distance (y - h) / sqrt(1 + |grad h|^2) (first-order
@@ -251,11 +223,9 @@ public:
                                    sdfccd_Aabb{ { -kHalf - 0.5, -12.5, -kHalf - 0.5 }, { kHalf + 0.5, kAmp + 1, kHalf + 0.5 } }, 128, land);
         c.killBelow(up, -12);
         for (auto& b : rigidStatics()) b->setFriction(0.9f);
-        std::shared_ptr<MeshData> cube = loadMesh(o.data_dir + "/bullet3/cube.obj", 2.0);
-        std::shared_ptr<MeshData> torus = loadMesh(o.data_dir + "/bullet3/torus_textured.obj", 2.0);
+        std::shared_ptr<MeshData> cube = loadDataMesh(o, "bullet3/cube.obj", 2.0, "cube");
+        std::shared_ptr<MeshData> torus = loadDataMesh(o, "bullet3/torus_textured.obj", 2.0, "torus");
         if (!cube || !torus) return false;
-        cube->name = "cube";
-        torus->name = "torus";
         int side = o.quick ? 5 : 10, layers = o.quick ? 1 : 2;
         int k = 0;
         for (int l = 0; l < layers; ++l)
@@ -279,15 +249,7 @@ private:
     }
 };
 
-Scene* createLandscape(const Options& opt)
-{
-    Landscape* s = new Landscape(opt);
-    if (!s->build()) {
-        delete s;
-        return nullptr;
-    }
-    return s;
-}
+Scene* createLandscape(const Options& opt) { return built(new Landscape(opt)); }
 
 } // namespace
 

@@ -52,7 +52,7 @@ public:
     {
         gravity[2] = -9.81;
         ccd_margin = kMargin;
-        std::shared_ptr<MeshData> file = loadMesh(m_opt.data_dir + "/bullet3/bunny.obj", 0.25);
+        std::shared_ptr<MeshData> file = loadDataMesh(m_opt, "bullet3/bunny.obj", 0.25);
         if (!file) return false;
         // bunny.obj is Y up: turn it to Z up, (x, y, z) -> (x, -z, y).
         std::vector<double> bv = file->v;
@@ -62,15 +62,8 @@ public:
             bv[i + 2] = y;
         }
         std::shared_ptr<MeshData> bunny = makeMesh("bunny", bv, file->f);
-        sdfccd_GridDef gd = sdfccd_default_grid_def();
-        gd.resolution[0] = gd.resolution[1] = gd.resolution[2] = 32;
-        gd.padding = 0.05;
-        gd.threads = 2;
-        sdfccd_SdfId grid{};
-        if (sdfccd_create_grid_from_mesh(bunny->handle, &gd, &grid) != SDFCCD_OK) {
-            std::fprintf(stderr, "sdfccd_scenes: bunny grid: %s\n", sdfccd_last_error());
-            return false;
-        }
+        sdfccd_SdfId grid = gridFromMesh(bunny->handle, 32, 0.05, "bunny grid");
+        if (grid.index1 == 0) return false;
         m_owned.push_back(grid);
         sdfccd_MeshDef def = sdfccd_default_mesh_def();
         def.vertices = bunny->v.data();
@@ -317,15 +310,7 @@ private:
     std::vector<Spring> m_springs;
 };
 
-Scene* createCloth(const Options& opt)
-{
-    Cloth* s = new Cloth(opt);
-    if (!s->build()) {
-        delete s;
-        return nullptr;
-    }
-    return s;
-}
+Scene* createCloth(const Options& opt) { return built(new Cloth(opt)); }
 
 } // namespace
 

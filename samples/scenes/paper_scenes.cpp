@@ -112,9 +112,8 @@ public:
     using PaperScene::PaperScene;
     bool build()
     {
-        std::shared_ptr<MeshData> m = loadMesh(options().data_dir + "/../samples/report/dataset/shuriken.obj", 1);
+        std::shared_ptr<MeshData> m = loadDataMesh(options(), "../samples/report/dataset/shuriken.obj", 1, "shuriken");
         if (!m) return false;
-        m->name = "shuriken";
         Csg c{ this };
         sdfccd_SdfId shell = c.op(SDFCCD_CSG_DIFFERENCE, c.sphere(0.6), c.sphere(0.58));
         sdfccd_SdfId plate = c.op(SDFCCD_CSG_INTERSECTION, shell, c.at(c.box(0.15, 0.3, 0.35), -0.5, 0, 0));
@@ -179,9 +178,8 @@ public:
     using PaperScene::PaperScene;
     bool build()
     {
-        std::shared_ptr<MeshData> m = loadMesh(options().data_dir + "/meshes/pyramid.obj", 1);
+        std::shared_ptr<MeshData> m = loadDataMesh(options(), "meshes/pyramid.obj", 1, "pyramid");
         if (!m) return false;
-        m->name = "pyramid";
         m->finish(12);
         Collider& g = addGround(*this, 0, 1);
         (void)g;
@@ -201,19 +199,11 @@ public:
     bool build()
     {
         const Options& o = options();
-        std::shared_ptr<MeshData> torus = loadMesh(o.data_dir + "/bullet3/torus_textured.obj", 1);
-        std::shared_ptr<MeshData> bunny = loadMesh(o.data_dir + "/bullet3/bunny.obj", 0.25);
+        std::shared_ptr<MeshData> torus = loadDataMesh(o, "bullet3/torus_textured.obj", 1);
+        std::shared_ptr<MeshData> bunny = loadDataMesh(o, "bullet3/bunny.obj", 0.25, "bunny");
         if (!torus || !bunny) return false;
-        bunny->name = "bunny";
-        sdfccd_GridDef gd = sdfccd_default_grid_def();
-        gd.resolution[0] = gd.resolution[1] = gd.resolution[2] = 32;
-        gd.padding = 0.1;
-        gd.threads = 2;
-        sdfccd_SdfId grid{};
-        if (sdfccd_create_grid_from_mesh(torus->handle, &gd, &grid) != SDFCCD_OK) {
-            std::fprintf(stderr, "sdfccd_scenes: torus grid: %s\n", sdfccd_last_error());
-            return false;
-        }
+        sdfccd_SdfId grid = gridFromMesh(torus->handle, 32, 0.1, "torus grid");
+        if (grid.index1 == 0) return false;
         sdfccd_GridInfo gi;
         sdfccd_grid_get_info(grid, &gi);
         // Lying torus (its axis, y in the file, turned to z); the exact reference is the mesh itself.
@@ -275,9 +265,8 @@ public:
     using PaperScene::PaperScene;
     bool build()
     {
-        std::shared_ptr<MeshData> box = loadMesh(options().data_dir + "/bullet3/cube.obj", 0.5);
+        std::shared_ptr<MeshData> box = loadDataMesh(options(), "bullet3/cube.obj", 0.5, "coarse_box");
         if (!box) return false;
-        box->name = "coarse_box";
         box->finish(20);
         sdfccd_SpikeGridDef def = sdfccd_default_spike_grid_def();
         sdfccd_SdfId spikes{};
@@ -317,15 +306,7 @@ public:
     }
 };
 
-template <class T> Scene* create(const Options& opt)
-{
-    T* s = new T(opt);
-    if (!s->build()) {
-        delete s;
-        return nullptr;
-    }
-    return s;
-}
+template <class T> Scene* create(const Options& opt) { return built(new T(opt)); }
 
 // ---------------------------------------------------------------------------------------------
 // Kinematic scenes through the C ABI.
@@ -530,7 +511,7 @@ public:
         colliders.push_back(c);
         Body b;
         b.name = "pyramid";
-        b.mesh = loadMesh(opt.data_dir + "/meshes/pyramid.obj", 1);
+        b.mesh = loadDataMesh(opt, "meshes/pyramid.obj", 1);
         if (!b.mesh) return;
         b.mesh->finish(12);
         b.frame.p[2] = 0.16; // base (local z = -0.15) 1 cm above the box; corners (r 0.18) sweep 2 cm into it

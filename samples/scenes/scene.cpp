@@ -87,6 +87,27 @@ bool takeMeshArrays(sdfccd_MeshId id, std::vector<double>& v, std::vector<uint32
     return ok;
 }
 
+std::shared_ptr<MeshData> loadDataMesh(const Options& opt, const std::string& file, double scale, const char* name)
+{
+    std::shared_ptr<MeshData> m = loadMesh(opt.data_dir + "/" + file, scale);
+    if (m && name) m->name = name;
+    return m;
+}
+
+sdfccd_SdfId gridFromMesh(sdfccd_MeshId mesh, int resolution, double padding, const char* what)
+{
+    sdfccd_GridDef gd = sdfccd_default_grid_def();
+    gd.resolution[0] = gd.resolution[1] = gd.resolution[2] = resolution;
+    gd.padding = padding;
+    gd.threads = 2;
+    sdfccd_SdfId grid{};
+    if (sdfccd_create_grid_from_mesh(mesh, &gd, &grid) != SDFCCD_OK) {
+        std::fprintf(stderr, "sdfccd_scenes: %s: %s\n", what, sdfccd_last_error());
+        return sdfccd_SdfId{};
+    }
+    return grid;
+}
+
 std::shared_ptr<MeshData> loadMesh(const std::string& path, double scale)
 {
     sdfccd_MeshLoadDef def = sdfccd_default_mesh_load_def();

@@ -66,11 +66,17 @@ struct MeshData {
 
 /** Loads an OBJ through sdfccd_load_mesh, scaled; returns null (message on stderr) on failure. */
 std::shared_ptr<MeshData> loadMesh(const std::string& path, double scale);
+/** loadMesh of `file` in the data folder (opt.data_dir + "/" + file), named `name` in reports
+ * (null: the file's base name). */
+std::shared_ptr<MeshData> loadDataMesh(const Options& opt, const std::string& file, double scale, const char* name = nullptr);
 /** Copies a mesh handle's vertices (3 per vertex) and triangles (3 per triangle) out, with its info,
  * and destroys the handle. False (message on stderr; the handle still destroyed) on failure. */
 bool takeMeshArrays(sdfccd_MeshId id, std::vector<double>& v, std::vector<uint32_t>& f, sdfccd_MeshInfo& info);
 /** A mesh from arrays. */
 std::shared_ptr<MeshData> makeMesh(const std::string& name, std::vector<double> v, std::vector<uint32_t> f);
+/** The grid SDF of `mesh` (sdfccd_create_grid_from_mesh: `resolution` cells per axis, `padding`
+ * m around the mesh, 2 threads); a null handle (message naming `what` on stderr) on failure. */
+sdfccd_SdfId gridFromMesh(sdfccd_MeshId mesh, int resolution, double padding, const char* what);
 
 /** A rigid transform in double: x_world = R x_local + p (R row-major). */
 struct Frame {
@@ -153,6 +159,14 @@ public:
     double ccd_margin = 0.01;        /**< Contact margin of the scene's CCD (m). */
     sdfccd_Aabb view{};          /**< Snapshot view box (world); empty (lo = hi) frames the bodies. */
 };
+
+/** `s` once its build() succeeded, else null (`s` deleted; build() printed why): the body of
+ * the `create` function of a scene that is built after construction. */
+template <class S> Scene* built(S* s)
+{
+    std::unique_ptr<S> owned(s);
+    return owned->build() ? owned.release() : nullptr;
+}
 
 /** Table entry: Box2D's benchmark model. */
 struct SceneEntry {
