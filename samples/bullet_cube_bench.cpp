@@ -14,10 +14,10 @@
 #include <vector>
 
 #include <btBulletDynamicsCommon.h>
-#include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
 #include <BulletCollision/Gimpact/btGImpactShape.h>
 
 #include "sdfccd_bullet/sdfccd_bullet.h"
+#include "scenes/bullet_scene.h" // BulletWorld (the scenes' world setup), takeMeshArrays
 
 namespace {
 
@@ -55,11 +55,9 @@ std::unique_ptr<Mesh> slabMesh(sdfccd_SdfId slab)
     sdfccd_MeshId id;
     if (sdfccd_extract_isosurface(slab, box, 104, &id) != SDFCCD_OK) return nullptr;
     sdfccd_MeshInfo info;
-    sdfccd_mesh_get_info(id, &info);
-    std::vector<double> v(3 * (size_t)info.vertex_count);
-    std::vector<uint32_t> f(3 * (size_t)info.triangle_count);
-    sdfccd_mesh_get_data(id, v.data(), f.data());
-    sdfccd_destroy_mesh(id);
+    std::vector<double> v;
+    std::vector<uint32_t> f;
+    if (!scenes::takeMeshArrays(id, v, f, info)) return nullptr;
     std::unique_ptr<Mesh> m(new Mesh);
     m->v.assign(v.begin(), v.end());
     m->f.assign(f.begin(), f.end());
@@ -72,14 +70,9 @@ enum Variant { kBridgeMeshFirst, kBridgeSdfFirst, kGImpactPeer };
 void run(Variant variant, int steps, sdfccd_SdfId slab)
 {
     sdfccd_bullet::Bridge bridge;
-    btDefaultCollisionConfiguration config;
-    btCollisionDispatcher dispatcher(&config);
-    btDbvtBroadphase broadphase;
-    btSequentialImpulseConstraintSolver solver;
-    btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
-    world.setGravity(btVector3(0, 0, -9.81));
-    if (variant == kGImpactPeer) btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
-    else if (bridge.registerWith(&world) != sdfccd_bullet::Status::Ok) std::exit(1);
+    scenes::BulletWorld bw(btVector3(0, 0, -9.81), variant == kGImpactPeer ? nullptr : &bridge);
+    if (bw.status != sdfccd_bullet::Status::Ok) std::exit(1);
+    btDiscreteDynamicsWorld& world = bw.world;
 
     sdfccd_bullet::SdfShape sdf_shape(slab);
     std::unique_ptr<Mesh> peer;

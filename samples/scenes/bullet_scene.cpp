@@ -41,6 +41,14 @@ btQuaternion tumble(int i)
     return axisAngle(r * std::cos(a), r * std::sin(a), z, std::fmod(1.7 * i + 0.4, 6.283185307179586));
 }
 
+BulletWorld::BulletWorld(const btVector3& gravity, sdfccd_bullet::Bridge* bridge)
+    : dispatcher(&config), world(&dispatcher, &broadphase, &solver, &config)
+{
+    world.setGravity(gravity);
+    if (bridge) status = bridge->registerWith(&world);
+    else btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
+}
+
 BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_axis)
     : m_opt(opt), m_gravity(gravity), m_up(up_axis)
 {
@@ -54,30 +62,20 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     cfg.patch_band = opt.patch_band;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
-    m_config.reset(new btDefaultCollisionConfiguration());
-    m_dispatcher.reset(new btCollisionDispatcher(m_config.get()));
-    m_broadphase.reset(new btDbvtBroadphase());
-    m_solver.reset(new btSequentialImpulseConstraintSolver());
-    m_world.reset(new btDiscreteDynamicsWorld(m_dispatcher.get(), m_broadphase.get(), m_solver.get(), m_config.get()));
-    m_world->setGravity(gravity);
-    if (m_bridge) {
-        sdfccd_bullet::Status s = m_bridge->registerWith(m_world.get());
-        if (s != sdfccd_bullet::Status::Ok)
-            std::fprintf(stderr, "sdfccd_scenes: bridge registration failed: %s\n", sdfccd_bullet::statusString(s));
-    } else {
-        btGImpactCollisionAlgorithm::registerAlgorithm(m_dispatcher.get());
-    }
+    m_bullet.reset(new BulletWorld(gravity, m_bridge.get()));
+    m_world = &m_bullet->world;
+    m_dispatcher = &m_bullet->dispatcher;
+    if (m_bullet->status != sdfccd_bullet::Status::Ok)
+        std::fprintf(stderr, "sdfccd_scenes: bridge registration failed: %s\n", sdfccd_bullet::statusString(m_bullet->status));
 }
 
 BulletScene::~BulletScene()
 {
     for (auto& b : m_rigid) m_world->removeRigidBody(b.get());
     m_rigid.clear();
-    m_world.reset();
-    m_solver.reset();
-    m_broadphase.reset();
-    m_dispatcher.reset();
-    m_config.reset();
+    m_bullet.reset();
+    m_world = nullptr;
+    m_dispatcher = nullptr;
     m_shapes.clear();
     m_stock.clear();
     m_assets.clear();

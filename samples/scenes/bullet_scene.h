@@ -21,6 +21,21 @@
 
 namespace scenes {
 
+/** A Bullet dynamics world (default collision configuration, dispatcher, DBVT broadphase,
+ * sequential-impulse solver) with `gravity`, and `bridge` registered with it; with a null
+ * `bridge`, Bullet's own GImpact algorithm instead (the stock variant). The setup shared by every
+ * Bullet scene and the cube benchmark (samples/bullet_cube_bench.cpp). `bridge` must outlive it. */
+struct BulletWorld {
+    BulletWorld(const btVector3& gravity, sdfccd_bullet::Bridge* bridge);
+    btDefaultCollisionConfiguration config;
+    btCollisionDispatcher dispatcher;
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    btDiscreteDynamicsWorld world;
+    /** The bridge's registerWith() result (Ok for the stock variant). */
+    sdfccd_bullet::Status status = sdfccd_bullet::Status::Ok;
+};
+
 class BulletScene : public Scene {
 public:
     BulletScene(const Options& opt, const btVector3& gravity, int up_axis);
@@ -51,7 +66,7 @@ public:
     /** Owns an SDF handle (destroyed with the scene). */
     sdfccd_SdfId own(sdfccd_SdfId id);
 
-    btDiscreteDynamicsWorld* world() { return m_world.get(); }
+    btDiscreteDynamicsWorld* world() { return m_world; }
     sdfccd_bullet::Bridge* bridge() { return m_bridge.get(); }
     const Options& options() const { return m_opt; }
 
@@ -67,11 +82,9 @@ private:
     Options m_opt;
     btVector3 m_gravity;
     std::unique_ptr<sdfccd_bullet::Bridge> m_bridge;
-    std::unique_ptr<btDefaultCollisionConfiguration> m_config;
-    std::unique_ptr<btCollisionDispatcher> m_dispatcher;
-    std::unique_ptr<btDbvtBroadphase> m_broadphase;
-    std::unique_ptr<btSequentialImpulseConstraintSolver> m_solver;
-    std::unique_ptr<btDiscreteDynamicsWorld> m_world;
+    std::unique_ptr<BulletWorld> m_bullet;          // destroyed before the bridge
+    btDiscreteDynamicsWorld* m_world = nullptr;     // &m_bullet->world
+    btCollisionDispatcher* m_dispatcher = nullptr;  // &m_bullet->dispatcher
     std::vector<std::unique_ptr<GImpactAsset>> m_assets;
     std::vector<std::unique_ptr<StockMesh>> m_stock;
     std::vector<std::unique_ptr<btCollisionShape>> m_shapes;
