@@ -193,8 +193,8 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
         scc_tri_state st;
         scc_fw_tri_state(s, tn, &st);
         double bb[3];
-        int have_dir = 0;
-        if (s->b[0] > 0.0 && s->b[1] > 0.0 && s->b[2] > 0.0) have_dir = interior_direction(&st, gn, s->b, bb);
+        int have_dir = 0, interior = 0;
+        if (s->b[0] > 0.0 && s->b[1] > 0.0 && s->b[2] > 0.0) interior = have_dir = interior_direction(&st, gn, s->b, bb);
         if (!have_dir) {
             int sv = scc_fw_support(&st, gn);
             int av = sv;
@@ -211,6 +211,15 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
             }
         }
         double step = have_dir ? spatial_search(s, &st, xn, bb, tn) : 0.0;
+        if (interior && step <= s->dist_tol) {
+            /* Stalled inside (ours): at a kink of the field (a box's edge or corner under the face)
+             * the steepest descent of one side need not descend, and the iterate would stop short
+             * of the minimum over the triangle (test_sweep: 19 us late on a box). Before concluding,
+             * the paper's step towards the support vertex (Eq. 15) is searched too. */
+            int sv = scc_fw_support(&st, gn);
+            for (int j = 0; j < 3; ++j) bb[j] = j == sv;
+            step = spatial_search(s, &st, scc_fw_point(s, s->b, tn, NULL), bb, tn);
+        }
         int small = fabs(tn - t) <= p->time_tol && step <= s->dist_tol; /* line 32 */
         t = tn;
         if (small) { *io_iterations += it; return 1; }

@@ -90,8 +90,9 @@ typedef struct sdfccd_QueryParams {
     int32_t fwgss_brent_spatial;   /**< FWGSS: the spatial line searches (Algorithm 2 lines 22-31) use Brent's method
                                         (parabolic steps safeguarded by golden section), which needs fewer SDF
                                         evaluations where phi is smooth along the segment (data set: 11-24 % fewer per
-                                        query, 0 false negatives), but in test_sweep it misses one more case (3 of 982
-                                        instead of 2); 0 = the paper's golden-section search. Default 0. */
+                                        query, 0 false negatives), but in test_sweep it misses one more case (2 of 982
+                                        instead of 1) and leaves more cases unconverged; 0 = the paper's
+                                        golden-section search. Default 0. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
