@@ -228,27 +228,86 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
     return 0;
 }
 
+/* The vertex path with weights b enters the margin between lo (phi - margin = flo > 0) and *io_t
+ * (*io_phi <= margin), the last step of a conservative advancement; that step is short, so phi is
+ * nearly linear on it and a few regula falsi steps move the witness to the crossing (otherwise it
+ * can lie up to a time tolerance late, and a witness of a shared trace then bounds other
+ * triangles' descents by a late time). */
+static void refine_entry(scc_fw_state* s, const double b[3], double lo, double flo, double* io_t, double* io_phi)
+{
+    const double margin = s->p->margin;
+    double hi = *io_t, fhi = *io_phi - margin;
+    for (int k = 0; k < 3 && hi - lo > 1e-3 * s->p->time_tol; ++k) {
+        double t = hi - fhi * (hi - lo) / (fhi - flo);
+        if (!(t > lo && t < hi)) t = 0.5 * (lo + hi);
+        double phi = scc_sdf_eval(s->sdf, scc_fw_point(s, b, t, NULL), NULL);
+        s->evals++;
+        if (phi - margin > 0.0) {
+            lo = t;
+            flo = phi - margin;
+        } else {
+            hi = t;
+            fhi = phi - margin;
+            *io_t = t;
+            *io_phi = phi;
+        }
+    }
+}
+
 /* Conservative advancement of one vertex path (ours): with |grad phi| <= L and the vertex's speed
  * <= S, phi cannot reach the margin sooner than (phi - margin) / (L S), so stepping by that never
  * skips a crossing (steps are at least the time tolerance). Stops at the first witness (which
- * shrinks te), at te, or after `cap` steps. */
-static void trace_vertex(scc_fw_state* s, int i, double speed, int cap)
+ * shrinks te), at te, or after `cap` steps. With a shared record (a mesh query's vertex, motion.h)
+ * the part of the path traced for an earlier triangle is not traced again: its witness is reused,
+ * a clear stretch is skipped, and the new steps extend the record. */
+static void trace_vertex(scc_fw_state* s, int i, int cap)
 {
     const double b[3] = { i == 0, i == 1, i == 2 };
+    scc_vertex_trace* r = s->m->trace[i];
     double t = s->ts;
+    double speed;
+    if (r) {
+        if (r->speed < 0.0) r->speed = scc_vertex_speed_bound(s->m, i);
+        speed = r->speed;
+        if (r->hit_t >= s->ts && r->hit_t <= s->te) {
+            scc_fw_witness(s, r->hit_t, b, r->hit_phi);
+            return;
+        }
+        if (r->from <= t && t < r->to) t = r->to;
+    } else {
+        speed = scc_vertex_speed_bound(s->m, i);
+    }
+    if (!(speed > 0.0)) return;
+    const double start = t;
+    double t_prev = t, f_prev = INFINITY, clear_to = t;
     for (int k = 0; k < cap && t < s->te && s->evals < s->p->max_evals; ++k) {
         scc_vec3 x = scc_fw_point(s, b, t, NULL);
         double phi = scc_sdf_eval(s->sdf, x, NULL);
         s->evals++;
         if (phi <= s->p->margin) {
+            if (k > 0) refine_entry(s, b, t_prev, f_prev, &t, &phi);
             scc_fw_witness(s, t, b, phi);
-            return;
+            if (r && t < r->hit_t) { r->hit_t = t; r->hit_phi = phi; }
+            clear_to = t_prev;
+            break;
         }
+        t_prev = t;
+        f_prev = phi - s->p->margin;
         scc_aabb box = { scc_sub(x, scc_v3(phi, phi, phi)), scc_add(x, scc_v3(phi, phi, phi)) };
         double step = (phi - s->p->margin) / (fmax(scc_sdf_lipschitz(s->sdf, &box), 1e-12) * speed);
         /* Near the surface the steps shrink geometrically; a step of the time tolerance can then
          * pass a crossing by at most that tolerance. */
         t += fmax(step, s->p->time_tol);
+        clear_to = t;
+    }
+    if (!r || !(clear_to > start)) return;
+    /* [start, clear_to) is clear now: merge it with the recorded stretch when they touch, else
+     * keep the longer one */
+    if (!(r->to > r->from) || start > r->to || clear_to < r->from) {
+        if (!(r->to > r->from) || clear_to - start > r->to - r->from) { r->from = start; r->to = clear_to; }
+    } else {
+        r->from = fmin(r->from, start);
+        r->to = fmax(r->to, clear_to);
     }
 }
 
@@ -327,10 +386,8 @@ void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb
         scc_fw_finish(&s, 1, 0, out);
         return;
     }
-    if (p->fwgss_vertex_trace > 0) {
-        if (speed > 0.0)
-            for (int i = 0; i < 3; ++i) trace_vertex(&s, i, speed, p->fwgss_vertex_trace);
-    }
+    if (p->fwgss_vertex_trace > 0)
+        for (int i = 0; i < 3; ++i) trace_vertex(&s, i, p->fwgss_vertex_trace);
     int order[3];
     scc_fw_start_order(&s, order);
     int converged = 1;

@@ -12,6 +12,8 @@
 #include "bsh.h"
 #include "ccd.h"
 
+#include <string.h>
+
 typedef struct contact_buf {
     scc_contact* a;
     size_t n, cap;
@@ -42,6 +44,7 @@ void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_mot
     m->sdf = mm->sdf;
     m->t0 = mm->t0;
     m->t1 = mm->t1;
+    m->trace[0] = m->trace[1] = m->trace[2] = NULL;
     if (mm->body) {
         m->kind = SCC_TRI_RIGID;
         m->body = mm->body;
@@ -71,6 +74,7 @@ typedef struct mesh_ctx {
     void* probe_user;
     int64_t broad_evals;
     const scc_bsh_stats* broad;  /* live broad-phase counters (NULL without the broad phase) */
+    scc_vertex_trace* traces;    /* one per mesh vertex (FWGSS with the vertex trace), else NULL */
     int budget_exhausted;        /* the evaluation budget ran out before every triangle was tested */
 } mesh_ctx;
 
@@ -95,6 +99,19 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
     double tb = fmin(c->mm->t1, c->best + p->toi_window);
     scc_tri_motion m;
     scc_mesh_triangle_motion(c->mm, t, &m);
+    if (c->traces) {
+        const uint32_t* f = c->mm->mesh->indices + 3 * t;
+        for (int i = 0; i < 3; ++i) {
+            scc_vertex_trace* r = &c->traces[f[i]];
+            if (r->epoch != c->ws->trace_epoch) {
+                r->epoch = c->ws->trace_epoch;
+                r->speed = -1.0;
+                r->from = r->to = 0.0;
+                r->hit_t = r->hit_phi = INFINITY;
+            }
+            m.trace[i] = r;
+        }
+    }
     scc_query_summary s;
     if (c->probe) c->probe(c->probe_user, t, 1);
     if (!(ta < tb)) ta = c->mm->t0;
@@ -213,9 +230,22 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     c.broad_evals = 0;
     c.broad = NULL;
     c.budget_exhausted = 0;
+    c.traces = NULL;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
     int ok = 1;
-    if (p->broad_phase && mm->mesh->triangle_count > 0) {
+    if (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0 && mm->mesh->vertex_count > 0) {
+        /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
+        size_t need = (size_t)mm->mesh->vertex_count * sizeof *c.traces;
+        int fresh = ws->slot[SCC_WS_TRACES].bytes < need;
+        c.traces = scc_ws_get(ws, SCC_WS_TRACES, need);
+        if (!c.traces) ok = 0;
+        else if (fresh || ++ws->trace_epoch == 0) {
+            memset(c.traces, 0, ws->slot[SCC_WS_TRACES].bytes);
+            ws->trace_epoch = 1;
+        }
+    }
+    if (!ok) {
+    } else if (p->broad_phase && mm->mesh->triangle_count > 0) {
         ok = run_broad_phase(&c);
     } else {
         for (uint32_t t = 0; t < mm->mesh->triangle_count && ok && !c.budget_exhausted; ++t) ok = test_triangle(&c, t, mm->t0);

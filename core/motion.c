@@ -125,6 +125,17 @@ double scc_tri_speed_bound(const scc_tri_motion* m)
     return speed;
 }
 
+double scc_vertex_speed_bound(const scc_tri_motion* m, int i)
+{
+    scc_tri_motion v = *m;
+    for (int k = 0; k < 3; ++k) {
+        v.local[k] = m->local[i];
+        v.start[k] = m->start[i];
+        v.end[k] = m->end[i];
+    }
+    return scc_tri_speed_bound(&v);
+}
+
 double scc_tri_accel_bound(const scc_tri_motion* m)
 {
     /* World acceleration of a point of a body spinning at constant w about a centre moving at

@@ -10,6 +10,7 @@
 #ifndef SCC_MOTION_H
 #define SCC_MOTION_H
 
+#include <stdint.h>
 #include "scc_math.h"
 
 typedef struct scc_rigid {
@@ -28,6 +29,18 @@ scc_vec3 scc_rigid_center_at(const scc_rigid* r, double t);
 
 typedef enum scc_tri_motion_kind { SCC_TRI_RIGID, SCC_TRI_LINEAR } scc_tri_motion_kind;
 
+/* What one query has learnt about one vertex path by FWGSS's conservative vertex trace
+ * (fwgss.c). A mesh query keeps one per mesh vertex and hands the triangle solver the records of
+ * its three vertices, so a vertex shared by several triangles is traced once per query instead of
+ * once per triangle; a triangle query has none. */
+typedef struct scc_vertex_trace {
+    uint32_t epoch;     /* the mesh query's epoch when the record is in use (stale otherwise) */
+    double speed;       /* speed bound of this vertex (SDF frame); < 0 until computed */
+    double from, to;    /* the path is clear of the margin on [from, to) (empty when to <= from) */
+    double hit_t;       /* earliest contact witnessed on the path (INFINITY: none) */
+    double hit_phi;     /* phi there */
+} scc_vertex_trace;
+
 typedef struct scc_tri_motion {
     scc_tri_motion_kind kind;
     scc_vec3 local[3];       /* SCC_TRI_RIGID: vertices in the body's local frame */
@@ -36,6 +49,7 @@ typedef struct scc_tri_motion {
     const scc_rigid* body;   /* SCC_TRI_RIGID */
     const scc_rigid* sdf;    /* NULL: the SDF is static at the world origin */
     double t0, t1;           /* the query interval (linear motion spans exactly this) */
+    scc_vertex_trace* trace[3]; /* optional shared vertex traces (mesh query); NULL: traced locally */
 } scc_tri_motion;
 
 /* A snapshot of the triangle at one time: vertex positions and velocities in the SDF frame. */
@@ -54,6 +68,8 @@ scc_vec3 scc_tri_point_at(const scc_tri_motion* m, const double b[3], double t, 
 
 /* Upper bound on the speed (SDF frame) of any point of the triangle over [m->t0, m->t1]. */
 double scc_tri_speed_bound(const scc_tri_motion* m);
+/* The same for vertex i of the triangle alone. */
+double scc_vertex_speed_bound(const scc_tri_motion* m, int i);
 
 /* Upper bound on the acceleration (SDF frame) of any point of the triangle over [m->t0, m->t1]. */
 double scc_tri_accel_bound(const scc_tri_motion* m);

@@ -8,6 +8,7 @@
 #define SCC_WORKSPACE_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "alloc.h"
 
 enum {
@@ -19,6 +20,7 @@ enum {
     SCC_WS_MOVING,    /* broad phase: nodes refitted for linear motion */
     SCC_WS_STAGING,   /* the ABI: contacts before conversion to the world frame */
     SCC_WS_VERTICES,  /* the ABI: linear-motion vertex copies */
+    SCC_WS_TRACES,    /* mesh query: one FWGSS vertex trace record per mesh vertex (motion.h) */
     SCC_WS_SLOTS
 };
 
@@ -27,11 +29,13 @@ typedef struct scc_ws_slot { void* p; size_t bytes; } scc_ws_slot;
 typedef struct scc_workspace {
     const scc_allocator* alloc;
     scc_ws_slot slot[SCC_WS_SLOTS];
+    uint32_t trace_epoch;  /* mesh queries so far (tags the SCC_WS_TRACES records in use) */
 } scc_workspace;
 
 static inline void scc_ws_init(scc_workspace* ws, const scc_allocator* alloc)
 {
     ws->alloc = alloc;
+    ws->trace_epoch = 0;
     for (int i = 0; i < SCC_WS_SLOTS; ++i) {
         ws->slot[i].p = NULL;
         ws->slot[i].bytes = 0;
