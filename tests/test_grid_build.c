@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "test_util.h"
-#include "grid_internal.h"
+#include "test_internal.h"
 
 #ifndef SDFCCD_TEST_TMP_DIR
 #define SDFCCD_TEST_TMP_DIR "."
@@ -101,8 +101,8 @@ START_TEST(test_threads_identical_and_progress)
     def.progress_user = &log;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &b), SDFCCD_OK);
     scc_grid *ga, *gb;
-    ck_assert_int_eq(sdfccd__grid_lookup(a, "t", &ga), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd__grid_lookup(b, "t", &gb), SDFCCD_OK);
+    ga = test_grid_of(a);
+    gb = test_grid_of(b);
     ck_assert_uint_eq(ga->fields[0].node_count, gb->fields[0].node_count);
     for (uint64_t l = 0; l < ga->fields[0].node_count; ++l) ck_assert(scc_grid_node_value(ga, 0, l) == scc_grid_node_value(gb, 0, l));
     ck_assert_int_eq(memcmp(ga->cell_lipschitz, gb->cell_lipschitz, ga->fields[0].cell_count * 4), 0);
@@ -313,7 +313,7 @@ START_TEST(test_lipschitz_bounds)
     sdfccd_SdfId id;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &id), SDFCCD_OK);
     scc_grid* g;
-    ck_assert_int_eq(sdfccd__grid_lookup(id, "t", &g), SDFCCD_OK);
+    g = test_grid_of(id);
     double worst_ratio = 0, sum_ratio = 0;
     for (uint64_t l = 0; l < g->n_cells; ++l) {
         const uint32_t i = (uint32_t)(l % 10), j = (uint32_t)(l / 10 % 10), k = (uint32_t)(l / 100);

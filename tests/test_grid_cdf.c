@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "test_util.h"
-#include "grid_internal.h"
+#include "test_internal.h"
 
 #ifndef SDFCCD_TEST_TMP_DIR
 #define SDFCCD_TEST_TMP_DIR "."
@@ -26,13 +26,6 @@ static unsigned char* read_all(const char* path, size_t* out_size)
     fclose(f);
     *out_size = (size_t)n;
     return b;
-}
-
-static scc_grid* grid_of(sdfccd_SdfId id)
-{
-    scc_grid* g = NULL;
-    ck_assert_int_eq(sdfccd__grid_lookup(id, "test", &g), SDFCCD_OK);
-    return g;
 }
 
 static sdfccd_SdfId load_grid(const char* rel)
@@ -182,7 +175,7 @@ START_TEST(test_box_cdf_loads_and_matches_analytic)
     ck_assert_int_eq(info.file_bytes, 27040);
     ck_assert_double_eq(info.domain.hi.x, 1.0034641016151378);
     ck_assert_double_eq(info.domain.lo.x, -1.0034701016151377);
-    scc_grid* g = grid_of(id);
+    scc_grid* g = test_grid_of(id);
     /* Node values equal the exact box distance at the positions of section 2. */
     for (uint64_t l = 0; l < g->fields[0].node_count; ++l)
         ck_assert_double_near(scc_grid_node_value(g, 0, l), test_box_distance(sdfccd__pv(scc_grid_dense_node_position(g, l)), 1.0), 1e-12);
@@ -327,9 +320,9 @@ static void compare_with_generated(const char* mesh_rel, const char* cdf_rel, in
     def.resolution[0] = def.resolution[1] = def.resolution[2] = res;
     sdfccd_SdfId ours, theirs = load_grid(cdf_rel);
     ck_assert_msg(sdfccd_create_grid_from_mesh(mesh, &def, &ours) == SDFCCD_OK, "%s", sdfccd_last_error());
-    scc_grid* a = grid_of(ours);
-    scc_grid* b = grid_of(theirs);
-    const scc_mesh* m = &sdfccd__mesh_lookup(mesh)->mesh;
+    scc_grid* a = test_grid_of(ours);
+    scc_grid* b = test_grid_of(theirs);
+    const scc_mesh* m = test_mesh_of(mesh);
     ck_assert_int_eq(memcmp(&a->lo, &b->lo, sizeof a->lo), 0);
     ck_assert_int_eq(memcmp(&a->hi, &b->hi, sizeof a->hi), 0);
     ck_assert_int_eq(memcmp(&a->h, &b->h, sizeof a->h), 0);
@@ -409,7 +402,7 @@ START_TEST(test_sparse_multifield_cdm)
     def.resolution[0] = def.resolution[1] = def.resolution[2] = 24;
     sdfccd_SdfId dense;
     ck_assert_int_eq(sdfccd_create_grid_from_mesh(mesh, &def, &dense), SDFCCD_OK);
-    scc_grid* g = grid_of(sp);
+    scc_grid* g = test_grid_of(sp);
     test_rng rng = { 99 };
     int culled = 0, kept = 0;
     for (int it = 0; it < 4000; ++it) {
@@ -524,7 +517,7 @@ START_TEST(test_corrupt_files)
         sdfccd_GridInfo gi;
         ck_assert_int_eq(sdfccd_grid_get_info(id, &gi), SDFCCD_OK);
         ck_assert_int_lt(gi.valued_cells, 125);
-        scc_grid* g = grid_of(id);
+        scc_grid* g = test_grid_of(id);
         const sdfccd_Vec3 p = { g->lo.x + 4.6 * g->h.x, g->lo.y + 2.5 * g->h.y, g->lo.z + 2.5 * g->h.z };
         double v, raw;
         sdfccd_Vec3 gr;

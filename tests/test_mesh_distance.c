@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "test_util.h"
-#include "grid_internal.h"
+#include "test_internal.h"
 #include "../core/mesh_distance.h"
 
 static double winding_number(const scc_mesh* m, scc_vec3 p)
@@ -77,7 +77,7 @@ START_TEST(test_bvh_vs_brute_force)
     test_rng rng = { 2 };
     for (size_t mi = 0; mi < sizeof meshes / sizeof meshes[0]; ++mi) {
         sdfccd_MeshId id = test_load_mesh(meshes[mi]);
-        const scc_mesh* m = &sdfccd__mesh_lookup(id)->mesh;
+        const scc_mesh* m = test_mesh_of(id);
         scc_tri_bvh bvh;
         ck_assert_int_eq(scc_tri_bvh_build(&bvh, sdfccd__allocator(), m), 1);
         const scc_vec3 c = scc_scale(scc_add(m->bounds.lo, m->bounds.hi), 0.5), e = scc_sub(m->bounds.hi, m->bounds.lo);
@@ -233,7 +233,7 @@ START_TEST(test_signs_vs_winding_number)
     test_rng rng = { 5 };
     for (size_t mi = 0; mi < sizeof meshes / sizeof meshes[0]; ++mi) {
         sdfccd_MeshId id = test_load_mesh(meshes[mi]);
-        const scc_mesh* m = &sdfccd__mesh_lookup(id)->mesh;
+        const scc_mesh* m = test_mesh_of(id);
         sdfccd_MeshTopology topo;
         ck_assert_int_eq(sdfccd_mesh_get_topology(id, &topo), SDFCCD_OK);
         ck_assert_msg(topo.closed && topo.volume > 0, "%s should be closed and outward", meshes[mi]);

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT
  * sdfccd C ABI: allocator hooks and byte count, error messages, version queries, the
- * generation-checked handle registry shared by SDFs and meshes, and SDF objects (mesh objects
- * are in mesh_api.c). */
+ * generation-checked handle registry shared by SDFs and meshes, and the one lifetime both kinds
+ * of object share (references, acquire for calls in flight, destroy). Mesh creation is in
+ * mesh_api.c, the SDF kinds in sdf_api.c. */
 #include "capi_internal.h"
 #include "../../core/bsh.h"
 
@@ -206,20 +207,8 @@ int sdfccd__registry_add(void* obj, uint32_t kind, uint32_t* out_index1, uint32_
     return 1;
 }
 
-void* sdfccd__registry_get(uint32_t index1, uint32_t generation, uint32_t kind)
-{
-    void* obj = NULL;
-    pthread_mutex_lock(&s_lock);
-    if (index1 >= 1 && index1 <= s_slot_count) {
-        slot* s = &s_slots[index1 - 1];
-        if (s->kind == kind && s->generation == generation) obj = s->obj;
-    }
-    pthread_mutex_unlock(&s_lock);
-    return obj;
-}
-
 /* Removes the entry and returns its object (NULL if the id is not live). */
-void* sdfccd__registry_remove(uint32_t index1, uint32_t generation, uint32_t kind)
+static void* registry_remove(uint32_t index1, uint32_t generation, uint32_t kind)
 {
     void* obj = NULL;
     pthread_mutex_lock(&s_lock);
@@ -238,7 +227,53 @@ void* sdfccd__registry_remove(uint32_t index1, uint32_t generation, uint32_t kin
     return obj;
 }
 
-/* ---------------- SDF objects ---------------- */
+/* ---------------- objects behind handles ----------------
+ * SDF and mesh objects share one lifetime: a reference count changed only under the registry
+ * lock, one reference held by the handle and one by every call in flight that uses the object
+ * (and, for SDFs, one by every combination using it as a child). Whatever drops the last one
+ * frees the object, so a destroy that races a call frees it when that call returns. */
+
+static const char* kind_noun(uint32_t kind) { return kind == SDFCCD__KIND_SDF ? "SDF" : "mesh"; }
+
+static uint32_t* object_refs(void* obj, uint32_t kind)
+{
+    return kind == SDFCCD__KIND_SDF ? &((sdfccd__sdf*)obj)->refs : &((sdfccd__mesh*)obj)->refs;
+}
+
+static void object_free(void* obj, uint32_t kind)
+{
+    if (kind == SDFCCD__KIND_SDF) {
+        sdfccd__sdf* s = obj;
+        if (s->release_extra) s->release_extra(s);
+        for (int i = 0; i < 2; ++i) sdfccd__sdf_release(s->children[i]);
+        sdfccd__free(s->storage, s->storage_size);
+        sdfccd__free(s, sizeof *s);
+    } else {
+        sdfccd__mesh* m = obj;
+        scc_bsh_destroy(m->bsh, sdfccd__allocator());
+        sdfccd__free(m->block, m->block_size);
+        sdfccd__free(m, sizeof *m);
+    }
+}
+
+static void object_release(void* obj, uint32_t kind)
+{
+    if (!obj) return;
+    pthread_mutex_lock(&s_lock);
+    const uint32_t left = --*object_refs(obj, kind);
+    pthread_mutex_unlock(&s_lock);
+    if (!left) object_free(obj, kind);
+}
+
+void sdfccd__sdf_release(sdfccd__sdf* s) { object_release(s, SDFCCD__KIND_SDF); }
+void sdfccd__mesh_release(sdfccd__mesh* m) { object_release(m, SDFCCD__KIND_MESH); }
+
+void sdfccd__sdf_retain(sdfccd__sdf* s)
+{
+    pthread_mutex_lock(&s_lock);
+    s->refs++;
+    pthread_mutex_unlock(&s_lock);
+}
 
 sdfccd__sdf* sdfccd__sdf_new(size_t storage_size)
 {
@@ -253,27 +288,6 @@ sdfccd__sdf* sdfccd__sdf_new(size_t storage_size)
     return s;
 }
 
-void sdfccd__sdf_release(sdfccd__sdf* s)
-{
-    if (!s) return;
-    /* References only change under the registry lock so concurrent destroys stay consistent. */
-    pthread_mutex_lock(&s_lock);
-    uint32_t left = --s->refs;
-    pthread_mutex_unlock(&s_lock);
-    if (left) return;
-    if (s->release_extra) s->release_extra(s);
-    for (int i = 0; i < 2; ++i) sdfccd__sdf_release(s->children[i]);
-    sdfccd__free(s->storage, s->storage_size);
-    sdfccd__free(s, sizeof *s);
-}
-
-void sdfccd__sdf_retain(sdfccd__sdf* s)
-{
-    pthread_mutex_lock(&s_lock);
-    s->refs++;
-    pthread_mutex_unlock(&s_lock);
-}
-
 sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id)
 {
     sdfccd_SdfId id = { 0, 0 };
@@ -286,10 +300,10 @@ sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id)
 }
 
 /* ---------------- references held by calls in flight ----------------
- * A query or evaluation takes a reference on the objects it uses (acquire), recorded in a
- * per-thread list, and drops them when it returns (release_to). A destroy that races it only
- * drops the handle's reference, so the object is freed when the last call using it ends. */
-enum { HOLD_MAX = 16 };
+ * Every public call that takes a handle runs inside SDFCCD__HELD_CALL: acquire records the
+ * reference it takes in a per-thread list, and the wrapper drops everything recorded since the
+ * call began when it returns. There is no other way from a handle to its object. */
+enum { HOLD_MAX = 32 };
 typedef struct held { void* obj; uint32_t kind; } held;
 static _Thread_local held s_held[HOLD_MAX];
 static _Thread_local int s_held_n = 0;
@@ -299,72 +313,58 @@ int sdfccd__hold_mark(void) { return s_held_n; }
 void sdfccd__hold_release_to(int mark)
 {
     while (s_held_n > mark) {
-        held h = s_held[--s_held_n];
-        if (h.kind == SDFCCD__KIND_SDF) sdfccd__sdf_release(h.obj);
-        else sdfccd__mesh_release(h.obj);
+        --s_held_n;
+        object_release(s_held[s_held_n].obj, s_held[s_held_n].kind);
     }
 }
 
-/* Looks up a live handle and, under the registry lock, takes a reference held until release_to. */
+/* Looks up a live handle and, under the registry lock, takes a reference held until release_to.
+ * NULL with an INVALID_HANDLE message when the id is not live (or the list is full: calls nested
+ * through user callbacks deeper than HOLD_MAX). */
 static void* acquire(uint32_t index1, uint32_t generation, uint32_t kind)
 {
     void* obj = NULL;
+    int full = 0;
     pthread_mutex_lock(&s_lock);
-    if (index1 >= 1 && index1 <= s_slot_count && s_held_n < HOLD_MAX) {
+    if (index1 >= 1 && index1 <= s_slot_count) {
         slot* s = &s_slots[index1 - 1];
         if (s->kind == kind && s->generation == generation) {
-            obj = s->obj;
-            if (kind == SDFCCD__KIND_SDF) ((sdfccd__sdf*)obj)->refs++;
-            else ((sdfccd__mesh*)obj)->refs++;
-            s_held[s_held_n].obj = obj;
-            s_held[s_held_n].kind = kind;
-            ++s_held_n;
+            if (s_held_n < HOLD_MAX) {
+                obj = s->obj;
+                ++*object_refs(obj, kind);
+                s_held[s_held_n].obj = obj;
+                s_held[s_held_n].kind = kind;
+                ++s_held_n;
+            } else {
+                full = 1;
+            }
         }
     }
     pthread_mutex_unlock(&s_lock);
+    if (full)
+        sdfccd__error(SDFCCD_INVALID_HANDLE, "%s handle {%u, %u}: more than %d handles in use by nested calls on this thread",
+                      kind_noun(kind), index1, generation, HOLD_MAX);
+    else if (!obj)
+        sdfccd__error(SDFCCD_INVALID_HANDLE, "%s handle {%u, %u} is not a live %s", kind_noun(kind), index1, generation, kind_noun(kind));
     return obj;
 }
 
-sdfccd__sdf* sdfccd__sdf_acquire(sdfccd_SdfId id)
-{
-    sdfccd__sdf* s = acquire(id.index1, id.generation, SDFCCD__KIND_SDF);
-    if (!s) sdfccd__error(SDFCCD_INVALID_HANDLE, "SDF handle {%u, %u} is not a live SDF", id.index1, id.generation);
-    return s;
-}
+sdfccd__sdf* sdfccd__sdf_acquire(sdfccd_SdfId id) { return acquire(id.index1, id.generation, SDFCCD__KIND_SDF); }
+sdfccd__mesh* sdfccd__mesh_acquire(sdfccd_MeshId id) { return acquire(id.index1, id.generation, SDFCCD__KIND_MESH); }
 
-sdfccd__mesh* sdfccd__mesh_acquire(sdfccd_MeshId id)
+/* Removes the handle and drops its reference (the object lives on while calls or combinations
+ * still hold one). */
+static sdfccd_Status destroy_handle(uint32_t index1, uint32_t generation, uint32_t kind, const char* fn)
 {
-    sdfccd__mesh* m = acquire(id.index1, id.generation, SDFCCD__KIND_MESH);
-    if (!m) sdfccd__error(SDFCCD_INVALID_HANDLE, "mesh handle {%u, %u} is not a live mesh", id.index1, id.generation);
-    return m;
-}
-
-void sdfccd__mesh_release(sdfccd__mesh* m)
-{
-    if (!m) return;
-    pthread_mutex_lock(&s_lock);
-    uint32_t left = --m->refs;
-    pthread_mutex_unlock(&s_lock);
-    if (left) return;
-    scc_bsh_destroy(m->bsh, sdfccd__allocator());
-    sdfccd__free(m->block, m->block_size);
-    sdfccd__free(m, sizeof *m);
-}
-
-sdfccd__sdf* sdfccd__sdf_lookup(sdfccd_SdfId id)
-{
-    sdfccd__sdf* s = sdfccd__registry_get(id.index1, id.generation, SDFCCD__KIND_SDF);
-    if (!s) sdfccd__error(SDFCCD_INVALID_HANDLE, "SDF handle {%u, %u} is not a live SDF", id.index1, id.generation);
-    return s;
-}
-
-sdfccd_Status sdfccd_destroy_sdf(sdfccd_SdfId id)
-{
-    sdfccd__sdf* s = sdfccd__registry_remove(id.index1, id.generation, SDFCCD__KIND_SDF);
-    if (!s) return sdfccd__error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_sdf: handle {%u, %u} is not a live SDF", id.index1, id.generation);
-    sdfccd__sdf_release(s);
+    void* obj = registry_remove(index1, generation, kind);
+    if (!obj)
+        return sdfccd__error(SDFCCD_INVALID_HANDLE, "%s: handle {%u, %u} is not a live %s", fn, index1, generation, kind_noun(kind));
+    object_release(obj, kind);
     return SDFCCD_OK;
 }
+
+sdfccd_Status sdfccd_destroy_sdf(sdfccd_SdfId id) { return destroy_handle(id.index1, id.generation, SDFCCD__KIND_SDF, "sdfccd_destroy_sdf"); }
+sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId id) { return destroy_handle(id.index1, id.generation, SDFCCD__KIND_MESH, "sdfccd_destroy_mesh"); }
 
 sdfccd_Pose sdfccd_pose_identity(void)
 {

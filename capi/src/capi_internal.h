@@ -62,10 +62,6 @@ static inline sdfccd_Status sdfccd__check_def_args(const char* fn, const void* d
 enum { SDFCCD__KIND_FREE = 0, SDFCCD__KIND_SDF = 1, SDFCCD__KIND_MESH = 2 };
 /* Adds `obj` under a new generation-checked id; 0 when the table cannot grow. */
 int sdfccd__registry_add(void* obj, uint32_t kind, uint32_t* out_index1, uint32_t* out_generation);
-/* The live object of that id and kind, or NULL. */
-void* sdfccd__registry_get(uint32_t index1, uint32_t generation, uint32_t kind);
-/* Removes the entry and returns its object (NULL if the id is not live). */
-void* sdfccd__registry_remove(uint32_t index1, uint32_t generation, uint32_t kind);
 
 /* ---- SDF objects ----
  * A sdfccd__sdf owns one block `storage` (the concrete core SDF, which embeds scc_sdf first),
@@ -88,8 +84,6 @@ void sdfccd__sdf_release(sdfccd__sdf* s);
 void sdfccd__sdf_retain(sdfccd__sdf* s); /* adds a reference (for combinations that use a child) */
 /* Registers a new object (takes over its one reference). On failure the object is released. */
 sdfccd_Status sdfccd__sdf_register(sdfccd__sdf* s, sdfccd_SdfId* out_id);
-/* Looks up a live handle; NULL (with an INVALID_HANDLE message set) when unknown. */
-sdfccd__sdf* sdfccd__sdf_lookup(sdfccd_SdfId id);
 
 /* ---- mesh objects (mesh_api.c) ---- */
 typedef struct sdfccd__mesh {
@@ -106,18 +100,26 @@ typedef struct sdfccd__mesh {
 sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count, const uint32_t* indices,
                                   uint32_t triangle_count, int drop_degenerate, const char* what,
                                sdfccd_MeshId* out_mesh);
-sdfccd__mesh* sdfccd__mesh_lookup(sdfccd_MeshId id);
 /* Drops one reference; frees the mesh at zero. */
 void sdfccd__mesh_release(sdfccd__mesh* m);
 
 /* ---- references held by a call in flight (safe concurrent destroy) ----
- * acquire looks up a live handle and takes a reference recorded in a per-thread list; a public
- * call takes mark = sdfccd__hold_mark() on entry and calls sdfccd__hold_release_to(mark) on
- * every return, so a concurrent destroy frees the object only after the call ends. */
+ * The only way from a handle to its object: acquire looks up a live handle and takes a
+ * reference recorded in a per-thread list. Every public call that takes a handle runs its body
+ * through SDFCCD__HELD_CALL, which drops what the body acquired when it returns, so a destroy
+ * racing the call frees the object only after the call ends (never a use after free). */
 sdfccd__sdf* sdfccd__sdf_acquire(sdfccd_SdfId id);   /* NULL with an INVALID_HANDLE message */
 sdfccd__mesh* sdfccd__mesh_acquire(sdfccd_MeshId id); /* NULL with an INVALID_HANDLE message */
 int sdfccd__hold_mark(void);
 void sdfccd__hold_release_to(int mark);
+/* `return body;` with every reference the body acquired dropped after it ran. */
+#define SDFCCD__HELD_CALL(body)                           \
+    do {                                                  \
+        const int mark_ = sdfccd__hold_mark();            \
+        const sdfccd_Status st_ = (body);                 \
+        sdfccd__hold_release_to(mark_);                   \
+        return st_;                                       \
+    } while (0)
 /* DEGENERATE with a message when the topology cannot give correct signs, else OK. */
 struct scc_mesh_topology;
 sdfccd_Status sdfccd__mesh_topology_message(const struct scc_mesh_topology* t, const char* fn);

@@ -174,16 +174,6 @@ static sdfccd_Status check_interval(double t0, double t1, const char* fn)
     return SDFCCD_OK;
 }
 
-/* Runs a query body and drops the references it acquired (sdfccd__sdf_acquire/mesh_acquire), so
- * an SDF or mesh destroyed by another thread during the call is freed only when it returns. */
-#define HELD_CALL(body)                                   \
-    do {                                                  \
-        const int mark_ = sdfccd__hold_mark();            \
-        const sdfccd_Status st_ = (body);                 \
-        sdfccd__hold_release_to(mark_);                   \
-        return st_;                                       \
-    } while (0)
-
 /* Common prologue: out_result, params, interval, SDF handle (acquired) and SDF motion. */
 typedef struct query_setup {
     scc_params p;
@@ -209,7 +199,7 @@ static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motio
         if ((st = convert_motion(sdf_motion, t0, t1, what, &q->sdf_motion))) return st;
         q->sdf_motion_ptr = &q->sdf_motion;
     }
-    q->sdf = sdfccd__sdf_acquire(sdf); /* held until the public call returns (HELD_CALL) */
+    q->sdf = sdfccd__sdf_acquire(sdf); /* held until the public call returns (SDFCCD__HELD_CALL) */
     if (!q->sdf) return SDFCCD_INVALID_HANDLE;
     return SDFCCD_OK;
 }
@@ -326,14 +316,14 @@ sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* 
                                     const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
                                     sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
-    HELD_CALL(query_triangle(sdf, sdf_motion, triangle, motion, t0, t1, params, out_contacts, capacity, out_result));
+    SDFCCD__HELD_CALL(query_triangle(sdf, sdf_motion, triangle, motion, t0, t1, params, out_contacts, capacity, out_result));
 }
 
 sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3],
                                            const sdfccd_Vec3 end[3], double t0, double t1, const sdfccd_QueryParams* params,
                                            sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
-    HELD_CALL(query_triangle_linear(sdf, sdf_motion, start, end, t0, t1, params, out_contacts, capacity, out_result));
+    SDFCCD__HELD_CALL(query_triangle_linear(sdf, sdf_motion, start, end, t0, t1, params, out_contacts, capacity, out_result));
 }
 
 sdfccd_Status sdfccd_create_workspace(sdfccd_Workspace** out_workspace)
@@ -402,7 +392,7 @@ sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_
                                 const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
                                 sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
-    HELD_CALL(query_mesh(NULL, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh"));
+    SDFCCD__HELD_CALL(query_mesh(NULL, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh"));
 }
 
 sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
@@ -411,7 +401,7 @@ sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_mesh_ws: workspace"))) return st;
-    HELD_CALL(query_mesh(workspace, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh_ws"));
+    SDFCCD__HELD_CALL(query_mesh(workspace, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh_ws"));
 }
 
 static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
@@ -459,7 +449,7 @@ sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotio
                                        const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
                                        sdfccd_QueryResult* out_result)
 {
-    HELD_CALL(query_mesh_linear(NULL, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
+    SDFCCD__HELD_CALL(query_mesh_linear(NULL, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
                                 "sdfccd_query_mesh_linear"));
 }
 
@@ -470,6 +460,6 @@ sdfccd_Status sdfccd_query_mesh_linear_ws(sdfccd_Workspace* workspace, sdfccd_Sd
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_mesh_linear_ws: workspace"))) return st;
-    HELD_CALL(query_mesh_linear(workspace, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
+    SDFCCD__HELD_CALL(query_mesh_linear(workspace, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_contacts, capacity, out_result,
                                 "sdfccd_query_mesh_linear_ws"));
 }

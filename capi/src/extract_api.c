@@ -3,12 +3,12 @@
 #include "capi_internal.h"
 #include "../../core/marching_tetrahedra.h"
 
-sdfccd_Status sdfccd_extract_isosurface(sdfccd_SdfId sdf, sdfccd_Aabb box, int32_t resolution,
+static sdfccd_Status extract_isosurface_held(sdfccd_SdfId sdf, sdfccd_Aabb box, int32_t resolution,
                                         sdfccd_MeshId* out_mesh)
 {
     sdfccd_Status st = sdfccd__check_ptr(out_mesh, "out_mesh");
     if (st != SDFCCD_OK) return st;
-    sdfccd__sdf* s = sdfccd__sdf_lookup(sdf);
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     if ((st = sdfccd__check_vec(box.lo, "box.lo")) != SDFCCD_OK) return st;
     if ((st = sdfccd__check_vec(box.hi, "box.hi")) != SDFCCD_OK) return st;
@@ -39,4 +39,10 @@ sdfccd_Status sdfccd_extract_isosurface(sdfccd_SdfId sdf, sdfccd_Aabb box, int32
                              1, "sdfccd_extract_isosurface", out_mesh);
     scc_isosurface_free(&iso, sdfccd__allocator());
     return st;
+}
+
+sdfccd_Status sdfccd_extract_isosurface(sdfccd_SdfId sdf, sdfccd_Aabb box, int32_t resolution,
+                                        sdfccd_MeshId* out_mesh)
+{
+    SDFCCD__HELD_CALL(extract_isosurface_held(sdf, box, resolution, out_mesh));
 }

@@ -34,10 +34,10 @@ sdfccd_Status sdfccd__grid_register(scc_grid* g, sdfccd_SdfId* out_sdf)
     return sdfccd__sdf_register(s, out_sdf);
 }
 
-sdfccd_Status sdfccd__grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid)
+sdfccd_Status sdfccd__grid_acquire(sdfccd_SdfId id, const char* fn, scc_grid** out_grid)
 {
     *out_grid = NULL;
-    sdfccd__sdf* s = sdfccd__sdf_lookup(id);
+    sdfccd__sdf* s = sdfccd__sdf_acquire(id); /* held until the caller's SDFCCD__HELD_CALL returns */
     if (!s) return sdfccd__error(SDFCCD_INVALID_HANDLE, "%s: SDF handle {%u, %u} is not a live SDF", fn, id.index1, id.generation);
     if (s->release_extra != grid_release)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: SDF handle {%u, %u} is not a grid", fn, id.index1, id.generation);
@@ -241,12 +241,12 @@ static double mesh_sample(void* user, scc_vec3 p, uint32_t* state, double cap)
     return c->sign * scc_mesh_sdf_distance_capped(c->ms, p, state, cap);
 }
 
-sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
+static sdfccd_Status create_grid_from_mesh_held(sdfccd_MeshId mesh, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
 {
     static const char* fn = "sdfccd_create_grid_from_mesh";
     sdfccd_Status st;
     if ((st = check_grid_def(def, fn)) || (st = sdfccd__check_ptr(out_grid, "sdfccd_create_grid_from_mesh: out_grid"))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
+    sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_sdf ms;
     if (!scc_mesh_sdf_init(&ms, sdfccd__allocator(), &m->mesh)) return sdfccd__oom("a mesh distance structure");
@@ -274,6 +274,11 @@ sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_Grid
     return sdfccd__grid_register(g, out_grid);
 }
 
+sdfccd_Status sdfccd_create_grid_from_mesh(sdfccd_MeshId mesh, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
+{
+    SDFCCD__HELD_CALL(create_grid_from_mesh_held(mesh, def, out_grid));
+}
+
 /* ---------------- build from an SDF ---------------- */
 
 typedef struct sdf_sample_ctx { const scc_sdf* sdf; double sign; } sdf_sample_ctx;
@@ -286,12 +291,12 @@ static double sdf_sample(void* user, scc_vec3 p, uint32_t* state, double cap)
     return c->sign * scc_sdf_eval(c->sdf, p, NULL);
 }
 
-sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
+static sdfccd_Status create_grid_from_sdf_held(sdfccd_SdfId sdf, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
 {
     static const char* fn = "sdfccd_create_grid_from_sdf";
     sdfccd_Status st;
     if ((st = check_grid_def(def, fn)) || (st = sdfccd__check_ptr(out_grid, "sdfccd_create_grid_from_sdf: out_grid"))) return st;
-    sdfccd__sdf* s = sdfccd__sdf_lookup(sdf);
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     scc_aabb domain;
     if (def->fit_domain) {
@@ -302,7 +307,6 @@ sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef
         domain = sdfccd__box(def->domain);
     }
     if ((st = check_domain(domain, def, fn))) return st;
-    sdfccd__sdf_retain(s); /* keep the source alive during the build */
     sdfccd__pool pool;
     sdfccd__pool_init(&pool, def->threads, def->progress, def->progress_user);
     scc_grid_build_def bd;
@@ -313,9 +317,13 @@ sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef
     bd.sample_lipschitz = isfinite(s->sdf->lipschitz) && s->sdf->lipschitz > 0.0 ? s->sdf->lipschitz : 0.0;
     scc_grid* g = NULL;
     st = build_status(scc_grid_build(sdfccd__allocator(), &bd, &g), fn);
-    sdfccd__sdf_release(s);
     if (st) return st;
     return sdfccd__grid_register(g, out_grid);
+}
+
+sdfccd_Status sdfccd_create_grid_from_sdf(sdfccd_SdfId sdf, const sdfccd_GridDef* def, sdfccd_SdfId* out_grid)
+{
+    SDFCCD__HELD_CALL(create_grid_from_sdf_held(sdf, def, out_grid));
 }
 
 /* ---------------- inspection ---------------- */
@@ -328,12 +336,12 @@ int64_t sdfccd__grid_file_bytes(const scc_grid* g)
     return b;
 }
 
-sdfccd_Status sdfccd_grid_get_info(sdfccd_SdfId grid, sdfccd_GridInfo* out_info)
+static sdfccd_Status grid_get_info_held(sdfccd_SdfId grid, sdfccd_GridInfo* out_info)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(out_info, "sdfccd_grid_get_info: out_info"))) return st;
     scc_grid* g;
-    if ((st = sdfccd__grid_lookup(grid, "sdfccd_grid_get_info", &g))) return st;
+    if ((st = sdfccd__grid_acquire(grid, "sdfccd_grid_get_info", &g))) return st;
     sdfccd_GridInfo* o = out_info;
     memset(o, 0, sizeof *o);
     for (int i = 0; i < 3; ++i) o->resolution[i] = (int32_t)g->res[i];
@@ -352,7 +360,12 @@ sdfccd_Status sdfccd_grid_get_info(sdfccd_SdfId grid, sdfccd_GridInfo* out_info)
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_grid_interpolate(sdfccd_SdfId grid, int32_t field, sdfccd_Vec3 p, double* out_value,
+sdfccd_Status sdfccd_grid_get_info(sdfccd_SdfId grid, sdfccd_GridInfo* out_info)
+{
+    SDFCCD__HELD_CALL(grid_get_info_held(grid, out_info));
+}
+
+static sdfccd_Status grid_interpolate_held(sdfccd_SdfId grid, int32_t field, sdfccd_Vec3 p, double* out_value,
                                       sdfccd_Vec3* out_grad, int32_t* out_has_value)
 {
     sdfccd_Status st;
@@ -361,7 +374,7 @@ sdfccd_Status sdfccd_grid_interpolate(sdfccd_SdfId grid, int32_t field, sdfccd_V
         (st = sdfccd__check_vec(p, "sdfccd_grid_interpolate: p")))
         return st;
     scc_grid* g;
-    if ((st = sdfccd__grid_lookup(grid, "sdfccd_grid_interpolate", &g))) return st;
+    if ((st = sdfccd__grid_acquire(grid, "sdfccd_grid_interpolate", &g))) return st;
     if (field < 0 || (uint32_t)field >= g->field_count)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_grid_interpolate: field %d is not in [0, %u)", field, g->field_count);
     double v = 0.0;
@@ -373,13 +386,24 @@ sdfccd_Status sdfccd_grid_interpolate(sdfccd_SdfId grid, int32_t field, sdfccd_V
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_grid_lipschitz_bound(sdfccd_SdfId grid, sdfccd_Aabb box, double* out_bound)
+sdfccd_Status sdfccd_grid_interpolate(sdfccd_SdfId grid, int32_t field, sdfccd_Vec3 p, double* out_value,
+                                      sdfccd_Vec3* out_grad, int32_t* out_has_value)
+{
+    SDFCCD__HELD_CALL(grid_interpolate_held(grid, field, p, out_value, out_grad, out_has_value));
+}
+
+static sdfccd_Status grid_lipschitz_bound_held(sdfccd_SdfId grid, sdfccd_Aabb box, double* out_bound)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(out_bound, "sdfccd_grid_lipschitz_bound: out_bound"))) return st;
     scc_grid* g;
-    if ((st = sdfccd__grid_lookup(grid, "sdfccd_grid_lipschitz_bound", &g))) return st;
+    if ((st = sdfccd__grid_acquire(grid, "sdfccd_grid_lipschitz_bound", &g))) return st;
     scc_aabb b = sdfccd__box(box);
     *out_bound = scc_grid_lipschitz_in(&g->base, &b);
     return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_grid_lipschitz_bound(sdfccd_SdfId grid, sdfccd_Aabb box, double* out_bound)
+{
+    SDFCCD__HELD_CALL(grid_lipschitz_bound_held(grid, box, out_bound));
 }

@@ -202,12 +202,12 @@ sdfccd_Status sdfccd_load_grid(const char* path, sdfccd_SdfId* out_grid)
 
 static int wr(FILE* f, const void* p, size_t n) { return n == 0 || fwrite(p, 1, n, f) == n; }
 
-sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
+static sdfccd_Status save_grid_held(sdfccd_SdfId grid, const char* path)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(path, "sdfccd_save_grid: path"))) return st;
     scc_grid* g;
-    if ((st = sdfccd__grid_lookup(grid, "sdfccd_save_grid", &g))) return st;
+    if ((st = sdfccd__grid_acquire(grid, "sdfccd_save_grid", &g))) return st;
     if (!host_is_little_endian()) return sdfccd__error(SDFCCD_UNSUPPORTED, "sdfccd_save_grid: .cdf files are little-endian; this host is not");
     FILE* f = fopen(path, "wb");
     if (!f) return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_save_grid: cannot create '%s': %s", path, strerror(errno));
@@ -295,4 +295,9 @@ sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
         return sdfccd__error(SDFCCD_IO_ERROR, "sdfccd_save_grid: writing '%s' failed", path);
     }
     return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_save_grid(sdfccd_SdfId grid, const char* path)
+{
+    SDFCCD__HELD_CALL(save_grid_held(grid, path));
 }

@@ -9,8 +9,9 @@
 
 /* Wraps a finished core grid in a new SDF handle (takes ownership; destroys it on failure). */
 sdfccd_Status sdfccd__grid_register(scc_grid* g, sdfccd_SdfId* out_sdf);
-/* The grid behind a handle: INVALID_HANDLE, or INVALID_ARGUMENT when the SDF is not a grid. */
-sdfccd_Status sdfccd__grid_lookup(sdfccd_SdfId id, const char* fn, scc_grid** out_grid);
+/* The grid behind a handle, acquired (sdfccd__sdf_acquire: call it inside SDFCCD__HELD_CALL):
+ * INVALID_HANDLE, or INVALID_ARGUMENT when the SDF is not a grid. */
+sdfccd_Status sdfccd__grid_acquire(sdfccd_SdfId id, const char* fn, scc_grid** out_grid);
 /* Size of the .cdf file of a grid. */
 int64_t sdfccd__grid_file_bytes(const scc_grid* g);
 

@@ -88,21 +88,6 @@ sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count,
     return SDFCCD_OK;
 }
 
-sdfccd__mesh* sdfccd__mesh_lookup(sdfccd_MeshId id)
-{
-    sdfccd__mesh* m = sdfccd__registry_get(id.index1, id.generation, SDFCCD__KIND_MESH);
-    if (!m) sdfccd__error(SDFCCD_INVALID_HANDLE, "mesh handle {%u, %u} is not a live mesh", id.index1, id.generation);
-    return m;
-}
-
-sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId id)
-{
-    sdfccd__mesh* m = sdfccd__registry_remove(id.index1, id.generation, SDFCCD__KIND_MESH);
-    if (!m) return sdfccd__error(SDFCCD_INVALID_HANDLE, "sdfccd_destroy_mesh: handle {%u, %u} is not a live mesh", id.index1, id.generation);
-    sdfccd__mesh_release(m); /* freed now, or when the last query using it returns */
-    return SDFCCD_OK;
-}
-
 sdfccd_MeshDef sdfccd_default_mesh_def(void)
 {
     sdfccd_MeshDef d;
@@ -118,11 +103,11 @@ sdfccd_Status sdfccd_create_mesh(const sdfccd_MeshDef* def, sdfccd_MeshId* out_m
                                def->drop_degenerate, "sdfccd_create_mesh", out_mesh);
 }
 
-sdfccd_Status sdfccd_mesh_get_info(sdfccd_MeshId id, sdfccd_MeshInfo* out_info)
+static sdfccd_Status mesh_get_info_held(sdfccd_MeshId id, sdfccd_MeshInfo* out_info)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(out_info, "sdfccd_mesh_get_info: out_info"))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(id);
+    sdfccd__mesh* m = sdfccd__mesh_acquire(id);
     if (!m) return SDFCCD_INVALID_HANDLE;
     out_info->vertex_count = m->mesh.vertex_count;
     out_info->triangle_count = m->mesh.triangle_count;
@@ -132,9 +117,14 @@ sdfccd_Status sdfccd_mesh_get_info(sdfccd_MeshId id, sdfccd_MeshInfo* out_info)
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_mesh_get_data(sdfccd_MeshId id, double* out_vertices, uint32_t* out_indices)
+sdfccd_Status sdfccd_mesh_get_info(sdfccd_MeshId id, sdfccd_MeshInfo* out_info)
 {
-    sdfccd__mesh* m = sdfccd__mesh_lookup(id);
+    SDFCCD__HELD_CALL(mesh_get_info_held(id, out_info));
+}
+
+static sdfccd_Status mesh_get_data_held(sdfccd_MeshId id, double* out_vertices, uint32_t* out_indices)
+{
+    sdfccd__mesh* m = sdfccd__mesh_acquire(id);
     if (!m) return SDFCCD_INVALID_HANDLE;
     if (out_vertices)
         for (uint32_t i = 0; i < m->mesh.vertex_count; ++i) {
@@ -144,6 +134,11 @@ sdfccd_Status sdfccd_mesh_get_data(sdfccd_MeshId id, double* out_vertices, uint3
         }
     if (out_indices) memcpy(out_indices, m->mesh.indices, (size_t)m->mesh.triangle_count * 3 * sizeof(uint32_t));
     return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_mesh_get_data(sdfccd_MeshId id, double* out_vertices, uint32_t* out_indices)
+{
+    SDFCCD__HELD_CALL(mesh_get_data_held(id, out_vertices, out_indices));
 }
 
 /* ---------------- topology and distance ---------------- */
@@ -160,11 +155,11 @@ sdfccd_Status sdfccd__mesh_topology_message(const scc_mesh_topology* t, const ch
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_mesh_get_topology(sdfccd_MeshId mesh, sdfccd_MeshTopology* out_topology)
+static sdfccd_Status mesh_get_topology_held(sdfccd_MeshId mesh, sdfccd_MeshTopology* out_topology)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(out_topology, "sdfccd_mesh_get_topology: out_topology"))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
+    sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_topology t;
     if (!scc_mesh_topology_check(sdfccd__allocator(), &m->mesh, &t)) return sdfccd__oom("a topology check");
@@ -176,7 +171,12 @@ sdfccd_Status sdfccd_mesh_get_topology(sdfccd_MeshId mesh, sdfccd_MeshTopology* 
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_mesh_signed_distance(sdfccd_MeshId mesh, const sdfccd_Vec3* points, int32_t count, int32_t allow_open,
+sdfccd_Status sdfccd_mesh_get_topology(sdfccd_MeshId mesh, sdfccd_MeshTopology* out_topology)
+{
+    SDFCCD__HELD_CALL(mesh_get_topology_held(mesh, out_topology));
+}
+
+static sdfccd_Status mesh_signed_distance_held(sdfccd_MeshId mesh, const sdfccd_Vec3* points, int32_t count, int32_t allow_open,
                                           double* out_distances, sdfccd_Vec3* out_closest)
 {
     sdfccd_Status st;
@@ -186,7 +186,7 @@ sdfccd_Status sdfccd_mesh_signed_distance(sdfccd_MeshId mesh, const sdfccd_Vec3*
         return st;
     for (int32_t i = 0; i < count; ++i)
         if ((st = sdfccd__check_vec(points[i], "sdfccd_mesh_signed_distance: a point"))) return st;
-    sdfccd__mesh* m = sdfccd__mesh_lookup(mesh);
+    sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_sdf ms;
     if (!scc_mesh_sdf_init(&ms, sdfccd__allocator(), &m->mesh)) return sdfccd__oom("a mesh distance structure");
@@ -203,4 +203,10 @@ sdfccd_Status sdfccd_mesh_signed_distance(sdfccd_MeshId mesh, const sdfccd_Vec3*
     }
     scc_mesh_sdf_destroy(&ms);
     return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_mesh_signed_distance(sdfccd_MeshId mesh, const sdfccd_Vec3* points, int32_t count, int32_t allow_open,
+                                          double* out_distances, sdfccd_Vec3* out_closest)
+{
+    SDFCCD__HELD_CALL(mesh_signed_distance_held(mesh, points, count, allow_open, out_distances, out_closest));
 }

@@ -141,15 +141,15 @@ sdfccd_Status sdfccd_create_spike_grid(const sdfccd_SpikeGridDef* def, sdfccd_Sd
     return sdfccd__sdf_register(s, out_sdf);
 }
 
-sdfccd_Status sdfccd_create_csg(sdfccd_CsgOp op, sdfccd_SdfId a, sdfccd_SdfId b, sdfccd_SdfId* out_sdf)
+static sdfccd_Status create_csg_held(sdfccd_CsgOp op, sdfccd_SdfId a, sdfccd_SdfId b, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(out_sdf, "sdfccd_create_csg: out_sdf"))) return st;
     if (op != SDFCCD_CSG_UNION && op != SDFCCD_CSG_INTERSECTION && op != SDFCCD_CSG_DIFFERENCE)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_csg: unknown operation %d", (int)op);
-    sdfccd__sdf* sa = sdfccd__sdf_lookup(a);
+    sdfccd__sdf* sa = sdfccd__sdf_acquire(a);
     if (!sa) return SDFCCD_INVALID_HANDLE;
-    sdfccd__sdf* sb = sdfccd__sdf_lookup(b);
+    sdfccd__sdf* sb = sdfccd__sdf_acquire(b);
     if (!sb) return SDFCCD_INVALID_HANDLE;
     sdfccd__sdf* s = new_shape(sizeof(scc_sdf_csg), "a CSG combination");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
@@ -160,6 +160,11 @@ sdfccd_Status sdfccd_create_csg(sdfccd_CsgOp op, sdfccd_SdfId a, sdfccd_SdfId b,
     s->children[0] = sa;
     s->children[1] = sb;
     return sdfccd__sdf_register(s, out_sdf);
+}
+
+sdfccd_Status sdfccd_create_csg(sdfccd_CsgOp op, sdfccd_SdfId a, sdfccd_SdfId b, sdfccd_SdfId* out_sdf)
+{
+    SDFCCD__HELD_CALL(create_csg_held(op, a, b, out_sdf));
 }
 
 /* Validates a pose and returns it as a core transform with a normalised rotation. */
@@ -177,7 +182,7 @@ sdfccd_Status sdfccd__check_pose(sdfccd_Pose pose, const char* what, scc_xform* 
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, double scale, sdfccd_SdfId* out_sdf)
+static sdfccd_Status create_transformed_held(sdfccd_SdfId child, sdfccd_Pose pose, double scale, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
     scc_xform xf;
@@ -190,7 +195,7 @@ sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, do
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_transformed: scale must be in [1e-100, 1e100] (got %g)", scale);
     if (fmax(fabs(pose.position.x), fmax(fabs(pose.position.y), fabs(pose.position.z))) > 1e150)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_transformed: pose position has a coordinate above 1e150");
-    sdfccd__sdf* c = sdfccd__sdf_lookup(child);
+    sdfccd__sdf* c = sdfccd__sdf_acquire(child);
     if (!c) return SDFCCD_INVALID_HANDLE;
     sdfccd__sdf* s = new_shape(sizeof(scc_sdf_transform), "a transformed SDF");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
@@ -198,6 +203,11 @@ sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, do
     sdfccd__sdf_retain(c);
     s->children[0] = c;
     return sdfccd__sdf_register(s, out_sdf);
+}
+
+sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, double scale, sdfccd_SdfId* out_sdf)
+{
+    SDFCCD__HELD_CALL(create_transformed_held(child, pose, scale, out_sdf));
 }
 
 /* ---- user callbacks ---- */
@@ -255,21 +265,24 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
     return sdfccd__sdf_register(s, out_sdf);
 }
 
-sdfccd_Status sdfccd_sdf_eval(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad)
+static sdfccd_Status sdf_eval_held(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(out_value, "sdfccd_sdf_eval: out_value")) || (st = sdfccd__check_vec(p, "sdfccd_sdf_eval: p"))) return st;
-    const int mark = sdfccd__hold_mark();
-    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf); /* a concurrent destroy frees it after this call */
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     scc_vec3 g;
     *out_value = scc_sdf_eval(s->sdf, sdfccd__v(p), out_grad ? &g : NULL);
     if (out_grad) *out_grad = sdfccd__pv(g);
-    sdfccd__hold_release_to(mark);
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_sdf_eval_batch(sdfccd_SdfId sdf, const sdfccd_Vec3* points, int32_t count, double* out_values,
+sdfccd_Status sdfccd_sdf_eval(sdfccd_SdfId sdf, sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad)
+{
+    SDFCCD__HELD_CALL(sdf_eval_held(sdf, p, out_value, out_grad));
+}
+
+static sdfccd_Status sdf_eval_batch_held(sdfccd_SdfId sdf, const sdfccd_Vec3* points, int32_t count, double* out_values,
                                      sdfccd_Vec3* out_grads)
 {
     sdfccd_Status st;
@@ -279,23 +292,27 @@ sdfccd_Status sdfccd_sdf_eval_batch(sdfccd_SdfId sdf, const sdfccd_Vec3* points,
         return st;
     for (int32_t i = 0; i < count; ++i)
         if ((st = sdfccd__check_vec(points[i], "sdfccd_sdf_eval_batch: a point"))) return st;
-    const int mark = sdfccd__hold_mark();
-    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf); /* a concurrent destroy frees it after this call */
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     for (int32_t i = 0; i < count; ++i) {
         scc_vec3 g;
         out_values[i] = scc_sdf_eval(s->sdf, sdfccd__v(points[i]), out_grads ? &g : NULL);
         if (out_grads) out_grads[i] = sdfccd__pv(g);
     }
-    sdfccd__hold_release_to(mark);
     return SDFCCD_OK;
 }
 
-sdfccd_Status sdfccd_sdf_get_info(sdfccd_SdfId sdf, sdfccd_SdfInfo* out_info)
+sdfccd_Status sdfccd_sdf_eval_batch(sdfccd_SdfId sdf, const sdfccd_Vec3* points, int32_t count, double* out_values,
+                                     sdfccd_Vec3* out_grads)
+{
+    SDFCCD__HELD_CALL(sdf_eval_batch_held(sdf, points, count, out_values, out_grads));
+}
+
+static sdfccd_Status sdf_get_info_held(sdfccd_SdfId sdf, sdfccd_SdfInfo* out_info)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(out_info, "sdfccd_sdf_get_info: out_info"))) return st;
-    sdfccd__sdf* s = sdfccd__sdf_lookup(sdf);
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     out_info->kind = (sdfccd_SdfKind)s->sdf->kind;
     out_info->domain = sdfccd__pbox(s->sdf->domain);
@@ -303,4 +320,9 @@ sdfccd_Status sdfccd_sdf_get_info(sdfccd_SdfId sdf, sdfccd_SdfInfo* out_info)
     out_info->lipschitz = s->sdf->lipschitz;
     out_info->memory_bytes = s->memory_bytes + (int64_t)sizeof *s;
     return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_sdf_get_info(sdfccd_SdfId sdf, sdfccd_SdfInfo* out_info)
+{
+    SDFCCD__HELD_CALL(sdf_get_info_held(sdf, out_info));
 }

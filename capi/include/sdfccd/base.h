@@ -8,9 +8,11 @@
  * thread. The library never prints and never aborts on bad input.
  *
  * Threads: queries and evaluations may run concurrently from any number of threads, also on the
- * same SDF and mesh handles. Creating and destroying handles is thread-safe too, but a handle
- * must not be destroyed while another thread is still using it in a call. sdfccd_set_allocator()
- * must not race with any other call.
+ * same SDF and mesh handles. Creating and destroying handles is thread-safe too, also while other
+ * threads (or a callback inside the call) use the handle: every call that takes a handle holds a
+ * reference on its object while it runs, so a concurrent destroy makes later calls return
+ * ::SDFCCD_INVALID_HANDLE and frees the object when the last call using it returns.
+ * sdfccd_set_allocator() must not race with any other call.
  */
 #ifndef SDFCCD_BASE_H
 #define SDFCCD_BASE_H

@@ -33,7 +33,7 @@ SDFCCD_API sdfccd_MeshDef sdfccd_default_mesh_def(void);
  * no triangles (::SDFCCD_DEGENERATE), a zero-area triangle unless dropped. */
 SDFCCD_API sdfccd_Status sdfccd_create_mesh(const sdfccd_MeshDef* def, sdfccd_MeshId* out_mesh);
 
-/** Releases the mesh. */
+/** Releases the handle. The mesh's memory is freed once no call in flight (on any thread) uses it. */
 SDFCCD_API sdfccd_Status sdfccd_destroy_mesh(sdfccd_MeshId mesh);
 
 /** What sdfccd_mesh_get_info() reports. */

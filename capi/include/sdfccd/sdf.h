@@ -106,7 +106,8 @@ SDFCCD_API sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void);
 /** Creates a user SDF. The library does not check that `eval` keeps `lipschitz`. */
 SDFCCD_API sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfccd_SdfId* out_sdf);
 
-/** Releases the handle. The shape's memory is freed once no combination uses it. */
+/** Releases the handle. The shape's memory is freed once no combination and no call in flight
+ * (on any thread) uses it. */
 SDFCCD_API sdfccd_Status sdfccd_destroy_sdf(sdfccd_SdfId sdf);
 
 /** Value (and gradient when out_grad is not NULL) at p, in the SDF's local frame. */
