@@ -138,6 +138,8 @@ BridgeImpl::BridgeImpl(const Config& c) : cfg(c)
     if (!(cfg.vertex_distance >= 0)) cfg.vertex_distance = 0;
 }
 
+BridgeImpl::~BridgeImpl() { sdfccd_destroy_workspace(workspace); }
+
 bool BridgeImpl::isOurSdf(const btCollisionShape* s) const
 {
     const int type = s->getShapeType();

@@ -1,24 +1,29 @@
 // SPDX-License-Identifier: MIT
 // sdfccd Bullet bridge: the contact policy of one mesh-SDF pair per step (see bridge.h).
 //
-//  1. One CCD query over the step (sdfccd_query_mesh on [0, dt]) with the contact margin. Its
-//     WHOLE contact set at the earliest time of impact is kept (the buffer grows to
-//     contacts_found; every triangle within the library's TOI window, with subdivision contacts),
-//     plus the vertices of those triangles within Config::vertex_distance of the surface then.
-//  2. Whenever the step has any contact, also when it STARTS in contact: discrete queries at the
-//     start pose with the margin widened by the step's travel (every feature that can reach the
-//     surface during the step: phi is 1-Lipschitz; moving steps only) and at the predicted end
-//     pose; each feature they report is constrained by its own closest surface point at the START of
-//     the step (the classic speculative-contact rule), so the rest of the motion (a rotation
-//     about a touching corner, a slide, a face landing after its first point) cannot push it in.
-//  3. Every candidate is expressed at the start of the step: point on the mesh, point on the SDF
+//  1. A discrete query at the start pose with the margin widened by the step's travel: every
+//     feature that can come within the margin during the step (phi is Lipschitz). When its broad
+//     phase culls every triangle, the step provably has no contact and nothing else runs.
+//  2. Unless that query shows the step STARTS in contact (a feature already within the margin;
+//     the CCD would then only report "penetrating at t0"), one CCD query (sdfccd_query_mesh on
+//     [0, dt]) with the contact margin. Its WHOLE contact set at the earliest time of impact is
+//     kept (the buffer grows to contacts_found; every triangle within the library's TOI window,
+//     with subdivision contacts), plus the vertices of those triangles within
+//     Config::vertex_distance of the surface then. No hit: no contact this step.
+//  3. Whenever the step has any contact, also when it starts in contact: the features of the
+//     start-pose query and those of a discrete query at the predicted end pose; each is
+//     constrained by its own closest surface point at the START of the step (the classic
+//     speculative-contact rule), so the rest of the motion (a rotation about a touching corner,
+//     a slide, a face landing after its first point) cannot push it in.
+//  4. Every candidate is expressed at the start of the step: point on the mesh, point on the SDF
 //     surface, normal, and gap d along the normal (negative: penetrating). The set is reduced to
 //     the manifold's 4 points: deepest, then the points maximising the contact polygon's area.
-//  4. The points are written into the pair's manifold the way btManifoldResult and
+//  5. The points are written into the pair's manifold the way btManifoldResult and
 //     btPersistentManifold::refreshContactPoints do it: persistent points keep their warm-start
 //     impulses and lifetime, and the contact added / processed / started / ended callbacks fire.
 // The speculative constraint (notes/bullet-integration.md section 3.4 A): a point with gap d > 0
 // lets the solver close at most d in the step, so the mesh stops on the surface.
+// All queries go through one reusable sdfccd_Workspace per bridge (no allocation per query).
 #include "internal.h"
 
 #include <algorithm>
@@ -142,6 +147,7 @@ struct Gatherer {
     double margin;
     std::vector<Candidate>* out;
     std::vector<std::pair<uint32_t, double>> tris;
+    int64_t evals = 0; // our own sdfccd_sdf_eval calls
 
     // A material point (mesh frame) constrained by a surface point qB and normal nL (SDF frame)
     // found at some time in the step; all expressed at the start of the step.
@@ -163,6 +169,7 @@ struct Gatherer {
         const btVector3 q = S.t0.invXform(M.t0 * local);
         double phi = 0;
         sdfccd_Vec3 g;
+        ++evals;
         if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !std::isfinite(phi)) return;
         btVector3 nL = bt(g);
         const btScalar len = nL.length();
@@ -188,6 +195,7 @@ struct Gatherer {
             const double* v = &me->vertices[3 * (size_t)vt[i].first];
             const btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
             double phi = 0;
+            ++evals;
             if (sdfccd_sdf_eval(sdf, v3(Sx.invXform(Mx * local)), &phi, nullptr) != SDFCCD_OK || !(phi <= accept)) continue;
             addFromStart(local, (int)vt[i].second);
         }
@@ -232,6 +240,7 @@ struct Gatherer {
             const btVector3 q = Sx.invXform(Mx * local);
             double phi = 0;
             sdfccd_Vec3 g;
+            ++evals;
             if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !(phi <= accept)) continue;
             btVector3 nL = bt(g);
             const btScalar len = nL.length();
@@ -258,6 +267,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.query_errors++;
         return false;
     }
+    if (!workspace && sdfccd_create_workspace(&workspace) != SDFCCD_OK) workspace = nullptr;
     if (out_radius) *out_radius = G.me->radius;
     G.M = motionOf(mw->getCollisionObject(), mw->getWorldTransform(), dt);
     G.S = motionOf(sw->getCollisionObject(), sw->getWorldTransform(), dt);
@@ -276,72 +286,118 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     }
     G.margin = margin;
     G.out = &cands;
+    G.evals = 0;
     const sdfccd_RigidMotion mm = G.M.rigid(), sm_value = G.S.rigid();
     const sdfccd_RigidMotion* sm = static_sdf ? nullptr : &sm_value;
     sdfccd_QueryParams params = cfg.query;
     params.margin = margin;
-    if (contacts.size() < 256) contacts.resize(256);
-    sdfccd_QueryResult res;
-    auto start = std::chrono::steady_clock::now();
-    sdfccd_Status status = sdfccd_query_mesh(G.sdf, sm, G.me->id, &mm, 0.0, dt, &params, contacts.data(),
-                                             (int32_t)contacts.size(), &res);
-    if (status == SDFCCD_OK && res.contacts_found > res.contact_count) {
-        // Keep the whole set: grow the buffer and ask again (rare once the buffer has grown).
-        contacts.resize((size_t)res.contacts_found);
-        stats.requeries++;
-        status = sdfccd_query_mesh(G.sdf, sm, G.me->id, &mm, 0.0, dt, &params, contacts.data(), (int32_t)contacts.size(),
-                                   &res);
-    }
-    stats.query_seconds += seconds(start);
-    stats.queries++;
-    if (status != SDFCCD_OK) {
-        stats.query_errors++;
-        return false;
-    }
-    stats.last_state = (int)res.state;
-    stats.sdf_evaluations += res.sdf_evaluations;
-    if (!res.hit) {
-        stats.last_toi_fraction = 1;
-        return false;
-    }
-    stats.hits++;
-    stats.last_toi_fraction = res.fraction;
-    G.addContacts(contacts.data(), res.contact_count, margin + std::max(cfg.vertex_distance, params.contact_slop));
 
-    // Each triangle gives its FIRST contact only, so the rest of a face that lands after its first
-    // point, or passes through a thin part of the SDF within the step, needs more: every feature
-    // within the step's travel of the surface at the START of the step (the speculative-contact
-    // rule: phi is 1-Lipschitz, so nothing else can reach the surface in the step), and every
-    // feature in contact at the predicted end pose (the closest points of large triangles
-    // differ there), each constrained by its own closest surface point at the start of the step.
-    auto discrete = [&](const btTransform& Mx, const btTransform& Sx, double dcd_margin) {
+    // One query into `buf` (grown to the whole contact set, asked again when it was too small).
+    auto run = [&](std::vector<sdfccd_Contact>& buf, const sdfccd_RigidMotion* s, const sdfccd_RigidMotion* m, double t1,
+                   const sdfccd_QueryParams& p, sdfccd_QueryResult* r) {
+        if (buf.size() < 256) buf.resize(256);
+        auto query = [&]() {
+            return workspace ? sdfccd_query_mesh_ws(workspace, G.sdf, s, G.me->id, m, 0.0, t1, &p, buf.data(), (int32_t)buf.size(), r)
+                             : sdfccd_query_mesh(G.sdf, s, G.me->id, m, 0.0, t1, &p, buf.data(), (int32_t)buf.size(), r);
+        };
+        const auto t_start = std::chrono::steady_clock::now();
+        sdfccd_Status st = query();
+        if (st == SDFCCD_OK && r->contacts_found > r->contact_count) {
+            // Keep the whole set: grow the buffer and ask again (rare once the buffer has grown).
+            buf.resize((size_t)r->contacts_found);
+            stats.requeries++;
+            st = query();
+        }
+        stats.query_seconds += seconds(t_start);
+        if (st == SDFCCD_OK) stats.sdf_evaluations += r->sdf_evaluations;
+        return st;
+    };
+    // A discrete query at pose (Mx, Sx) with margin `dcd_margin`, into `buf`.
+    auto discrete = [&](std::vector<sdfccd_Contact>& buf, const btTransform& Mx, const btTransform& Sx, double dcd_margin,
+                        sdfccd_QueryResult* r) {
         sdfccd_RigidMotion m1 = sdfccd_default_rigid_motion(), s1 = sdfccd_default_rigid_motion();
         m1.pose = toPose(Mx);
         s1.pose = toPose(Sx);
         sdfccd_QueryParams dcd = params;
         dcd.method = SDFCCD_METHOD_DCD;
         dcd.margin = dcd_margin;
-        sdfccd_QueryResult r1;
-        auto t_start = std::chrono::steady_clock::now();
-        sdfccd_Status st1 = sdfccd_query_mesh(G.sdf, static_sdf ? nullptr : &s1, G.me->id, &m1, 0.0, 0.0, &dcd, contacts.data(),
-                                              (int32_t)contacts.size(), &r1);
-        if (st1 == SDFCCD_OK && r1.contacts_found > r1.contact_count) {
-            contacts.resize((size_t)r1.contacts_found);
-            stats.requeries++;
-            st1 = sdfccd_query_mesh(G.sdf, static_sdf ? nullptr : &s1, G.me->id, &m1, 0.0, 0.0, &dcd, contacts.data(), (int32_t)contacts.size(), &r1);
-        }
-        stats.query_seconds += seconds(t_start);
         stats.end_pose_queries++;
-        if (st1 == SDFCCD_OK) stats.sdf_evaluations += r1.sdf_evaluations;
-        if (st1 == SDFCCD_OK && r1.hit) G.addPose(contacts.data(), r1.contact_count, Mx, Sx, dcd_margin);
+        return run(buf, static_sdf ? nullptr : &s1, &m1, 0.0, dcd, r) == SDFCCD_OK;
     };
+
+    // Moving steps. (1) A discrete query at the start pose with the margin widened by the step's
+    // travel: phi is 1-Lipschitz (the library scales by the SDF's bound), so it sees every feature
+    // that can come within the margin during the step. Its broad phase finding no triangle in
+    // reach PROVES the step has no contact: no other query runs. A feature already within the
+    // margin means the step starts in contact: the CCD query would only report "penetrating at
+    // t0" with the same features, so it is skipped (it costs as much as both discrete queries
+    // together on a resting body). Otherwise (2) the CCD query over the step; no hit, no contact.
+    // With SDFCCD_METHOD_DCD (the discrete baseline the scenes compare against) the old order is
+    // kept: the main query decides alone whether the step has contact.
+    const bool continuous = params.method != SDFCCD_METHOD_DCD;
+    sdfccd_QueryResult r0{};
+    bool start_ran = false, start_ok = false, starts_touching = false;
+    double start_margin = margin, travel = 0;
     if (dt > 0) {
         const double reach = G.me->radius + (double)(G.M.t0.getOrigin() - G.S.t0.getOrigin()).length();
-        const double travel = dt * ((double)(G.M.v - G.S.v).length() + (double)G.M.w.length() * G.me->radius +
-                                    (double)G.S.w.length() * reach);
-        if (res.toi > 0 || travel > margin) discrete(G.M.t0, G.S.t0, margin + travel);
-        discrete(G.M.t1, G.S.t1, margin);
+        travel = dt * ((double)(G.M.v - G.S.v).length() + (double)G.M.w.length() * G.me->radius + (double)G.S.w.length() * reach);
+        start_margin = margin + travel;
     }
+    if (dt > 0 && continuous) {
+        start_ran = true;
+        start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0);
+        if (start_ok && r0.triangles_tested == 0 && r0.state == SDFCCD_STATE_NO_HIT) {
+            stats.queries_skipped++;
+            stats.last_state = (int)SDFCCD_STATE_NO_HIT;
+            stats.last_toi_fraction = 1;
+            return false;
+        }
+        if (start_ok && r0.hit)
+            for (int i = 0; i < r0.contact_count && !starts_touching; ++i) starts_touching = start_contacts[(size_t)i].distance <= margin;
+    }
+    if (starts_touching) {
+        stats.queries_skipped++;
+        stats.last_state = (int)SDFCCD_STATE_PENETRATING;
+        stats.hits++;
+        stats.last_toi_fraction = 0;
+    } else {
+        sdfccd_QueryResult res;
+        sdfccd_Status status = run(contacts, sm, &mm, dt, params, &res);
+        stats.queries++;
+        if (status != SDFCCD_OK) {
+            stats.query_errors++;
+            return false;
+        }
+        stats.last_state = (int)res.state;
+        if (!res.hit) {
+            stats.last_toi_fraction = 1;
+            return false;
+        }
+        stats.hits++;
+        stats.last_toi_fraction = res.fraction;
+        G.addContacts(contacts.data(), res.contact_count, margin + std::max(cfg.vertex_distance, params.contact_slop));
+        if (dt > 0 && !start_ran && (res.toi > 0 || travel > margin)) {
+            start_ran = true;
+            start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0);
+        }
+    }
+
+    // Each triangle gives its FIRST contact only, so the rest of a face that lands after its first
+    // point, or passes through a thin part of the SDF within the step, needs more: every feature
+    // within the step's travel of the surface at the START of the step (the speculative-contact
+    // rule), and every feature in contact at the predicted end pose (the closest points of large
+    // triangles differ there), each constrained by its own closest surface point at the start of
+    // the step. When the CCD query was skipped, the vertices of the start pose's triangles within
+    // the vertex distance count too, as they would have with the CCD's contacts (a face resting
+    // flat gives its corners).
+    if (dt > 0) {
+        const double accept = starts_touching ? std::max(start_margin, margin + std::max(cfg.vertex_distance, params.contact_slop))
+                                              : start_margin;
+        if (start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, accept);
+        sdfccd_QueryResult r1;
+        if (discrete(contacts, G.M.t1, G.S.t1, margin, &r1) && r1.hit) G.addPose(contacts.data(), r1.contact_count, G.M.t1, G.S.t1, margin);
+    }
+    stats.own_evaluations += G.evals;
     if (static_sdf)
         for (Candidate& c : cands) {
             c.pA0 = sdf_world * c.pA0;

@@ -118,6 +118,7 @@ class BridgeImpl
 {
 public:
     explicit BridgeImpl(const Config& c);
+    ~BridgeImpl();
 
     // Which side of a pair is the mesh and which the SDF (false if the bridge does not handle it).
     bool orient(const btCollisionObjectWrapper* w0, const btCollisionObjectWrapper* w1, bool& mesh_is_body1) const;
@@ -147,7 +148,8 @@ public:
     std::vector<PairRecord> pairs;
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
-    std::vector<sdfccd_Contact> contacts;
+    std::vector<sdfccd_Contact> contacts, start_contacts;
+    sdfccd_Workspace* workspace = nullptr; // the queries' scratch storage (no allocation per query)
 
     struct CreateFunc;
     std::unique_ptr<CreateFunc> fn[2]; // contact points, closest points

@@ -12,16 +12,20 @@
  *      SdfShape vs SdfShape (Config::sdf_pairs): the moving one's isosurface triangulation
  *      against the other's field.
  *  - the contact model, per pair and step (contact_policy.cpp):
- *      1. one CCD query (sdfccd_query_mesh) over the step from the start pose (world transform)
- *         to the predicted end pose (interpolation transform); its whole contact set at the
- *         earliest time of impact is kept (every triangle in the library's TOI window, with
- *         subdivision contacts), plus those triangles' vertices within Config::vertex_distance;
- *      2. whenever the step has any contact, also when it STARTS in contact, discrete queries
- *         at the start pose with the margin widened by the step's travel (every feature that can
- *         reach the surface in the step; moving steps only) and at the predicted end pose; each
- *         feature found is constrained by its own closest surface point at the start of the
- *         step (speculative contacts for the rest of the motion: resting, sliding and tipping
- *         over an edge cannot sink, and a fast body is held by its whole front, not one point);
+ *      1. a discrete query at the start pose (world transform) with the margin widened by the
+ *         step's travel finds every feature that can reach the surface in the step; when its
+ *         broad phase culls every triangle the step has no contact and nothing else runs;
+ *      2. unless a feature is already within the margin (the step STARTS in contact), one CCD
+ *         query (sdfccd_query_mesh) over the step from the start pose to the predicted end pose
+ *         (interpolation transform); its whole contact set at the earliest time of impact is
+ *         kept (every triangle in the library's TOI window, with subdivision contacts), plus
+ *         those triangles' vertices within Config::vertex_distance; no hit, no contact;
+ *      2b. whenever the step has any contact, also when it starts in contact, the start-pose
+ *         features and those of a discrete query at the predicted end pose; each feature found
+ *         is constrained by its own closest surface point at the start of the step
+ *         (speculative contacts for the rest of the motion: resting, sliding and tipping over an
+ *         edge cannot sink, and a fast body is held by its whole front, not one point);
+ *         with Config::query.method DCD (the discrete baseline) step 2 always runs, first;
  *      3. every candidate is expressed at the start of the step (distance = gap along the normal,
  *         negative when penetrating) and the set is reduced to the manifold's 4 points: the
  *         deepest, then the points that maximise the contact polygon's area (as Bullet's
@@ -140,12 +144,16 @@ struct Config {
 /** Counters for measurements (all since construction or resetStats()). */
 struct Stats {
     int64_t queries = 0;               /**< CCD queries (sdfccd_query_mesh over the step) made by the algorithm. */
-    int64_t end_pose_queries = 0;      /**< Discrete queries at the predicted end pose (steps with contact). */
+    int64_t end_pose_queries = 0;      /**< Discrete queries (at the start pose over the step's reach, at the predicted end pose). */
+    int64_t queries_skipped = 0;       /**< CCD queries not run because the start-pose query settled them: nothing
+                                            within reach (its broad phase proves no contact), or the step starts in
+                                            contact (the CCD would report penetration at the start with the same features). */
     int64_t requeries = 0;             /**< Queries repeated because the contact buffer was too small. */
     int64_t sdf_evaluations = 0;       /**< SDF evaluations of all those queries (the library's count). */
+    int64_t own_evaluations = 0;       /**< The bridge's own SDF evaluations (closest points at the start of the step). */
     int64_t candidates = 0;            /**< Contact candidates before the reduction to 4 points. */
     double query_seconds = 0;          /**< Wall time inside all those calls. */
-    int64_t hits = 0;                  /**< Queries that found contact (hit). */
+    int64_t hits = 0;                  /**< Pair-steps with contact: CCD hits and steps that start in contact. */
     int64_t speculative_contacts = 0;  /**< Contacts written for impacts inside a step. */
     int64_t ordinary_contacts = 0;     /**< Contacts written for features in contact at step start. */
     int64_t query_errors = 0;          /**< Queries that failed or had no mesh/SDF to work with (no contacts written). */
