@@ -357,6 +357,8 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
     s.step_ms = cfg.steps ? 1e3 * total_step / cfg.steps : 0;
     s.ccd_ms = cfg.steps ? 1e3 * (end.ccd_seconds - start_cost.ccd_seconds) / cfg.steps : 0;
     s.ccd_queries = end.ccd_queries - start_cost.ccd_queries;
+    if (cfg.steps && end.sdf_evaluations >= 0 && start_cost.sdf_evaluations >= 0)
+        s.sdf_evals_per_step = (double)(end.sdf_evaluations - start_cost.sdf_evaluations) / cfg.steps;
     return s;
 }
 
@@ -381,6 +383,7 @@ void printSummary(const Summary& s, std::FILE* out)
     std::fprintf(out, "  step_ms             %.4f\n", s.step_ms);
     std::fprintf(out, "  ccd_ms              %.4f  (%.1f%% of the step, %lld queries)\n", s.ccd_ms,
                  s.step_ms > 0 ? 100 * s.ccd_ms / s.step_ms : 0.0, (long long)s.ccd_queries);
+    if (s.sdf_evals_per_step >= 0) std::fprintf(out, "  sdf_evals_per_step  %.0f\n", s.sdf_evals_per_step);
     if (s.probe_steps != 0) {
         double share = s.probe_total_ms + s.probe_step_ms > 0 ? 100 * s.probe_total_ms / (s.probe_total_ms + s.probe_step_ms) : 0;
         std::fprintf(out, "  table4              steps %d  total_ms %.3f  runtime_pct %.1f  tri_tested %lld  per-triangle (%lld): mean_us %.2f "

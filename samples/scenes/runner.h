@@ -60,6 +60,7 @@ struct Summary {
     double step_ms = 0;            /**< Mean wall time per step. */
     double ccd_ms = 0;             /**< Mean CCD time per step. */
     int64_t ccd_queries = 0;
+    double sdf_evals_per_step = -1; /**< Mean SDF evaluations per step of the collision pipeline (-1: unknown). */
     int body_count = 0;
     int64_t deep_samples = 0;      /**< Sample-steps with phi < -1 mm. */
     // Table 4 probe (RunConfig::probe), over the steps up to and including the first probe hit.

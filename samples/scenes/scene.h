@@ -130,6 +130,7 @@ struct StepCost {
     int64_t ccd_queries = 0; /**< Cumulative. */
     int64_t hits = 0;        /**< Cumulative queries that found contact. */
     int64_t triangles_tested = 0; /**< Cumulative (direct queries only; -1 when unknown). */
+    int64_t sdf_evaluations = -1; /**< Cumulative SDF evaluations of the collision pipeline (-1 when unknown). */
     int contacts = 0;        /**< Contact points alive after this step (manifolds or query contacts). */
 };
 
