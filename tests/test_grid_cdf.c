@@ -286,23 +286,6 @@ START_TEST(test_roundtrip_bytes)
 }
 END_TEST
 
-/* Generalised winding number of a closed mesh at p (solid angles, Van Oosterom and Strackee):
- * about 1 inside, 0 outside. An independent reference for signs. */
-static double winding_number(const scc_mesh* m, scc_vec3 p)
-{
-    double w = 0;
-    for (uint32_t t = 0; t < m->triangle_count; ++t) {
-        scc_vec3 v[3];
-        scc_mesh_triangle(m, t, v);
-        const scc_vec3 a = scc_sub(v[0], p), b = scc_sub(v[1], p), c = scc_sub(v[2], p);
-        const double la = scc_len(a), lb = scc_len(b), lc = scc_len(c);
-        const double num = scc_dot(a, scc_cross(b, c));
-        const double den = la * lb * lc + scc_dot(a, b) * lc + scc_dot(b, c) * la + scc_dot(c, a) * lb;
-        w += 2.0 * atan2(num, den);
-    }
-    return w / (4.0 * SCC_PI);
-}
-
 /* Our builds of the meshes Discregrid's files were made from, at the same resolution and the
  * default domain, agree with them. Both sample the exact mesh distance at bit-identical node
  * positions, so magnitudes differ only by round-off in the point-triangle distance (about
@@ -337,7 +320,7 @@ static void compare_with_generated(const char* mesh_rel, const char* cdf_rel, in
         const double x = scc_grid_node_value(a, 0, i), y = scc_grid_node_value(b, 0, i);
         if (fabs(y) > 1e-9 && (x < 0) != (y < 0)) {
             ck_assert_double_near(fabs(x), fabs(y), 1e-10);
-            const double w = winding_number(m, scc_grid_dense_node_position(a, i));
+            const double w = test_winding_number(m, scc_grid_dense_node_position(a, i));
             ck_assert_msg((w > 0.5) == (x < 0), "node %llu: our sign %g disagrees with the winding number %g", (unsigned long long)i, x, w);
             ck_assert_int_lt(flips, 64);
             flipped[flips++] = (uint32_t)i;

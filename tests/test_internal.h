@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: MIT
- * For single-threaded tests that look inside objects (capi_internal.h): the object behind a live
- * handle. The reference acquire takes is dropped at once; the test's handle keeps the object
- * alive until the test destroys it. */
+ * Test support for the suites that use internals (INTERNALS in tests/CMakeLists.txt, which also
+ * compiles test_internal.c into them). For single-threaded tests that look inside objects
+ * (capi_internal.h): the object behind a live handle. The reference acquire takes is dropped at
+ * once; the test's handle keeps the object alive until the test destroys it. And independent
+ * references computed on core types. */
 #ifndef SDFCCD_TEST_INTERNAL_H
 #define SDFCCD_TEST_INTERNAL_H
 
@@ -26,5 +28,9 @@ static inline scc_grid* test_grid_of(sdfccd_SdfId id)
     ck_assert_int_eq(st, SDFCCD_OK);
     return g;
 }
+
+/* Generalised winding number of a closed mesh at p (solid angles, Van Oosterom and Strackee):
+ * about 1 inside, 0 outside. An independent reference for signs. */
+double test_winding_number(const scc_mesh* m, scc_vec3 p);
 
 #endif

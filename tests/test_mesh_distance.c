@@ -11,21 +11,6 @@
 #include "test_internal.h"
 #include "../core/mesh_distance.h"
 
-static double winding_number(const scc_mesh* m, scc_vec3 p)
-{
-    double w = 0;
-    for (uint32_t t = 0; t < m->triangle_count; ++t) {
-        scc_vec3 v[3];
-        scc_mesh_triangle(m, t, v);
-        const scc_vec3 a = scc_sub(v[0], p), b = scc_sub(v[1], p), c = scc_sub(v[2], p);
-        const double la = scc_len(a), lb = scc_len(b), lc = scc_len(c);
-        const double num = scc_dot(a, scc_cross(b, c));
-        const double den = la * lb * lc + scc_dot(a, b) * lc + scc_dot(b, c) * la + scc_dot(c, a) * lb;
-        w += 2.0 * atan2(num, den);
-    }
-    return w / (4.0 * SCC_PI);
-}
-
 /* Independent reference: distance to the plane when the projection falls inside (tested with
  * edge-normal signs), otherwise the least distance to the three segments. */
 static double seg_dist2(scc_vec3 p, scc_vec3 a, scc_vec3 b)
@@ -248,7 +233,7 @@ START_TEST(test_signs_vs_winding_number)
         int inside = 0;
         for (int i = 0; i < n; ++i) {
             if (fabs(d[i]) < 1e-9) continue;
-            double w = winding_number(m, sdfccd__v(p[i]));
+            double w = test_winding_number(m, sdfccd__v(p[i]));
             ck_assert_msg((w > 0.5) == (d[i] < 0), "%s: point (%g %g %g) d %g winding %g", meshes[mi], p[i].x, p[i].y, p[i].z, d[i], w);
             inside += d[i] < 0;
         }
