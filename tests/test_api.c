@@ -149,6 +149,43 @@ START_TEST(test_mesh_bad_inputs)
 }
 END_TEST
 
+/* The two calls on a batch of points (sdfccd_sdf_eval_batch, sdfccd_mesh_signed_distance) check
+ * count, the arrays and every point before writing anything, with the messages they had before
+ * the checks were shared. */
+START_TEST(test_point_batch_bad_inputs)
+{
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_sphere(0.5, &s), SDFCCD_OK);
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/cube.obj"); /* the cube [-0.5, 0.5]^3 */
+    sdfccd_Vec3 p[3] = { { 0.1, 0.1, 0.1 }, { 2, 0, 0 }, { 0, 0, 3 } };
+    double out[3] = { 7, 7, 7 };
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(s, NULL, 0, NULL, NULL), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, NULL, 0, 1, NULL, NULL), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(s, p, -2, out, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_sdf_eval_batch: count = -2 < 0");
+    ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, p, -2, 1, out, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_mesh_signed_distance: count = -2 < 0");
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(s, NULL, 3, out, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_sdf_eval_batch: points is NULL");
+    ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, NULL, 3, 1, out, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_mesh_signed_distance: points is NULL");
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(s, p, 3, NULL, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_sdf_eval_batch: out_values is NULL");
+    ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, p, 3, 1, NULL, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_mesh_signed_distance: out_distances is NULL");
+    p[2].z = INFINITY;
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(s, p, 3, out, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_sdf_eval_batch: a point is not finite (0, 0, inf)");
+    ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, p, 3, 1, out, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_mesh_signed_distance: a point is not finite (0, 0, inf)");
+    ck_assert(out[0] == 7 && out[1] == 7 && out[2] == 7); /* nothing written */
+    ck_assert_int_eq(sdfccd_mesh_signed_distance(mesh, p, 2, 1, out, NULL), SDFCCD_OK); /* the finite ones */
+    ck_assert_double_near(out[1], 1.5, 1e-12); /* (2, 0, 0) is 1.5 outside the face x = 0.5 */
+    sdfccd_destroy_mesh(mesh);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
 /* Contacts beyond the capacity are counted but not written. */
 START_TEST(test_capacity)
 {
@@ -238,6 +275,7 @@ int main(void)
     tcase_add_test(tc, test_version_and_config);
     tcase_add_test(tc, test_query_bad_inputs);
     tcase_add_test(tc, test_mesh_bad_inputs);
+    tcase_add_test(tc, test_point_batch_bad_inputs);
     tcase_add_test(tc, test_capacity);
     tcase_add_test(tc, test_allocator);
     suite_add_tcase(s, tc);

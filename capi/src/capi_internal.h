@@ -8,6 +8,7 @@
 #ifndef SDFCCD_CAPI_INTERNAL_H
 #define SDFCCD_CAPI_INTERNAL_H
 
+#include <math.h>
 #include <stdarg.h>
 #include <string.h>
 #include "sdfccd/sdfccd.h"
@@ -56,6 +57,23 @@ static inline sdfccd_Status sdfccd__check_def_args(const char* fn, const void* d
     if (!def) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: def is NULL", fn);
     if (!out) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %s is NULL", fn, out_name);
     return sdfccd__check_def(internal_value, fn, "def was", default_fn);
+}
+
+/* The arguments of FN on a batch of points: count >= 0 and, when count > 0, `points` and `out`
+ * (named OUT_NAME in the message) not NULL and every point finite. */
+static inline sdfccd_Status sdfccd__check_points(const char* fn, const sdfccd_Vec3* points, int32_t count, const void* out,
+                                                 const char* out_name)
+{
+    if (count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: count = %d < 0", fn, (int)count);
+    if (count == 0) return SDFCCD_OK;
+    if (!points) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: points is NULL", fn);
+    if (!out) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %s is NULL", fn, out_name);
+    for (int32_t i = 0; i < count; ++i) {
+        const sdfccd_Vec3 p = points[i];
+        if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: a point is not finite (%g, %g, %g)", fn, p.x, p.y, p.z);
+    }
+    return SDFCCD_OK;
 }
 
 /* ---- the handle registry (base.c), shared by SDF and mesh objects ---- */

@@ -180,12 +180,7 @@ static sdfccd_Status mesh_signed_distance_held(sdfccd_MeshId mesh, const sdfccd_
                                           double* out_distances, sdfccd_Vec3* out_closest)
 {
     sdfccd_Status st;
-    if (count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_mesh_signed_distance: count = %d < 0", count);
-    if (count > 0 && ((st = sdfccd__check_ptr(points, "sdfccd_mesh_signed_distance: points")) ||
-                      (st = sdfccd__check_ptr(out_distances, "sdfccd_mesh_signed_distance: out_distances"))))
-        return st;
-    for (int32_t i = 0; i < count; ++i)
-        if ((st = sdfccd__check_vec(points[i], "sdfccd_mesh_signed_distance: a point"))) return st;
+    if ((st = sdfccd__check_points("sdfccd_mesh_signed_distance", points, count, out_distances, "out_distances"))) return st;
     sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     scc_mesh_sdf ms;

@@ -286,12 +286,7 @@ static sdfccd_Status sdf_eval_batch_held(sdfccd_SdfId sdf, const sdfccd_Vec3* po
                                      sdfccd_Vec3* out_grads)
 {
     sdfccd_Status st;
-    if (count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_sdf_eval_batch: count = %d < 0", (int)count);
-    if (count > 0 && ((st = sdfccd__check_ptr(points, "sdfccd_sdf_eval_batch: points")) ||
-                      (st = sdfccd__check_ptr(out_values, "sdfccd_sdf_eval_batch: out_values"))))
-        return st;
-    for (int32_t i = 0; i < count; ++i)
-        if ((st = sdfccd__check_vec(points[i], "sdfccd_sdf_eval_batch: a point"))) return st;
+    if ((st = sdfccd__check_points("sdfccd_sdf_eval_batch", points, count, out_values, "out_values"))) return st;
     sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
     for (int32_t i = 0; i < count; ++i) {
