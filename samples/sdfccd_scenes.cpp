@@ -4,8 +4,13 @@
 //   sdfccd_scenes --list
 //   sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]
 //                 [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]
-//                 [--margin M] [--patch-band B] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]
+//                 [--margin M] [--patch-band B] [--hard-clamp T] [--solver-iterations N] [--data DIR]
+//                 [--check KEY=LIMIT,...] [--quiet] [--table4]
 //
+// --patch-band B / --hard-clamp T / --solver-iterations N override the Bullet scenes' set-up (the
+// bridge's Config::patch_band, Bridge::setHardClamp tolerance, btContactSolverInfo::m_numIterations;
+// B < 0 and T <= 0 turn them off). The paper's rigid scenes default to B = 0.02 and T = 0.0005
+// (T off with DCD), the Bullet re-creations to both off.
 // --table4 adds the paper's Table 4 figures (the CCD of the coming step through the C ABI, timed,
 // up to the first contact; see runner.h) as a "table4" line of the summary.
 // The Bullet build (float or double btScalar) is a separate library, so this program is built
@@ -14,6 +19,7 @@
 //
 // --check evaluates limits on the summary and exits 1 on a violation (the stability tests):
 //   max_pen=M       max penetration over the run <= M (m)
+//   max_pen_ccd=M   the same against the SDF the CCD is given (a grid's own field) <= M (m)
 //   min_max_pen=M   max penetration >= M (asserts that a method fails)
 //   fails=M         max penetration > M or at least one tunnelled body (a method fails)
 //   tunnelled=N     tunnelled bodies <= N;  min_tunnelled=N  >= N
@@ -48,8 +54,9 @@ void usage(std::FILE* f)
                  "usage: sdfccd_scenes --list\n"
                  "       sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]\n"
                  "                     [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]\n"
-                 "                     [--margin M] [--patch-band B] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
-                 "check keys: max_pen min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
+                 "                     [--margin M] [--patch-band B] [--hard-clamp T] [--solver-iterations N] [--data DIR]\n"
+                 "                     [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
+                 "check keys: max_pen max_pen_ccd min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
 }
 
 // Runs the sibling build (sdfccd_scenes <-> sdfccd_scenes_f64) with the same arguments.
@@ -118,6 +125,8 @@ int main(int argc, char** argv)
         else if (a == "--quick") opt.quick = true;
         else if (a == "--margin") opt.margin = std::atof(value("metres"));
         else if (a == "--patch-band") opt.patch_band = std::atof(value("metres"));
+        else if (a == "--solver-iterations") opt.solver_iterations = std::atoi(value("a count"));
+        else if (a == "--hard-clamp") opt.hard_clamp = std::atof(value("metres"));
         else if (a == "--data") opt.data_dir = value("a folder");
         else if (a == "--check") check = value("limits");
         else if (a == "--quiet") quiet = true;

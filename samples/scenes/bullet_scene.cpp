@@ -49,7 +49,7 @@ BulletWorld::BulletWorld(const btVector3& gravity, sdfccd_bullet::Bridge* bridge
     else btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
 }
 
-BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_axis)
+BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_axis, double patch_band, double hard_clamp)
     : m_opt(opt), m_gravity(gravity), m_up(up_axis)
 {
     up[0] = up[1] = up[2] = 0;
@@ -59,14 +59,31 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     cfg.query.method = opt.method;
     cfg.query.subdivision = opt.subdivision ? 1 : 0;
     if (opt.margin >= 0) cfg.contact_margin = opt.margin;
-    cfg.patch_band = opt.patch_band;
+    cfg.patch_band = std::isnan(opt.patch_band) ? patch_band : opt.patch_band;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
+    if (m_bridge && cfg.patch_band >= 0) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, " [patch manifold, band %g m]", cfg.patch_band);
+        m_description += buf;
+    }
+    const double clamp = std::isnan(opt.hard_clamp) ? hard_clamp : opt.hard_clamp;
+    if (m_bridge && clamp > 0) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, " [hard clamp %g m]", clamp);
+        m_description += buf;
+    }
     m_bullet.reset(new BulletWorld(gravity, m_bridge.get()));
     m_world = &m_bullet->world;
     m_dispatcher = &m_bullet->dispatcher;
+    if (opt.solver_iterations > 0) m_world->getSolverInfo().m_numIterations = opt.solver_iterations;
     if (m_bullet->status != sdfccd_bullet::Status::Ok)
         std::fprintf(stderr, "sdfccd_scenes: bridge registration failed: %s\n", sdfccd_bullet::statusString(m_bullet->status));
+    if (m_bridge && clamp > 0) {
+        sdfccd_bullet::Status s = m_bridge->setHardClamp(m_world, true, clamp);
+        if (s != sdfccd_bullet::Status::Ok)
+            std::fprintf(stderr, "sdfccd_scenes: hard clamp failed: %s\n", sdfccd_bullet::statusString(s));
+    }
 }
 
 BulletScene::~BulletScene()

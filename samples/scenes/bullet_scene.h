@@ -38,7 +38,9 @@ struct BulletWorld {
 
 class BulletScene : public Scene {
 public:
-    BulletScene(const Options& opt, const btVector3& gravity, int up_axis);
+    /** `patch_band` and `hard_clamp`: the scene's defaults of the bridge's Config::patch_band and hard
+     * clamp tolerance (Bridge::setHardClamp; <= 0: off), used where Options leaves them NaN. */
+    BulletScene(const Options& opt, const btVector3& gravity, int up_axis, double patch_band = -1, double hard_clamp = -1);
     ~BulletScene() override;
 
     void step(int i, double dt) override;

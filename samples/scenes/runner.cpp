@@ -51,7 +51,9 @@ double boxDistance(const sdfccd_Aabb& b, const double* p)
 
 struct Measure {
     double min_phi = 1e300;
-    int min_body = -1, min_collider = -1;
+    double min_phi_ccd = 1e300;                  // against the SDF the CCD works on (a grid: its own field)
+    int min_body = -1, min_collider = -1, min_sample = -1;
+    double min_where[3] = { NAN, NAN, NAN };     // world position of the deepest sample
     int64_t deep = 0;
     std::vector<double> body_min;                // per body
     std::vector<std::vector<double>> sample_phi; // per body, per sample (for snapshots)
@@ -62,7 +64,8 @@ void measure(Scene& scene, Measure& m)
 {
     size_t nb = scene.bodies.size();
     m.min_phi = 1e300;
-    m.min_body = m.min_collider = -1;
+    m.min_phi_ccd = 1e300;
+    m.min_body = m.min_collider = m.min_sample = -1;
     m.deep = 0;
     m.body_min.assign(nb, 1e300);
     m.sample_phi.resize(nb);
@@ -104,6 +107,22 @@ void measure(Scene& scene, Measure& m)
         } else {
             for (size_t i = 0; i < batch.size(); ++i) sdfccd_sdf_eval(c.exact, batch[i], &phi[i], nullptr);
         }
+        // The CCD's own SDF where it differs from the reference (a grid baked from a mesh): how
+        // deep the samples are in the field the CCD was given, apart from the grid's own error.
+        if (c.ccd.index1 && (c.exact_mesh.index1 || c.ccd.index1 != c.exact.index1 || c.ccd.generation != c.exact.generation)) {
+            for (size_t k = 0; k < owner.size(); ++k) {
+                size_t first = owner[k].second, end = k + 1 < owner.size() ? owner[k + 1].second : batch.size();
+                for (size_t i = first; i + 1 < end; ++i) {
+                    double p = 1e300;
+                    if (sdfccd_sdf_eval(c.ccd, batch[i], &p, nullptr) == SDFCCD_OK) m.min_phi_ccd = std::min(m.min_phi_ccd, p);
+                }
+            }
+        } else {
+            for (size_t k = 0; k < owner.size(); ++k) {
+                size_t first = owner[k].second, end = k + 1 < owner.size() ? owner[k + 1].second : batch.size();
+                for (size_t i = first; i + 1 < end; ++i) m.min_phi_ccd = std::min(m.min_phi_ccd, phi[i]);
+            }
+        }
         for (size_t k = 0; k < owner.size(); ++k) {
             size_t bi = owner[k].first, first = owner[k].second;
             size_t end = k + 1 < owner.size() ? owner[k + 1].second : batch.size();
@@ -117,6 +136,10 @@ void measure(Scene& scene, Measure& m)
                     m.min_phi = p;
                     m.min_body = (int)bi;
                     m.min_collider = (int)ci;
+                    m.min_sample = (int)i;
+                    const sdfccd_Vec3& l = batch[first + i];
+                    const double lp[3] = { l.x, l.y, l.z };
+                    c.frame.apply(lp, m.min_where);
                 }
             }
             if (phi[end - 1] < -scene.bodies[bi].mesh->half_thickness) m.tunnelled[bi] = 1;
@@ -227,7 +250,8 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
     s.description = scene.describe();
     s.body_count = (int)scene.bodies.size();
     if (csv)
-        std::fprintf(csv, "step,time,min_phi,deep_samples,contacts,ccd_ms,step_ms,ccd_queries,hits,energy,max_speed,tunnelled\n");
+        std::fprintf(csv, "step,time,min_phi,deep_samples,contacts,ccd_ms,step_ms,ccd_queries,hits,energy,max_speed,tunnelled,"
+                     "b0_x,b0_y,b0_z,b0_vx,b0_vy,b0_vz,b0_w,deepest_sample,deepest_x,deepest_y,deepest_z,min_phi_ccd_sdf\n");
     Measure m;
     std::vector<char> tunnelled(scene.bodies.size(), 0);
     int window = std::max(1, (int)std::lround(1.0 / cfg.dt));
@@ -266,6 +290,7 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
             s.max_penetration_step = i;
             s.max_penetration_where = "inside the step (executed motion)";
         }
+        if (m.min_phi_ccd < 1e299) s.max_penetration_ccd = std::max(s.max_penetration_ccd, std::max(0.0, -m.min_phi_ccd));
         if (m.min_phi < 1e299) {
             double pen = std::max(0.0, -m.min_phi);
             if (pen > s.max_penetration) {
@@ -325,10 +350,27 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
             for (size_t bi = 0; bi < scene.bodies.size(); ++bi)
                 if (scene.bodies[bi].active && speedBound(scene.bodies[bi], prev_world[bi], cfg.dt) > 0.05) ++s.moving_at_end;
         }
-        if (csv)
-            std::fprintf(csv, "%d,%.6f,%.6g,%lld,%d,%.4f,%.4f,%lld,%lld,%.6g,%.4g,%d\n", i, (i + 1) * cfg.dt,
+        if (csv) {
+            std::fprintf(csv, "%d,%.6f,%.6g,%lld,%d,%.4f,%.4f,%lld,%lld,%.6g,%.4g,%d", i, (i + 1) * cfg.dt,
                          m.min_phi < 1e299 ? m.min_phi : NAN, (long long)m.deep, c.contacts, 1e3 * ccd_s, 1e3 * step_s,
                          (long long)c.ccd_queries, (long long)c.hits, e, max_speed, tun_now);
+            // The first body's centre and velocity (per-step traces of single-body scenes).
+            double b0[7] = { NAN, NAN, NAN, NAN, NAN, NAN, NAN };
+            if (!scene.bodies.empty()) {
+                const Body& b = scene.bodies[0];
+                std::vector<double> w;
+                worldSamples(b, w);
+                for (int k = 0; k < 3; ++k) {
+                    b0[k] = w[w.size() - 3 + (size_t)k];
+                    b0[3 + k] = b.v[k];
+                }
+                b0[6] = std::sqrt(dot3(b.w, b.w));
+            }
+            std::fprintf(csv, ",%.6f,%.6f,%.6f,%.5g,%.5g,%.5g,%.5g", b0[0], b0[1], b0[2], b0[3], b0[4], b0[5], b0[6]);
+            // Where the deepest sample of the step is (its index in its body's samples: vertices first).
+            std::fprintf(csv, ",%d,%.6f,%.6f,%.6f,%.6g\n", m.min_sample, m.min_where[0], m.min_where[1], m.min_where[2],
+                         m.min_phi_ccd < 1e299 ? m.min_phi_ccd : NAN);
+        }
         if (snap.enabled() && (first_contact_now || i == cfg.steps - 1))
             snap.write(scene, m.sample_phi, first_contact_now ? "first_contact" : "end", i);
         prev_cost = c;
@@ -359,6 +401,7 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
     s.ccd_queries = end.ccd_queries - start_cost.ccd_queries;
     if (cfg.steps && end.sdf_evaluations >= 0 && start_cost.sdf_evaluations >= 0)
         s.sdf_evals_per_step = (double)(end.sdf_evaluations - start_cost.sdf_evaluations) / cfg.steps;
+    s.freezes = end.freezes - start_cost.freezes;
     return s;
 }
 
@@ -368,8 +411,11 @@ void printSummary(const Summary& s, std::FILE* out)
                  s.precision.c_str(), s.steps, s.dt);
     std::fprintf(out, "  max_penetration_m   %.6f  (step %d%s%s)\n", s.max_penetration, s.max_penetration_step,
                  s.max_penetration_where.empty() ? "" : ", ", s.max_penetration_where.c_str());
+    std::fprintf(out, "  max_pen_ccd_sdf_m   %.6f  (the same samples against the SDF the CCD is given: differs where it is a grid)\n",
+                 s.max_penetration_ccd);
     std::fprintf(out, "  end_penetration_m   %.6f\n", s.end_penetration);
     std::fprintf(out, "  deep_sample_steps   %lld  (samples deeper than 1 mm, summed over steps)\n", (long long)s.deep_samples);
+    if (s.freezes > 0) std::fprintf(out, "  response_freezes    %lld  (steps whose collision response hit its iteration cap)\n", (long long)s.freezes);
     std::fprintf(out, "  first_contact_step  %d  (first sample within 1 mm)\n", s.first_contact_step);
     std::fprintf(out, "  first_hit_step      %d  (first CCD contact; ccd %.3f ms, steps %.3f ms up to it)\n", s.first_hit_step,
                  s.ccd_ms_to_first_hit, s.step_ms_to_first_hit);
@@ -407,6 +453,7 @@ bool checkSummary(const Summary& s, const std::string& spec, std::string* why)
         bool pass;
         double val;
         if (key == "max_pen") { val = s.max_penetration; pass = val <= lim; }
+        else if (key == "max_pen_ccd") { val = s.max_penetration_ccd; pass = val <= lim; }
         else if (key == "min_max_pen") { val = s.max_penetration; pass = val >= lim; }
         else if (key == "tunnelled") { val = s.tunnelled; pass = val <= lim; }
         else if (key == "min_tunnelled") { val = s.tunnelled; pass = val >= lim; }

@@ -44,6 +44,7 @@ struct Summary {
     double dt = 0;
     double max_penetration = 0;    /**< m, >= 0. */
     int max_penetration_step = -1;
+    double max_penetration_ccd = 0; /**< m: the same samples against the SDF the CCD is given (a grid's own field; else = the reference). */
     std::string max_penetration_where;
     double end_penetration = 0;    /**< At the last step. */
     int first_contact_step = -1;   /**< First step with a sample at phi <= 1 mm. */
@@ -63,6 +64,7 @@ struct Summary {
     double sdf_evals_per_step = -1; /**< Mean SDF evaluations per step of the collision pipeline (-1: unknown). */
     int body_count = 0;
     int64_t deep_samples = 0;      /**< Sample-steps with phi < -1 mm. */
+    int64_t freezes = 0;           /**< Steps whose collision response froze what still hit (cloth; StepCost::freezes). */
     // Table 4 probe (RunConfig::probe), over the steps up to and including the first probe hit.
     int probe_steps = 0;           /**< Steps probed (-1 when no hit within the run). */
     double probe_total_ms = 0;     /**< Mesh queries: total time. */

@@ -19,6 +19,7 @@
 #define SDFCCD_SCENES_SCENE_H
 
 #include <cstdint>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,7 +35,11 @@ struct Options {
     bool stock = false;   /**< Bullet scenes: the SDF surfaces as btBvhTriangleMeshShape (no bridge). */
     bool quick = false;   /**< Fewer bodies where a scene is large (the ctest variants; documented per scene). */
     double margin = -1;   /**< Contact margin (m) of the bridge / queries; < 0: the scene's default. */
-    double patch_band = -1; /**< Bullet scenes: the bridge's Config::patch_band (< 0: off, the default). */
+    double patch_band = NAN; /**< Bullet scenes: the bridge's Config::patch_band (< 0: off; NaN: the scene's default,
+                                  0.02 in the paper's rigid scenes, off in the Bullet re-creations). */
+    int solver_iterations = -1; /**< Bullet scenes: btContactSolverInfo::m_numIterations; < 0: the scene's default. */
+    double hard_clamp = NAN; /**< Bullet scenes: Bridge::setHardClamp with this tolerance (m); <= 0: off; NaN: the scene's
+                                  default (0.5 mm in the paper's rigid scenes, off in the Bullet re-creations). */
     std::string data_dir; /**< The project's data/ folder. */
 };
 
@@ -132,6 +137,7 @@ struct StepCost {
     int64_t triangles_tested = 0; /**< Cumulative (direct queries only; -1 when unknown). */
     int64_t sdf_evaluations = -1; /**< Cumulative SDF evaluations of the collision pipeline (-1 when unknown). */
     int contacts = 0;        /**< Contact points alive after this step (manifolds or query contacts). */
+    int64_t freezes = 0;     /**< Cumulative: steps whose collision response hit its iteration cap and froze what still hit (cloth). */
 };
 
 class Scene {
