@@ -7,16 +7,24 @@
 // distance) standing on a ground box. Faces are measured on a lattice (density 3).
 //
 // The integrator (a small one, written for this scene): symplectic Euler with structural, shear
-// and bending springs (stiffness scaled so k dt^2 / m = 0.25, stable at 1 and 10 ms) and light
+// and bending springs (stiffness scaled so k dt^2 / m = 0.25) and light
 // damping, then 8 Jacobi passes of strain limiting (edges at most 5% longer than at rest).
-// Collision, each step: the predicted positions x* = x + dt v; if sdfccd_query_mesh_linear over
-// the whole cloth finds contact, every triangle near the SDF is queried with
-// sdfccd_query_triangle_linear (margin 1 mm); every contact it returns (one per triangle, plus
-// the subdivision contacts when enabled) becomes a plane constraint "the contact point of the
-// triangle at x* stays on the outer side of the plane through the surface point with normal n",
-// projected onto the triangle's vertices with its barycentric weights (4 Gauss-Seidel passes).
-// Velocities are then (x_new - x) / dt. So with one contact per triangle a face can pivot about it
-// and let the SDF through elsewhere; subdivision adds the contacts that hold the face.
+// Collision, each step (the paper's rule: the simulation does not advance past a time of impact):
+// the predicted positions x* = x + dt v give each vertex a displacement D over the step; every
+// triangle that can reach a collider is queried with sdfccd_query_triangle_linear (margin 1 mm)
+// on the motion x -> x + D, and
+//  - a triangle that first touches at toi in (0, dt] has its vertices put back where they were at
+//    that toi (D scaled by toi/dt; a vertex shared by several keeps the earliest): at its first
+//    time of impact the whole triangle is outside the margin surface;
+//  - a triangle already within the margin at the start (resting on the surface) turns each of its
+//    contacts into "no displacement into the surface" on its vertices (D.n >= 0, or back to half
+//    the margin when closer than that).
+// Placing some vertices back changes the motion of their neighbours' triangles, so the queries run
+// again on the new motion until nothing changes by more than 10 um (8 passes at most; then the
+// triangles that still reach the surface inside the step do not move in it, counted as
+// "response_freezes"). Velocities are (x_new - x) / dt, less their component into the surface at
+// every contact met. Without subdivision the first contact of a triangle is found all the same
+// (FWGSS minimises over the whole triangle); subdivision adds contacts at that time.
 //   cloth      10 ms steps (150 steps: 1.5 s)
 //   cloth-1ms  1 ms steps (1500 steps)
 #include <algorithm>
@@ -33,6 +41,8 @@ namespace {
 
 const int kN = 21;
 const double kSize = 0.8, kMass = 0.2, kMargin = 1e-3;
+const int kMaxSweeps = 8;   // CCD passes of the collision response per step before the freeze
+const double kStill = 1e-5; // m: a smaller change of a vertex's displacement ends the passes
 
 struct Spring {
     int a, b;
@@ -164,10 +174,18 @@ public:
             xs[i] = m_x[i] + dt * m_v[i];
         }
         strainLimit(xs);
-        collide(xs, dt);
+        std::vector<VertexPlane> planes;
+        collide(xs, dt, planes);
         for (size_t i = 0; i < m_x.size(); ++i) {
             m_v[i] = (xs[i] - m_x[i]) / dt;
             m_x[i] = xs[i];
+        }
+        // No velocity into the surface where a vertex met it.
+        for (const VertexPlane& vp : planes) {
+            double* v = &m_v[3 * (size_t)vp.v];
+            const double vn = v[0] * vp.n[0] + v[1] * vp.n[1] + v[2] * vp.n[2];
+            if (vn < 0)
+                for (int q = 0; q < 3; ++q) v[q] -= vn * vp.n[q];
         }
         bodies[0].mesh->samplesFor(m_x.data(), bodies[0].world);
     }
@@ -212,35 +230,45 @@ private:
         }
     }
 
-    struct PlaneContact {
-        uint32_t v[3];
-        double w[3], q[3], n[3]; // barycentric weights, point on the margin surface, normal
+    // One contact constraint on a vertex's displacement D over the step: D . n >= r.
+    struct VertexPlane {
+        uint32_t v;
+        double n[3], r;
     };
 
-    void collide(std::vector<double>& xs, double dt)
+    // The per-triangle CCD of the cloth's motion x0 -> x0 + D (every triangle that can reach a
+    // collider), with the kind of answer each gives:
+    //  - HIT at toi in (0, dt]: the triangle's vertices are moved back to their positions at the
+    //    toi (D scaled by toi / dt, the smallest factor over the vertex's triangles): at its first
+    //    time of impact the whole triangle is at the margin, never inside;
+    //  - PENETRATING (within the margin at the start of the step, e.g. resting on the surface):
+    //    each contact becomes "D . n >= r" on the triangle's vertices (no motion into the surface;
+    //    r pushes a vertex back to half the margin when it started closer than that).
+    // Returns the number of answers that changed D by more than kStill (10 um: a vertex stopped
+    // within 10 um past its time of impact is 1% of the margin inside it).
+    int sweep(const std::vector<double>& x0, std::vector<double>& D, double dt, std::vector<VertexPlane>& planes, bool freeze)
     {
         const MeshData& mesh = *bodies[0].mesh;
+        const int nv = mesh.vertexCount();
         sdfccd_QueryParams params = sdfccd_default_query_params();
         params.method = m_opt.method;
         params.subdivision = m_opt.subdivision ? 1 : 0;
         params.margin = kMargin;
-        std::vector<PlaneContact> planes;
+        std::vector<double> scale(nv, 1.0);
         std::vector<sdfccd_Contact> buf(32);
-        m_cost.contacts = 0;
+        size_t planes_before = planes.size();
+        int changed = 0;
         for (const Collider& c : colliders) {
             // World = collider frame shifted by p (no rotation in this scene): positions in its frame.
-            std::vector<double> a(m_x.size()), b(xs.size());
-            for (size_t i = 0; i < a.size(); ++i) {
-                a[i] = m_x[i] - c.frame.p[i % 3];
-                b[i] = xs[i] - c.frame.p[i % 3];
+            std::vector<sdfccd_Vec3> va((size_t)nv), vb((size_t)nv);
+            for (int i = 0; i < nv; ++i) {
+                const double* a = &x0[3 * (size_t)i];
+                const double* d = &D[3 * (size_t)i];
+                va[(size_t)i] = sdfccd_Vec3{ a[0] - c.frame.p[0], a[1] - c.frame.p[1], a[2] - c.frame.p[2] };
+                vb[(size_t)i] = sdfccd_Vec3{ va[(size_t)i].x + d[0], va[(size_t)i].y + d[1], va[(size_t)i].z + d[2] };
             }
             sdfccd_QueryResult res;
             auto t0 = std::chrono::steady_clock::now();
-            std::vector<sdfccd_Vec3> va(a.size() / 3), vb(b.size() / 3);
-            for (size_t i = 0; i < va.size(); ++i) {
-                va[i] = sdfccd_Vec3{ a[3 * i], a[3 * i + 1], a[3 * i + 2] };
-                vb[i] = sdfccd_Vec3{ b[3 * i], b[3 * i + 1], b[3 * i + 2] };
-            }
             sdfccd_Status st = sdfccd_query_mesh_linear(c.ccd, nullptr, mesh.handle, va.data(), vb.data(), 0, dt, &params, nullptr, 0, &res);
             ++m_cost.ccd_queries;
             if (st == SDFCCD_OK) m_cost.triangles_tested += res.triangles_tested;
@@ -251,55 +279,105 @@ private:
             ++m_cost.hits;
             for (int t = 0; t < mesh.triangleCount(); ++t) {
                 sdfccd_Vec3 s0[3], s1[3];
+                uint32_t tv[3];
                 double reach = 0, phi_min = 1e300;
                 for (int k = 0; k < 3; ++k) {
-                    uint32_t vi = mesh.f[3 * (size_t)t + k];
-                    s0[k] = sdfccd_Vec3{ a[3 * vi], a[3 * vi + 1], a[3 * vi + 2] };
-                    s1[k] = sdfccd_Vec3{ b[3 * vi], b[3 * vi + 1], b[3 * vi + 2] };
-                    reach = std::max(reach, dist(&a[3 * vi], &b[3 * vi]));
+                    tv[k] = mesh.f[3 * (size_t)t + k];
+                    s0[k] = va[tv[k]];
+                    s1[k] = vb[tv[k]];
+                    const double* d = &D[3 * (size_t)tv[k]];
+                    reach = std::max(reach, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
                     double phi;
                     sdfccd_sdf_eval(c.ccd, s0[k], &phi, nullptr);
                     phi_min = std::min(phi_min, phi);
                 }
-                double edge = std::max(dist(&a[3 * mesh.f[3 * t]], &a[3 * mesh.f[3 * t + 1]]),
-                                       std::max(dist(&a[3 * mesh.f[3 * t + 1]], &a[3 * mesh.f[3 * t + 2]]),
-                                                dist(&a[3 * mesh.f[3 * t + 2]], &a[3 * mesh.f[3 * t]])));
+                double edge = 0;
+                for (int k = 0; k < 3; ++k) {
+                    const sdfccd_Vec3& a = s0[k];
+                    const sdfccd_Vec3& b = s0[(k + 1) % 3];
+                    edge = std::max(edge, std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z)));
+                }
                 if (phi_min > reach + edge + kMargin) continue; // cannot reach the surface this step
                 sdfccd_QueryResult tr;
                 if (sdfccd_query_triangle_linear(c.ccd, nullptr, s0, s1, 0, dt, &params, buf.data(), (int32_t)buf.size(), &tr) != SDFCCD_OK ||
                     !tr.hit)
                     continue;
+                if (freeze && tr.state != SDFCCD_STATE_PENETRATING) {
+                    // Last resort after the iteration cap: a triangle that still reaches the
+                    // surface inside the step does not move this step.
+                    for (uint32_t v : tv) {
+                        const double* d = &D[3 * (size_t)v];
+                        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > kStill * kStill) ++changed;
+                        scale[v] = 0;
+                    }
+                    continue;
+                }
+                if (tr.state != SDFCCD_STATE_PENETRATING && tr.toi > 0) {
+                    const double f = std::max(0.0, std::min(1.0, tr.toi / dt));
+                    double moved = 0;
+                    for (uint32_t v : tv) {
+                        scale[v] = std::min(scale[v], f);
+                        const double* d = &D[3 * (size_t)v];
+                        moved = std::max(moved, (1 - f) * std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+                    }
+                    if (moved > kStill) ++changed;
+                }
                 for (int k = 0; k < tr.contact_count; ++k) {
                     const sdfccd_Contact& ct = buf[(size_t)k];
-                    PlaneContact pc;
-                    for (int q = 0; q < 3; ++q) {
-                        pc.v[q] = mesh.f[3 * (size_t)t + q];
-                        pc.w[q] = ct.barycentric[q];
+                    for (uint32_t v : tv) {
+                        VertexPlane vp;
+                        vp.v = v;
+                        vp.n[0] = ct.normal.x;
+                        vp.n[1] = ct.normal.y;
+                        vp.n[2] = ct.normal.z;
+                        vp.r = tr.state == SDFCCD_STATE_PENETRATING ? std::max(0.0, 0.5 * kMargin - ct.distance) : 0.0;
+                        planes.push_back(vp);
                     }
-                    const double n[3] = { ct.normal.x, ct.normal.y, ct.normal.z };
-                    const double p[3] = { ct.point.x, ct.point.y, ct.point.z };
-                    for (int q = 0; q < 3; ++q) {
-                        pc.n[q] = n[q];
-                        pc.q[q] = p[q] - (ct.distance - kMargin) * n[q] + c.frame.p[q]; // back to world
-                    }
-                    planes.push_back(pc);
                 }
             }
             m_cost.ccd_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         }
-        m_cost.contacts = (int)planes.size();
+        // Vertices of triangles that hit: their positions at the (earliest) time of impact.
+        for (int v = 0; v < nv; ++v)
+            if (scale[(size_t)v] < 1)
+                for (int q = 0; q < 3; ++q) D[3 * (size_t)v + q] *= scale[(size_t)v];
+        // Contacts of triangles within the margin at the start: no motion into the surface (a
+        // vertex stopped at a time of impact loses what is left of its inward part too).
         for (int pass = 0; pass < 4; ++pass)
-            for (const PlaneContact& pc : planes) {
-                double p[3] = { 0, 0, 0 }, ww = 0;
-                for (int k = 0; k < 3; ++k) {
-                    ww += pc.w[k] * pc.w[k];
-                    for (int q = 0; q < 3; ++q) p[q] += pc.w[k] * xs[3 * (size_t)pc.v[k] + q];
-                }
-                double cval = (p[0] - pc.q[0]) * pc.n[0] + (p[1] - pc.q[1]) * pc.n[1] + (p[2] - pc.q[2]) * pc.n[2];
-                if (cval >= 0 || ww <= 0) continue;
-                for (int k = 0; k < 3; ++k)
-                    for (int q = 0; q < 3; ++q) xs[3 * (size_t)pc.v[k] + q] -= cval * pc.w[k] / ww * pc.n[q];
+            for (size_t i = planes_before; i < planes.size(); ++i) {
+                const VertexPlane& vp = planes[i];
+                double* d = &D[3 * (size_t)vp.v];
+                const double dn = d[0] * vp.n[0] + d[1] * vp.n[1] + d[2] * vp.n[2];
+                if (dn >= vp.r) continue;
+                for (int q = 0; q < 3; ++q) d[q] += (vp.r - dn) * vp.n[q];
+                if (vp.r - dn > kStill && pass == 0) ++changed;
             }
+        return changed;
+    }
+
+    // The collision response: the vertices' displacements over the step are cut back until no
+    // triangle reaches the surface (see sweep); the last word is a freeze of what still hits.
+    // Returns the contact planes met (their normals remove the inward velocity afterwards).
+    void collide(std::vector<double>& xs, double dt, std::vector<VertexPlane>& planes)
+    {
+        const size_t n = m_x.size();
+        std::vector<double> D(n);
+        for (size_t i = 0; i < n; ++i) D[i] = xs[i] - m_x[i];
+        m_cost.contacts = 0;
+        planes.clear();
+        int iter = 0;
+        size_t last_pass = 0; // the contacts of the last pass are the step's contacts
+        for (; iter < kMaxSweeps; ++iter) {
+            last_pass = planes.size();
+            if (sweep(m_x, D, dt, planes, false) == 0) break;
+        }
+        if (iter == kMaxSweeps) {
+            ++m_cost.freezes;
+            while (sweep(m_x, D, dt, planes, true) > 0 && iter++ < 2 * kMaxSweeps) {
+            }
+        }
+        m_cost.contacts = (int)(planes.size() - last_pass);
+        for (size_t i = 0; i < n; ++i) xs[i] = m_x[i] + D[i];
     }
 
     Options m_opt;
