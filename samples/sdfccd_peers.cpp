@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "sdfccd/sdfccd.h"
+#include "scenes/scene.h" // takeMeshArrays
 
 namespace {
 
@@ -208,14 +209,12 @@ int main(int argc, char** argv)
         return 1;
     }
     sdfccd_MeshInfo info;
-    sdfccd_mesh_get_info(iso, &info);
     TriMesh tm;
-    tm.v.resize(3 * (size_t)info.vertex_count);
-    std::vector<uint32_t> f(3 * (size_t)info.triangle_count);
-    sdfccd_mesh_get_data(iso, tm.v.data(), f.data());
-    tm.f.assign(f.begin(), f.end());
-    sdfccd_destroy_mesh(iso);
+    std::vector<uint32_t> f;
+    const bool copied = scenes::takeMeshArrays(iso, tm.v, f, info); // destroys iso
     sdfccd_destroy_sdf(torus);
+    if (!copied) return 1;
+    tm.f.assign(f.begin(), f.end());
     std::fprintf(stderr, "[peers] torus mesh: %u triangles; %zu cases\n", info.triangle_count, cases.size());
 
     // Bullet world with GImpact registered.
