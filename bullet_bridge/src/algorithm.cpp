@@ -8,11 +8,14 @@
 // algorithm then orders the wrappers in one place and everything downstream sees (mesh, SDF).
 #include "internal.h"
 
+#include <cassert>
 #include <cstdio>
+#include <cstring>
+#include <map>
 #include <mutex>
 #include <new>
-#include <set>
 #include <string>
+#include <typeinfo>
 
 #include <BulletCollision/Gimpact/btGImpactShape.h>
 #include <LinearMath/btPoolAllocator.h>
@@ -23,9 +26,10 @@ using namespace detail;
 
 namespace {
 
-// Dispatchers that have a bridge (for the "registered twice" check across bridges).
+// Dispatchers that have a bridge (for the "registered twice" check across bridges, and for the
+// misuse report's diagnosis).
 std::mutex g_registry_mutex;
-std::set<const btCollisionDispatcher*> g_registered;
+std::map<const btCollisionDispatcher*, const BridgeImpl*> g_registered;
 
 } // namespace
 
@@ -313,7 +317,7 @@ Status Bridge::registerWith(btCollisionDispatcher* d)
         std::lock_guard<std::mutex> lock(g_registry_mutex);
         if (g_registered.count(d)) return Status::AlreadyRegistered;
         if (d->getNumManifolds() > 0) return Status::TooLate;
-        g_registered.insert(d);
+        g_registered[d] = m_impl;
     }
     // GImpact first: its registerAlgorithm overwrites every (GIMPACT, x) and (x, GIMPACT) slot.
     btGImpactCollisionAlgorithm::registerAlgorithm(d);
@@ -325,11 +329,15 @@ Status Bridge::registerWith(btCollisionDispatcher* d)
     return verify();
 }
 
-Status Bridge::verify() const
+Status Bridge::verify() const { return verifyImpl(m_impl); }
+
+namespace detail {
+
+Status verifyImpl(const BridgeImpl* impl)
 {
-    btCollisionDispatcher* d = m_impl->dispatcher;
+    btCollisionDispatcher* d = impl->dispatcher;
     if (!d) return Status::NotRegistered;
-    const Config& cfg = m_impl->cfg;
+    const Config& cfg = impl->cfg;
     Probe probe;
     // A valid SDF for the probe shape (a sphere), so the create function takes it as ours.
     sdfccd_SdfId sphere = kNullSdf;
@@ -360,6 +368,8 @@ Status Bridge::verify() const
     return result;
 }
 
+} // namespace detail
+
 Status Bridge::check(btCollisionWorld* world, std::string* message) const
 {
     say(message, "ok");
@@ -372,7 +382,7 @@ Status Bridge::check(btCollisionWorld* world, std::string* message) const
                      "after creating the world, before adding bodies");
         return Status::NotRegistered;
     }
-    if (verify() != Status::Ok) {
+    if (verifyImpl(m_impl) != Status::Ok) {
         say(message, "the dispatcher no longer creates the bridge's algorithm (registerCollisionCreateFunc or "
                      "btGImpactCollisionAlgorithm::registerAlgorithm was called after Bridge::registerWith)");
         return Status::Overwritten;
@@ -434,6 +444,108 @@ double Bridge::timeOfImpact(const btCollisionObject* mesh_body, const btCollisio
 }
 
 void Bridge::invalidateShape(const btCollisionShape* shape) { m_impl->shapes.invalidate(shape); }
+
+// ---------------------------------------------------------------------------------------------
+// Misuse reports (bridge.h: setMisuseHandler).
+namespace {
+
+std::mutex g_misuse_mutex;
+MisuseHandler g_misuse_handler = nullptr;
+void* g_misuse_user = nullptr;
+
+void defaultMisuseHandler(Status, const char* message, const btCollisionShape*, void*)
+{
+    // Debug builds of the bridge stop here so the mistake is seen on the first step it matters;
+    // release builds (NDEBUG) do nothing: the library never aborts there.
+    (void)message;
+    assert(!"sdfccd_bullet misuse (see the message passed to the misuse handler; Bridge::check(world) tells more)");
+}
+
+} // namespace
+
+MisuseHandler setMisuseHandler(MisuseHandler handler, void* user)
+{
+    std::lock_guard<std::mutex> lock(g_misuse_mutex);
+    MisuseHandler old = g_misuse_handler ? g_misuse_handler : defaultMisuseHandler;
+    g_misuse_handler = handler;
+    g_misuse_user = handler ? user : nullptr;
+    return old;
+}
+
+namespace {
+
+// The dispatcher's contact-point table, read without creating anything (findAlgorithm would
+// allocate from a world that may be stepping on another thread). A pointer to the protected
+// member, formed through a derived class, applies to any btCollisionDispatcher.
+struct DispatchTable : btCollisionDispatcher {
+    static btCollisionAlgorithmCreateFunc* contactFunc(const btCollisionDispatcher* d, int a, int b)
+    {
+        return (d->*(&DispatchTable::m_doubleDispatchContactPoints))[a][b];
+    }
+};
+
+// Both body orders of (GImpact, SdfShape) still create the bridge's algorithm.
+bool slotsIntact(const BridgeImpl* impl)
+{
+    const btCollisionDispatcher* d = impl->dispatcher;
+    const int t = impl->cfg.sdf_shape_type;
+    return d && DispatchTable::contactFunc(d, GIMPACT_SHAPE_PROXYTYPE, t) == impl->fn[0].get() &&
+           DispatchTable::contactFunc(d, t, GIMPACT_SHAPE_PROXYTYPE) == impl->fn[0].get();
+}
+
+} // namespace
+
+namespace detail {
+
+bool isGImpactCallback(const btTriangleCallback* callback)
+{
+    // btGImpactTriangleCallback is private to btGImpactCollisionAlgorithm.cpp: recognised by its
+    // type name (RTTI is on in Debian's builds). Not recognising it only loses the report.
+    if (!callback) return false;
+    const char* name = typeid(*callback).name();
+    return name && std::strstr(name, "btGImpactTriangleCallback") != nullptr;
+}
+
+void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported)
+{
+    // Which mistake it most likely is, from the bridges this process has registered (check(world)
+    // knows the world and tells exactly).
+    Status status = Status::NotRegistered;
+    {
+        std::lock_guard<std::mutex> lock(g_registry_mutex);
+        if (!g_registered.empty()) {
+            // (The dispatcher tables are read, not probed with findAlgorithm: another world may be
+            // stepping on another thread.)
+            status = Status::TooLate;
+            for (const auto& r : g_registered)
+                if (!slotsIntact(r.second)) status = Status::Overwritten;
+        }
+    }
+    if (last_reported == (int)status + 1) return; // said already
+    last_reported = (int)status + 1;
+    const char* what = status == Status::NotRegistered
+                           ? "no sdfccd_bullet::Bridge is registered: call Bridge::registerWith(world) right after creating the world"
+                       : status == Status::Overwritten
+                           ? "a registered bridge was overwritten (btGImpactCollisionAlgorithm::registerAlgorithm or "
+                             "registerCollisionCreateFunc after Bridge::registerWith)"
+                           : "the pair's algorithm was created before Bridge::registerWith (register before adding bodies), or this "
+                             "world's dispatcher has no bridge";
+    char message[512];
+    std::snprintf(message, sizeof message,
+                  "Bullet's GImpact algorithm is colliding a GImpact mesh with an SdfShape, without CCD (it can pass through): %s; "
+                  "Bridge::check(world) names the problem",
+                  what);
+    MisuseHandler h;
+    void* user;
+    {
+        std::lock_guard<std::mutex> lock(g_misuse_mutex);
+        h = g_misuse_handler ? g_misuse_handler : defaultMisuseHandler;
+        user = g_misuse_user;
+    }
+    h(status, message, shape, user);
+}
+
+} // namespace detail
 
 const Config& Bridge::config() const { return m_impl->cfg; }
 Stats Bridge::stats() const { return m_impl->stats; }

@@ -110,6 +110,14 @@ std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double t
 class MeshSdfAlgorithm;
 
 Status clampCheck(const BridgeImpl* impl, const btCollisionWorld* world);
+/** Bridge::verify() of `impl`. */
+Status verifyImpl(const BridgeImpl* impl);
+/** True when `callback` is Bullet's GImpact algorithm's triangle callback (btGImpactTriangleCallback). */
+bool isGImpactCallback(const btTriangleCallback* callback);
+/** Diagnoses Bullet's GImpact algorithm colliding with `shape` and reports it through the misuse
+ * handler unless the diagnosis equals the last one reported for the shape (`last_reported`:
+ * 0 = none, else the Status + 1; updated). */
+void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported);
 void clampForget(BridgeImpl* impl);
 
 } // namespace detail

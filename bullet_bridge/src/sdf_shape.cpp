@@ -2,6 +2,8 @@
 // sdfccd Bullet bridge: the SDF collision shape (see sdf_shape.h).
 #include "sdfccd_bullet/sdf_shape.h"
 
+#include "internal.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -26,7 +28,7 @@ bool finiteBox(const btVector3& lo, const btVector3& hi)
 
 SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type)
     : m_sdf(sdf), m_valid(false), m_scaling(1, 1, 1), m_margin(0), m_resolution(48), m_scaled(kNullSdf), m_scaledValid(false),
-      m_triangulated(false), m_meshInterface(nullptr), m_bvh(nullptr)
+      m_triangulated(false), m_meshInterface(nullptr), m_bvh(nullptr), m_misuseReported(0)
 {
     m_shapeType = shape_type;
     m_stretch.child = kNullSdf;
@@ -237,6 +239,10 @@ int SdfShape::getTriangulationTriangleCount() const
 
 void SdfShape::processAllTriangles(btTriangleCallback* callback, const btVector3& aabbMin, const btVector3& aabbMax) const
 {
+    // A registered bridge handles every GImpact mesh against a valid SdfShape, so Bullet's GImpact
+    // algorithm asking for our triangles means the bridge is not in charge of the pair (reported
+    // once per shape and diagnosis).
+    if (m_valid && detail::isGImpactCallback(callback)) detail::reportGImpactMisuse(this, m_misuseReported);
     if (!m_triangulated) buildTriangulation();
     if (m_bvh) m_bvh->processAllTriangles(callback, aabbMin, aabbMax);
 }

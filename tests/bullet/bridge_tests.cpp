@@ -29,6 +29,9 @@
 using sdfccd_bullet::Bridge;
 using sdfccd_bullet::SdfShape;
 using sdfccd_bullet::Status;
+using sdfccd_bullet::MisuseHandler;
+using sdfccd_bullet::setMisuseHandler;
+using sdfccd_bullet::statusString;
 
 static int g_pass = 0, g_fail = 0;
 #define CHECK(cond, ...)                                                         \
@@ -212,13 +215,33 @@ static void testCube(bool mesh_first)
 static void test_cube_mesh_first() { testCube(true); }
 static void test_cube_sdf_first() { testCube(false); }
 
+// Misuse reports (setMisuseHandler), recorded instead of the default debug-build assert.
+struct MisuseLog {
+    int calls = 0;
+    Status last = Status::Ok;
+    const btCollisionShape* shape = nullptr;
+    std::string message;
+};
+
+static void recordMisuse(Status status, const char* message, const btCollisionShape* shape, void* user)
+{
+    MisuseLog* log = static_cast<MisuseLog*>(user);
+    log->calls++;
+    log->last = status;
+    log->shape = shape;
+    log->message = message ? message : "";
+}
+
 static void test_cube_tunnels_without_bridge()
 {
+    MisuseLog log; // deliberate misuse: recorded, not asserted on (the cube may skip the slab's box)
+    setMisuseHandler(recordMisuse, &log);
     for (int order = 0; order < 2; ++order) {
         CubeRun r = runCube(false, order == 0, 30);
         CHECK(r.impact_step < 0, "without the bridge the cube should never be stopped (deviated at step %d)", r.impact_step);
         CHECK(r.z.back() < -50, "without the bridge the cube should tunnel: final z %.3f", r.z.back());
     }
+    setMisuseHandler(nullptr);
 }
 
 // ---- a spinning GImpact bar hitting a torus SDF ----
@@ -1062,6 +1085,8 @@ static void test_misuse()
 {
     sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
     std::string msg;
+    MisuseLog log; // the too-late world below collides through GImpact's algorithm on purpose
+    setMisuseHandler(recordMisuse, &log);
     {
         // Not registered.
         Bridge bridge;
@@ -1136,6 +1161,95 @@ static void test_misuse()
         CHECK(g_user_post == 3, "user post callback %d", g_user_post);
         bridge.setHardClamp(&w.world, false);
     }
+    setMisuseHandler(nullptr);
+    sdfccd_destroy_sdf(slab);
+}
+
+// ---- misuse noticed while stepping: the handler hears it on the first step it matters ----
+
+enum MisuseMode { kRegistered, kNotRegistered, kOverwritten, kTooLate };
+
+// A GImpact cube 5 cm above an SDF slab (their boxes overlap from the start), stepped 5 times,
+// with the bridge used as `mode` says. Returns the log; *first_step = step of the first report.
+static MisuseLog misuseRun(MisuseMode mode, sdfccd_SdfId slab, int* first_step, bool* ray_hit = nullptr)
+{
+    MisuseLog log;
+    setMisuseHandler(recordMisuse, &log);
+    *first_step = -1;
+    {
+        Bridge bridge;
+        World w;
+        if (mode == kRegistered || mode == kOverwritten) CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        if (mode != kRegistered) btGImpactCollisionAlgorithm::registerAlgorithm(&w.dispatcher); // overwrites the bridge's slots
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(cube->shape.get(), 1, btVector3(0, 0, 0.6), btVector3(0.5, 0.5, 0.5));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        for (int i = 0; i < 5; ++i) {
+            if (mode == kTooLate && i == 1) {
+                // The pair's (GImpact) algorithm exists (no contact point yet, so the dispatcher
+                // accepts the registration); registering now is too late for the pair.
+                CHECK(bridge.registerWith(&w.dispatcher) == Status::Ok, "register on the dispatcher");
+                CHECK(bridge.check(&w.world) == Status::TooLate, "check() does not see the too-late pair");
+            }
+            int before = log.calls;
+            w.step();
+            if (log.calls > before && *first_step < 0) *first_step = i;
+            if (log.calls > before) CHECK(log.shape == &shape, "the report names another shape");
+        }
+        if (ray_hit) {
+            // Ray tests use the shape's triangulation by design: not misuse.
+            btCollisionWorld::ClosestRayResultCallback ray(btVector3(2, 2, 1), btVector3(2, 2, -1));
+            w.world.rayTest(btVector3(2, 2, 1), btVector3(2, 2, -1), ray);
+            *ray_hit = ray.hasHit();
+        }
+        if (mode == kTooLate) bridge.unregister();
+    }
+    setMisuseHandler(nullptr);
+    return log;
+}
+
+static void test_misuse_handler()
+{
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    int first = -1;
+    bool ray_hit = false;
+    // Registered properly: the bridge handles the pair, nothing is reported (steps and a ray test).
+    MisuseLog ok = misuseRun(kRegistered, slab, &first, &ray_hit);
+    CHECK(ok.calls == 0, "a registered world reported misuse: %s", ok.message.c_str());
+    CHECK(ray_hit, "the ray missed the slab's triangulation (the ray path was not exercised)");
+    // Not registered: reported on the first step, once.
+    MisuseLog nr = misuseRun(kNotRegistered, slab, &first);
+    CHECK(nr.calls == 1 && nr.last == Status::NotRegistered && first == 0, "not registered: %d reports, last %s, first step %d",
+          nr.calls, statusString(nr.last), first);
+    CHECK(nr.message.find("registerWith") != std::string::npos, "the message does not say what to do: %s", nr.message.c_str());
+    // Overwritten by GImpact's registerAlgorithm after registerWith.
+    MisuseLog ow = misuseRun(kOverwritten, slab, &first);
+    CHECK(ow.calls == 1 && ow.last == Status::Overwritten && first == 0, "overwritten: %d reports, last %s, first step %d", ow.calls,
+          statusString(ow.last), first);
+    // Registered after the pair existed: NotRegistered before the registration, TooLate after it.
+    MisuseLog tl = misuseRun(kTooLate, slab, &first);
+    CHECK(tl.calls == 2 && tl.last == Status::TooLate && first == 0, "too late: %d reports, last %s, first step %d", tl.calls,
+          statusString(tl.last), first);
+    // The default handler is restored by NULL; in a release build it must not abort.
+    MisuseLog dummy;
+    setMisuseHandler(recordMisuse, &dummy);
+    CHECK(setMisuseHandler(nullptr) == recordMisuse, "setMisuseHandler does not return the previous handler");
+    MisuseHandler dflt = setMisuseHandler(nullptr);
+    CHECK(dflt != nullptr && dflt != recordMisuse, "no default handler");
+#ifdef NDEBUG
+    {
+        Bridge bridge;
+        World w;
+        btGImpactCollisionAlgorithm::registerAlgorithm(&w.dispatcher);
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        w.add(cube->shape.get(), 1, btVector3(0, 0, 0.6), btVector3(0.5, 0.5, 0.5));
+        for (int i = 0; i < 3; ++i) w.step(); // the default handler in a release build: no abort
+    }
+#endif
     sdfccd_destroy_sdf(slab);
 }
 
@@ -1148,6 +1262,7 @@ static const Test kTests[] = {
     { "cube_mesh_first", test_cube_mesh_first },
     { "cube_sdf_first", test_cube_sdf_first },
     { "cube_tunnels_without_bridge", test_cube_tunnels_without_bridge },
+    { "misuse_handler", test_misuse_handler },
     { "torus_spinning", test_torus_spinning },
     { "kinematic_sdf", test_kinematic_sdf },
     { "dynamic_sdf_on_mesh_floor", test_dynamic_sdf_on_mesh_floor },

@@ -36,7 +36,9 @@
  *    A point with gap d > 0 lets the solver close at most d in the step, so the mesh stops on
  *    the surface in its impact step; such speculative points have restitution 0.
  *  - Bridge::check(world) reports misuse (not registered, registered too late, overwritten,
- *    an SdfShape with a dead handle, a displaced hard clamp).
+ *    an SdfShape with a dead handle, a displaced hard clamp); while a world steps, Bullet's
+ *    GImpact algorithm colliding with an SdfShape (the bridge not in charge) goes to the misuse
+ *    handler, which asserts in debug builds (setMisuseHandler).
  *  - optional hard clamp (off by default), see setHardClamp().
  *
  * Manifold convention: body A = the mesh (or convex/moving SDF) body, body B = the SDF body; the
@@ -64,6 +66,7 @@
 #include "sdf_shape.h"
 
 class btCollisionDispatcher;
+class btCollisionShape;
 class btCollisionWorld;
 class btCollisionObject;
 class btDiscreteDynamicsWorld;
@@ -88,6 +91,32 @@ enum class Status {
 
 /** Constant name of a status, e.g. "TooLate". */
 const char* statusString(Status s);
+
+/** A misuse report: `status` is the likely mistake, `message` a sentence saying it and what to do
+ * (valid during the call), `shape` the SdfShape that saw it, `user` what setMisuseHandler got. */
+typedef void (*MisuseHandler)(Status status, const char* message, const btCollisionShape* shape, void* user);
+
+/** Sets the process-wide handler of misuse the bridge notices while a world steps, and returns
+ * the previous one. NULL restores the default, which asserts in debug builds of the bridge
+ * library (NDEBUG not defined) and does nothing in release builds (the bridge never aborts
+ * there). Tests and applications that want their own report (log, exception at their level,
+ * counter) install theirs.
+ *
+ * What is noticed: Bullet's own GImpact algorithm asking a valid SdfShape for its triangles
+ * (processAllTriangles from GImpact's callback). A registered, working bridge handles every
+ * GImpact mesh against a valid SdfShape, so this means the world's bridge is not in charge of
+ * the pair: the mesh collides with the shape's triangulation without CCD and can pass through.
+ * It happens in the first step in which such a pair's boxes overlap, once per SdfShape and
+ * diagnosis (a world registered too late is reported NotRegistered before the registration and
+ * TooLate after it). `status`:
+ *  NotRegistered  no bridge is registered in this process;
+ *  Overwritten    a registered bridge's verify() fails (its create functions were replaced);
+ *  TooLate        otherwise: the pair's algorithm predates the registration, or this world's
+ *                 dispatcher has no bridge while another world's has.
+ * Bridge::check(world) tells exactly which. Not noticed: convex shapes going through Bullet's
+ * convex-concave algorithm (intended with Config::convex_shapes off), ray tests and sweeps
+ * (they use the triangulation by design), and Bullet's btSdfCollisionShape (not ours). */
+MisuseHandler setMisuseHandler(MisuseHandler handler, void* user = nullptr);
 
 /** Size in bytes of the bridge's collision-algorithm object. It is taken from Bullet's
  * collision-algorithm pool when it fits the pool's element size (192 B in Debian's float and

@@ -116,7 +116,10 @@ public:
     btScalar getMargin() const override { return m_margin; }
 
     // ---- btConcaveShape ----
-    /** Reports the cached isosurface triangles (scaled, local frame) overlapping the box. */
+    /** Reports the cached isosurface triangles (scaled, local frame) overlapping the box. When the
+     * caller is Bullet's GImpact algorithm (the bridge is not handling a GImpact mesh against
+     * this shape), the misuse handler hears of it first, once per shape and diagnosis
+     * (setMisuseHandler). */
     void processAllTriangles(btTriangleCallback* callback, const btVector3& aabbMin,
                              const btVector3& aabbMax) const override;
 
@@ -138,6 +141,7 @@ private:
     mutable std::vector<int> m_indices;
     mutable btTriangleIndexVertexArray* m_meshInterface;
     mutable btBvhTriangleMeshShape* m_bvh;
+    mutable int m_misuseReported; // last misuse diagnosis reported for the shape (Status + 1; 0: none)
 };
 
 SDFCCD_BULLET_NAMESPACE_END
