@@ -33,9 +33,10 @@ typedef struct scc_params {
     int64_t cert_max_regions;
     int broad_phase;
     int fwgss_secant;       /* FWGSS entry time by Illinois regula falsi once a sign change is bracketed */
-    int fwgss_speed_tol;
+    int fwgss_speed_tol;    /* FWGSS spatial tolerance = speed bound x time_tol (else dist_tol) */
     int fwgss_brent_spatial; /* FWGSS spatial line searches by Brent's method (else golden section) */
-    int fwgss_clear_budget; /* FWGSS: evaluations of the no-contact proof tried before the descents (0: off) */    /* FWGSS spatial tolerance = speed bound x time_tol (else dist_tol) */
+    int fwgss_clear_budget; /* FWGSS: evaluations of the no-contact proof tried before the descents (0: off) */
+    double fwgss_gap_tol;   /* FWGSS: spatial line searches stop at max(spatial tolerance, this x the gap) */
     int64_t max_evals;      /* SDF evaluation budget of this call (> 0); solvers stop at it (NOT_CONVERGED) */
 } scc_params;
 

@@ -141,18 +141,22 @@ static int interior_direction(const scc_tri_state* st, scc_vec3 g, const double 
 }
 
 /* Golden-section search of phi at time t on the segment from the iterate (point xn, weights
- * s->b) to the weights bb; moves s->b there and returns the length of the step. */
-static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 xn, const double bb[3], double t)
+ * s->b, phi - margin = gap there) to the weights bb; moves s->b there and returns the length of
+ * the step. The search's tolerance is the spatial tolerance or, far from the surface, a fraction
+ * of the gap (ours): there the step only has to point the next temporal search the right way,
+ * and the searches that place the contact run at contact, where the gap is 0. */
+static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 xn, double gap, const double bb[3], double t)
 {
     const scc_params* p = s->p;
     scc_vec3 end = scc_add(scc_add(scc_scale(st->x[0], bb[0]), scc_scale(st->x[1], bb[1])), scc_scale(st->x[2], bb[2]));
     double len = scc_dist(end, xn);
     if (!(len > s->dist_tol)) return 0.0;
     space_ctx k = { s, xn, end, { s->b[0], s->b[1], s->b[2] }, { bb[0], bb[1], bb[2] }, t };
+    double tol = fmax(s->dist_tol, p->fwgss_gap_tol * gap) / len;
     /* Brent's parabolic steps (ours) converge superlinearly where phi is smooth along the segment;
      * golden section (Algorithm 1) otherwise. */
-    scc_gss_result sp = p->fwgss_brent_spatial ? scc_brent_minimize(0.0, 1.0, s->dist_tol / len, p->max_ls_iter, phi_on_segment, &k)
-                                               : scc_gss_minimize(0.0, 1.0, s->dist_tol / len, p->max_ls_iter, phi_on_segment, &k);
+    scc_gss_result sp = p->fwgss_brent_spatial ? scc_brent_minimize(0.0, 1.0, tol, p->max_ls_iter, phi_on_segment, &k)
+                                               : scc_gss_minimize(0.0, 1.0, tol, p->max_ls_iter, phi_on_segment, &k);
     for (int j = 0; j < 3; ++j) s->b[j] = fmax((1.0 - sp.l) * s->b[j] + sp.l * bb[j], 0.0);
     return sp.l * len;
 }
@@ -189,7 +193,7 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
          * towards an interior optimum (a spike apex under a face took more than 32 iterations and
          * stopped 62 us late), while the projected gradient points at it. */
         scc_vec3 xn, gn;
-        scc_fw_eval(s, s->b, tn, &xn, &gn, &v);
+        double gap = scc_fw_eval(s, s->b, tn, &xn, &gn, &v) - p->margin;
         scc_tri_state st;
         scc_fw_tri_state(s, tn, &st);
         double bb[3];
@@ -210,7 +214,7 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
                 have_dir = 1;
             }
         }
-        double step = have_dir ? spatial_search(s, &st, xn, bb, tn) : 0.0;
+        double step = have_dir ? spatial_search(s, &st, xn, gap, bb, tn) : 0.0;
         if (interior && step <= s->dist_tol) {
             /* Stalled inside (ours): at a kink of the field (a box's edge or corner under the face)
              * the steepest descent of one side need not descend, and the iterate would stop short
@@ -218,7 +222,7 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
              * the paper's step towards the support vertex (Eq. 15) is searched too. */
             int sv = scc_fw_support(&st, gn);
             for (int j = 0; j < 3; ++j) bb[j] = j == sv;
-            step = spatial_search(s, &st, scc_fw_point(s, s->b, tn, NULL), bb, tn);
+            step = spatial_search(s, &st, scc_fw_point(s, s->b, tn, NULL), gap, bb, tn);
         }
         int small = fabs(tn - t) <= p->time_tol && step <= s->dist_tol; /* line 32 */
         t = tn;

@@ -24,7 +24,8 @@ typedef struct options {
 
 /* FWGSS configurations compared by the experiments: today's defaults, the previous defaults
  * (before issue 9's parameters: golden-section entry search, fixed spatial tolerance, no clear
- * proof; the closed-form motion and the interior spatial step are not switchable), and the paper's
+ * proof, no gap tolerance; the closed-form motion, the interior spatial step, the shared and
+ * refined vertex traces and the start at the broad phase's candidate time are not switchable), and the paper's
  * configuration (no vertex trace, no restarts). */
 typedef enum fw_config { CFG_NEW, CFG_BASELINE, CFG_PAPER, CFG_COUNT } fw_config;
 static const char* k_cfg_name[CFG_COUNT] = { "new", "baseline", "paper" };
@@ -37,6 +38,7 @@ static sdfccd_QueryParams config_params(fw_config c, int subdivision)
         p.fwgss_secant_entry = 0;
         p.fwgss_speed_tolerance = 0;
         p.fwgss_clear_proof = 0;
+        p.fwgss_gap_tolerance = 0.0;
     }
     if (c == CFG_PAPER) {
         p.fwgss_vertex_trace = 0;

@@ -79,6 +79,11 @@ START_TEST(test_query_bad_inputs)
     bp = p;
     bp.margin = NAN;
     EXPECT(sdfccd_query_triangle(s, NULL, k_tri, &m, 0, DT, &bp, c, 4, &r), SDFCCD_INVALID_ARGUMENT);
+    bp = p;
+    bp.fwgss_gap_tolerance = -0.5;
+    EXPECT(sdfccd_query_triangle(s, NULL, k_tri, &m, 0, DT, &bp, c, 4, &r), SDFCCD_INVALID_ARGUMENT);
+    bp.fwgss_gap_tolerance = NAN;
+    EXPECT(sdfccd_query_triangle(s, NULL, k_tri, &m, 0, DT, &bp, c, 4, &r), SDFCCD_INVALID_ARGUMENT);
     sdfccd_SdfId unknown = { 999, 3 };
     EXPECT(sdfccd_query_triangle(unknown, NULL, k_tri, &m, 0, DT, &p, c, 4, &r), SDFCCD_INVALID_HANDLE);
     sdfccd_Vec3 end[3] = { { 0, 0, NAN }, { 0.1, 0, 0 }, { 0, 0.1, 0 } };

@@ -34,6 +34,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.fwgss_speed_tolerance = 1;
     p.fwgss_clear_proof = 64;
     p.fwgss_brent_spatial = 0;
+    p.fwgss_gap_tolerance = 0.5;
     return p;
 }
 
@@ -61,6 +62,7 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     NONNEG(subdivision_min_area);
     NONNEG(contact_slop);
     NONNEG(toi_window);
+    NONNEG(fwgss_gap_tolerance);
 #undef POS
 #undef NONNEG
     if (!isfinite(in->margin)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->margin is not finite", fn);
@@ -101,6 +103,7 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     out->fwgss_secant = in->fwgss_secant_entry != 0;
     out->fwgss_speed_tol = in->fwgss_speed_tolerance != 0;
     out->fwgss_brent_spatial = in->fwgss_brent_spatial != 0;
+    out->fwgss_gap_tol = in->fwgss_gap_tolerance;
     if (in->fwgss_clear_proof < 0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_clear_proof must be >= 0 (got %d)", fn, in->fwgss_clear_proof);
     out->fwgss_clear_budget = in->fwgss_clear_proof;

@@ -93,6 +93,11 @@ typedef struct sdfccd_QueryParams {
                                         query, 0 false negatives), but in test_sweep it misses one more case (2 of 982
                                         instead of 1) and leaves more cases unconverged; 0 = the paper's
                                         golden-section search. Default 0. */
+    double fwgss_gap_tolerance;    /**< FWGSS: a spatial line search stops at a tolerance of this fraction of the current
+                                        point's gap (phi - margin at the search's time) when that exceeds the spatial
+                                        tolerance: far from the surface a rough step serves as well, and the last
+                                        searches, at contact, keep the full precision. Finite, >= 0; 0 = always the
+                                        spatial tolerance. Default 0.5. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
