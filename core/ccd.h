@@ -36,7 +36,7 @@ typedef struct scc_params {
     int fwgss_speed_tol;    /* FWGSS spatial tolerance = speed bound x time_tol (else dist_tol) */
     int fwgss_brent_spatial; /* FWGSS spatial line searches by Brent's method (else golden section) */
     int fwgss_clear_budget; /* FWGSS: evaluations of the no-contact proof tried before the descents (0: off) */
-    double fwgss_gap_tol;   /* FWGSS: spatial line searches stop at max(spatial tolerance, this x the gap) */
+    double fwgss_gap_tol;   /* FWGSS: line searches far from the surface stop early by this fraction of the gap */
     int64_t max_evals;      /* SDF evaluation budget of this call (> 0); solvers stop at it (NOT_CONVERGED) */
 } scc_params;
 

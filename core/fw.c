@@ -17,6 +17,7 @@ void scc_fw_begin(scc_fw_state* s, const scc_sdf* sdf, const scc_tri_motion* m, 
     s->evals = 0;
     s->b[0] = 1.0; s->b[1] = 0.0; s->b[2] = 0.0;
     s->dist_tol = p->dist_tol;
+    s->time_slope = 0.0;
     scc_fw_prepare_motion(s);
 }
 

@@ -16,6 +16,7 @@ typedef struct scc_fw_state {
     double b[3];            /* current barycentric weights */
     int64_t evals;
     double dist_tol;        /* spatial tolerance of this solve (m) */
+    double time_slope;      /* FWGSS: early stop of signed temporal searches (scc_gss_minimize_gap), 0: none */
     /* Closed-form rigid motion (static SDF): x(t) = g0 + v tau + R(w tau) r0, tau = t - t0, with
      * the vertices' offsets r0 from the centre precomputed once and the rotation's sine and
      * cosine cached for the last time evaluated (spatial searches evaluate many points at one

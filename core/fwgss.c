@@ -179,9 +179,9 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
             ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, unsigned_phi_at_time, s);
             if (ls.f > s->dist_tol) ls = crossing_by_bisection(s, s->ts, fmin(t, s->te), p);
         } else if (scc_dot(g, v) > 0.0) { /* d = -1: moving away, look back in time */
-            ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, phi_at_time, s);
+            ls = scc_gss_minimize_gap(s->ts, t, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         } else {
-            ls = scc_gss_minimize(t, s->te, p->time_tol, p->max_ls_iter, phi_at_time, s);
+            ls = scc_gss_minimize_gap(t, s->te, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         }
         double tn = fmin(ls.l, s->te);
 
@@ -384,6 +384,10 @@ void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb
     double speed = scc_tri_speed_bound(m);
     /* A spatial error of speed x time_tol moves the entry time by about time_tol. */
     if (p->fwgss_speed_tol && speed > 0.0) s.dist_tol = speed * p->time_tol;
+    /* phi along a point's path changes at most L x speed per second: a temporal search whose
+     * bracket is narrower than fwgss_gap_tol x (smallest gap) / (L x speed) cannot hide a contact
+     * (scc_gss_minimize_gap), so far from the surface it stops there. */
+    s.time_slope = p->fwgss_gap_tol > 0.0 ? fmax(sdf->lipschitz, 1.0) * speed / p->fwgss_gap_tol : 0.0;
     /* Most triangles the broad phase hands over pass close to the field without touching it; a
      * short proof of that skips the descents. */
     if (p->fwgss_clear_budget > 0 && speed > 0.0 && prove_clear(&s, s.ts, s.te, speed, p->fwgss_clear_budget)) {

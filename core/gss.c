@@ -9,6 +9,11 @@
 
 scc_gss_result scc_gss_minimize(double a, double b, double tol, int max_iter, scc_gss_fn* f, void* ctx)
 {
+    return scc_gss_minimize_gap(a, b, tol, 0.0, max_iter, f, ctx);
+}
+
+scc_gss_result scc_gss_minimize_gap(double a, double b, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx)
+{
     const double r = 0.61803398874989484820; /* 1/phi */
     const double rc = 1.0 - r;
     scc_gss_result res;
@@ -24,8 +29,12 @@ scc_gss_result scc_gss_minimize(double a, double b, double tol, int max_iter, sc
     double l1 = a + (b - a) * a1, l2 = a + (b - a) * a2;
     double f1 = f(l1, ctx), f2 = f(l2, ctx);
     res.evals += 3;
-    int it = 0;
+    int it = 0, flat = 0;
     while (fabs(l3 - l0) > tol && it < max_iter) {
+        if (slope > 0.0) {
+            double m = fmin(fmin(f0, f1), fmin(f2, f3));
+            if (m > 0.0 && fabs(l3 - l0) * slope <= m) { flat = 1; break; }
+        }
         ++it;
         if (fmin(f0, f1) < fmin(f2, f3)) {
             a3 = a2; l3 = l2; f3 = f2;
@@ -42,7 +51,7 @@ scc_gss_result scc_gss_minimize(double a, double b, double tol, int max_iter, sc
         }
         res.evals++;
     }
-    res.converged = fabs(l3 - l0) <= tol;
+    res.converged = flat || fabs(l3 - l0) <= tol;
     double lmid = a + (b - a) * 0.5 * (a0 + a3);
     double fmid = f(lmid, ctx);
     res.evals++;

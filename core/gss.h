@@ -18,6 +18,12 @@ typedef struct scc_gss_result {
  * Returns the best of the final bracket's ends and its midpoint, as Algorithm 1 does. */
 scc_gss_result scc_gss_minimize(double a, double b, double tol, int max_iter, scc_gss_fn* f, void* ctx);
 
+/* The same, also stopping (converged) once the bracket's width times `slope` is at most the
+ * smallest value sampled so far, when that is positive (ours). With `slope` = 2 x a Lipschitz bound
+ * of f in l, f stays above half that value over the whole final bracket: no zero of f inside it
+ * is skipped, while far from zero the search ends early. slope <= 0: scc_gss_minimize. */
+scc_gss_result scc_gss_minimize_gap(double a, double b, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx);
+
 /* Brent's minimiser over [a, b] (a <= b): parabolic steps safeguarded by golden section; the same
  * result struct. Converges superlinearly near a smooth minimum. */
 scc_gss_result scc_brent_minimize(double a, double b, double tol, int max_iter, scc_gss_fn* f, void* ctx);

@@ -71,6 +71,43 @@ START_TEST(test_brent_known_minima)
 }
 END_TEST
 
+/* |x - c| + h: 1-Lipschitz, minimum h at c. */
+static double vee_at(double x, void* c) { const double* k = c; return fabs(x - k[0]) + k[1]; }
+
+/* The gap-stopped search (FWGSS's temporal searches with fwgss_gap_tolerance): with slope = 2 x the
+ * Lipschitz bound it ends as soon as the bracket is narrower than half the smallest value over the
+ * bound, so the function stays above half that value on the final bracket: far from zero it
+ * stops early, near zero or below it it is the plain search, bit for bit. */
+START_TEST(test_gss_gap_stop)
+{
+    double k[2] = { 0.3, 0.1 }; /* minimum 0.1 at 0.3 */
+    scc_gss_result plain = scc_gss_minimize(0.0, 1.0, 1e-9, 200, vee_at, k);
+    scc_gss_result gap = scc_gss_minimize_gap(0.0, 1.0, 1e-9, 2.0, 200, vee_at, k);
+    ck_assert(gap.converged);
+    /* the bracket may stop at width <= 0.1 / 2 = 0.05: about log(0.05) / log(0.618) = 7 iterations, plus 5 */
+    ck_assert_int_le(gap.evals, 13);
+    ck_assert_int_lt(gap.evals, plain.evals);
+    ck_assert_double_near(gap.l, 0.3, 0.05);
+    ck_assert_double_ge(gap.f, 0.1); /* a sampled value: never below the true minimum */
+    /* The guarantee: anywhere within the stopping width of the returned point the function is
+     * above half the smallest sample (here: the minimum 0.1 is above 0.05). */
+    ck_assert_double_ge(vee_at(0.3, k), 0.5 * gap.f);
+    /* A function that reaches zero: no early stop, the same result as the plain search. */
+    k[1] = -0.01;
+    plain = scc_gss_minimize(0.0, 1.0, 1e-9, 200, vee_at, k);
+    gap = scc_gss_minimize_gap(0.0, 1.0, 1e-9, 2.0, 200, vee_at, k);
+    ck_assert_int_eq(gap.evals, plain.evals);
+    ck_assert_double_eq(gap.l, plain.l);
+    ck_assert_double_eq(gap.f, plain.f);
+    /* slope 0 is the plain search */
+    k[1] = 0.1;
+    plain = scc_gss_minimize(0.0, 1.0, 1e-9, 200, vee_at, k);
+    gap = scc_gss_minimize_gap(0.0, 1.0, 1e-9, 0.0, 200, vee_at, k);
+    ck_assert_int_eq(gap.evals, plain.evals);
+    ck_assert_double_eq(gap.l, plain.l);
+}
+END_TEST
+
 static scc_params default_params(void)
 {
     scc_params p = { 0 };
@@ -145,6 +182,7 @@ int main(void)
     TCase* g = tcase_create("gss");
     tcase_add_test(g, test_gss_known_minima);
     tcase_add_test(g, test_brent_known_minima);
+    tcase_add_test(g, test_gss_gap_stop);
     suite_add_tcase(s, g);
     TCase* d = tcase_create("dcd");
     tcase_add_test(d, test_dcd_deepest_vertex);

@@ -93,11 +93,13 @@ typedef struct sdfccd_QueryParams {
                                         query, 0 false negatives), but in test_sweep it misses one more case (2 of 982
                                         instead of 1) and leaves more cases unconverged; 0 = the paper's
                                         golden-section search. Default 0. */
-    double fwgss_gap_tolerance;    /**< FWGSS: a spatial line search stops at a tolerance of this fraction of the current
-                                        point's gap (phi - margin at the search's time) when that exceeds the spatial
-                                        tolerance: far from the surface a rough step serves as well, and the last
-                                        searches, at contact, keep the full precision. Finite, >= 0; 0 = always the
-                                        spatial tolerance. Default 0.5. */
+    double fwgss_gap_tolerance;    /**< FWGSS: far from the surface the line searches stop early, by this fraction g of the
+                                        gap (phi - margin): a spatial search at a tolerance of g x the current point's gap
+                                        when that exceeds the spatial tolerance, a temporal search (not in contact) once
+                                        its bracket is narrower than g x the smallest gap sampled / (Lipschitz bound x
+                                        speed bound), which cannot hide a contact of the searched path (phi stays above
+                                        (1 - g) x that gap on the bracket). Searches at contact keep the full precision.
+                                        Finite, >= 0; 0 = off. Default 0.5. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
