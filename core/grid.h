@@ -182,6 +182,12 @@ typedef struct scc_grid_build_def {
                                   known bound in culled cells). */
     scc_parallel_for_fn* parallel_for; /* NULL: serial */
     void* parallel_user;
+    uint64_t max_bytes;        /* > 0: limit on what a narrow-band build holds at once for its
+                                  nodes (corner values, candidate and final blocks, lists, cell
+                                  map); an allocation that would pass it is not made and the build
+                                  returns SCC_GRID_BUILD_OVER_LIMIT. 0: no limit */
+    uint64_t* needed_bytes;    /* may be NULL: with OVER_LIMIT, the total the refused allocation
+                                  would have reached */
 } scc_grid_build_def;
 
 typedef enum scc_grid_build_status {
@@ -190,7 +196,8 @@ typedef enum scc_grid_build_status {
     SCC_GRID_BUILD_TOO_LARGE,  /* node or cell count beyond 32-bit ids */
     SCC_GRID_BUILD_EMPTY_BAND, /* the band culled every cell */
     SCC_GRID_BUILD_BAD_VALUE,  /* the sample function returned NaN or infinity */
-    SCC_GRID_BUILD_CANCELLED
+    SCC_GRID_BUILD_CANCELLED,
+    SCC_GRID_BUILD_OVER_LIMIT  /* the band's node storage would pass def->max_bytes */
 } scc_grid_build_status;
 
 /* Builds a one-field grid (dense in Discregrid's layout, or narrow-band). */

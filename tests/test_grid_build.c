@@ -124,7 +124,7 @@ END_TEST
  * narrow band; the callback is not called again after it cancelled. */
 START_TEST(test_progress_cancels)
 {
-    sdfccd_MeshId mesh = test_load_mesh("bullet3/torus_textured.obj");
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/cube.obj");
     sdfccd_SdfId sphere;
     ck_assert_int_eq(sdfccd_create_sphere(0.5, &sphere), SDFCCD_OK);
     for (int threads = 1; threads <= 2; ++threads)
@@ -552,6 +552,118 @@ START_TEST(test_core_band_unknown_lipschitz)
 }
 END_TEST
 
+/* Peak of the library's allocations, through the allocator hooks. */
+typedef struct peak_counter { int64_t now, peak; } peak_counter;
+static void* peak_alloc(size_t n, void* user)
+{
+    peak_counter* c = user;
+    c->now += (int64_t)n;
+    if (c->now > c->peak) c->peak = c->now;
+    return malloc(n);
+}
+static void peak_free(void* p, size_t n, void* user)
+{
+    peak_counter* c = user;
+    c->now -= (int64_t)n;
+    free(p);
+}
+
+/* Issue 11 ("memory"): a narrow-band build never allocates the dense node array (8 bytes per node
+ * of the full grid); it used to sample that array first. The peak of everything the build
+ * allocates (mesh distance structure, scratch, the grid and its derived tables) stays below the
+ * dense array alone, while the dense build of the same grid does allocate at least that much,
+ * and the band grid still equals the dense one in every kept cell. */
+START_TEST(test_band_never_dense)
+{
+    peak_counter c = { 0, 0 };
+    ck_assert_int_eq(sdfccd_byte_count(), 0);
+    ck_assert_int_eq(sdfccd_set_allocator(peak_alloc, peak_free, &c), SDFCCD_OK);
+    /* an analytic sphere at 60 x 64 x 56, dense and band: the dense build is the control */
+    sdfccd_SdfId sphere;
+    ck_assert_int_eq(sdfccd_create_sphere(0.5, &sphere), SDFCCD_OK);
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = 60;
+    def.resolution[1] = 64;
+    def.resolution[2] = 56;
+    def.padding = 0.05;
+    def.threads = 2;
+    const uint32_t res[3] = { 60, 64, 56 };
+    const int64_t dense_array = 8 * (int64_t)scc_grid_dense_node_count(res);
+    sdfccd_SdfId g[2];
+    int64_t peak[2];
+    for (int band = 0; band < 2; ++band) {
+        def.band = band ? 0.004 : 0.0;
+        c.peak = c.now;
+        const int64_t before = c.now;
+        ck_assert_msg(sdfccd_create_grid_from_sdf(sphere, &def, &g[band]) == SDFCCD_OK, "%s", sdfccd_last_error());
+        peak[band] = c.peak - before;
+    }
+    fprintf(stderr, "sphere 60x64x56: dense node array %lld bytes; build peak dense %lld, band %lld\n", (long long)dense_array,
+            (long long)peak[0], (long long)peak[1]);
+    ck_assert_int_ge(peak[0], dense_array); /* the measurement sees the dense array */
+    ck_assert_int_lt(peak[1], dense_array); /* the band build never allocates it */
+    sdfccd_GridInfo di, bi;
+    ck_assert_int_eq(sdfccd_grid_get_info(g[0], &di), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_grid_get_info(g[1], &bi), SDFCCD_OK);
+    ck_assert_int_lt(bi.stored_cells, di.stored_cells / 4);
+    test_rng rng = { 77 };
+    int compared = 0;
+    for (int i = 0; i < 4000; ++i) {
+        sdfccd_Vec3 p = { test_rng_uniform(&rng, -0.6, 0.6), test_rng_uniform(&rng, -0.6, 0.6), test_rng_uniform(&rng, -0.6, 0.6) };
+        double vd, vb;
+        int32_t hd, hb;
+        ck_assert_int_eq(sdfccd_grid_interpolate(g[0], 0, p, &vd, NULL, &hd), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_grid_interpolate(g[1], 0, p, &vb, NULL, &hb), SDFCCD_OK);
+        if (!hb) continue;
+        ck_assert_int_eq(hd, 1);
+        ck_assert_double_eq(vb, vd); /* kept cells hold the dense grid's values */
+        ++compared;
+    }
+    ck_assert_int_gt(compared, 10);
+    ck_assert_int_eq(sdfccd_destroy_sdf(g[0]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(g[1]), SDFCCD_OK);
+
+    /* max_bytes on a band build: the builder refuses the allocation that would pass the limit and
+     * names the total it needed; with exactly that figure the step passes (the next may need
+     * more), and with one byte less the same step fails again. */
+    def.band = 0.004;
+    def.max_bytes = 12 * 61 * 65 * 57 + 8 * 60 * 64 * 56; /* passes the check made before sampling */
+    long long needed = 0;
+    sdfccd_Status st = SDFCCD_OK;
+    int steps = 0;
+    while ((st = sdfccd_create_grid_from_sdf(sphere, &def, &g[1])) == SDFCCD_OUT_OF_MEMORY) {
+        ck_assert_int_eq(sscanf(strstr(sdfccd_last_error(), "needs ") + 6, "%lld", &needed), 1);
+        ck_assert_int_gt(needed, def.max_bytes);
+        def.max_bytes = needed;
+        ck_assert_int_lt(++steps, 6);
+    }
+    ck_assert_int_eq(st, SDFCCD_OK);
+    ck_assert_int_ge(steps, 2); /* at least the candidate blocks and the final blocks were refused */
+    ck_assert_int_eq(sdfccd_destroy_sdf(g[1]), SDFCCD_OK);
+    def.max_bytes = needed - 1;
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(sphere, &def, &g[1]), SDFCCD_OUT_OF_MEMORY);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "node storage"));
+    def.max_bytes = (int64_t)4 << 30;
+    ck_assert_int_eq(sdfccd_destroy_sdf(sphere), SDFCCD_OK);
+
+    /* a mesh (the cube) at 128^3, band only: the peak includes the mesh distance structure */
+    sdfccd_MeshId mesh = test_load_mesh("bullet3/cube.obj");
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 128;
+    const uint32_t res128[3] = { 128, 128, 128 };
+    const int64_t dense128 = 8 * (int64_t)scc_grid_dense_node_count(res128);
+    def.band = 0.004;
+    c.peak = c.now;
+    const int64_t before = c.now;
+    ck_assert_msg(sdfccd_create_grid_from_mesh(mesh, &def, &g[1]) == SDFCCD_OK, "%s", sdfccd_last_error());
+    fprintf(stderr, "cube mesh 128^3: dense node array %lld bytes; band build peak %lld\n", (long long)dense128, (long long)(c.peak - before));
+    ck_assert_int_lt(c.peak - before, dense128);
+    ck_assert_int_eq(sdfccd_destroy_sdf(g[1]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(mesh), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_byte_count(), 0);
+    ck_assert_int_eq(sdfccd_set_allocator(NULL, NULL, NULL), SDFCCD_OK);
+}
+END_TEST
+
 typedef struct eval_job { sdfccd_SdfId grid; const sdfccd_Vec3* p; double* out; int n; } eval_job;
 static void* eval_thread(void* arg)
 {
@@ -719,6 +831,7 @@ int main(void)
     tcase_add_test(tc, test_mesh_import_formats);
     tcase_add_test(tc, test_bad_defs);
     tcase_add_test(tc, test_core_band_unknown_lipschitz);
+    tcase_add_test(tc, test_band_never_dense);
     tcase_add_test(tc, test_concurrent_eval);
     suite_add_tcase(s, tc);
     return test_run_suite(s);

@@ -161,11 +161,18 @@ static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
                              def->resolution[0], def->resolution[1], def->resolution[2]);
     if (def->max_bytes < 1) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: max_bytes = %lld must be >= 1", fn, (long long)def->max_bytes);
     {
+        /* Dense: 8 bytes per node and 8 per cell (map and cell bounds). Narrow band: what it holds
+         * whatever the band (12 bytes per grid vertex, 8 per cell); the band-dependent part is
+         * checked by the builder before each allocation (scc_grid_build_def::max_bytes). */
         const uint64_t nodes = scc_grid_dense_node_count((const uint32_t[3]){ (uint32_t)def->resolution[0], (uint32_t)def->resolution[1], (uint32_t)def->resolution[2] });
-        const double need = 8.0 * (double)nodes + 8.0 * (double)n;
+        const double vertices = ((double)def->resolution[0] + 1) * ((double)def->resolution[1] + 1) * ((double)def->resolution[2] + 1);
+        const int band = def->band > 0.0 && isfinite(def->band);
+        const double need = band ? 12.0 * vertices + 8.0 * (double)n : 8.0 * (double)nodes + 8.0 * (double)n;
         if (need > (double)def->max_bytes)
-            return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: a %d x %d x %d grid needs about %.4g bytes (nodes and cell tables), above max_bytes (%lld)",
-                                 fn, def->resolution[0], def->resolution[1], def->resolution[2], need, (long long)def->max_bytes);
+            return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: a %d x %d x %d %s grid needs about %.4g bytes (%s), above max_bytes (%lld)",
+                                 fn, def->resolution[0], def->resolution[1], def->resolution[2], band ? "narrow-band" : "dense", need,
+                                 band ? "vertex values and cell tables before the band is known" : "nodes and cell tables",
+                                 (long long)def->max_bytes);
     }
     if (!def->fit_domain) {
         if ((st = sdfccd__check_vec(def->domain.lo, "domain.lo")) || (st = sdfccd__check_vec(def->domain.hi, "domain.hi"))) return st;
@@ -204,6 +211,7 @@ static sdfccd_Status build_status(scc_grid_build_status st, const char* fn)
     case SCC_GRID_BUILD_EMPTY_BAND: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the band culled every cell (no surface inside the domain?)", fn);
     case SCC_GRID_BUILD_BAD_VALUE: return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the source returned a non-finite value or one above 1e100 in magnitude at a node", fn);
     case SCC_GRID_BUILD_CANCELLED: return sdfccd__error(SDFCCD_CANCELLED, "%s: cancelled by the progress callback", fn);
+    case SCC_GRID_BUILD_OVER_LIMIT: break; /* reported by the caller, which knows the figure */
     }
     return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: unknown build failure", fn);
 }
@@ -226,6 +234,15 @@ static void fill_build_def(scc_grid_build_def* bd, const sdfccd_GridDef* def, sc
     bd->band = def->band > 0.0 ? def->band : 0.0;
     bd->parallel_for = sdfccd__pool_parallel_for;
     bd->parallel_user = pool;
+    bd->max_bytes = (uint64_t)def->max_bytes;
+}
+
+/* The builder's status as the public one; OVER_LIMIT with the figure the builder reached. */
+static sdfccd_Status finish_build(scc_grid_build_status st, uint64_t needed, const sdfccd_GridDef* def, const char* fn)
+{
+    if (st != SCC_GRID_BUILD_OVER_LIMIT) return build_status(st, fn);
+    return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: the narrow band's node storage needs %llu bytes, above max_bytes (%lld)", fn,
+                         (unsigned long long)needed, (long long)def->max_bytes);
 }
 
 /* ---------------- build from a mesh ---------------- */
@@ -268,7 +285,10 @@ static sdfccd_Status create_grid_from_mesh_held(sdfccd_MeshId mesh, const sdfccd
     bd.sample_user = &ctx;
     bd.sample_lipschitz = 1.0; /* exact distance */
     scc_grid* g = NULL;
-    st = build_status(scc_grid_build(sdfccd__allocator(), &bd, &g), fn);
+    uint64_t needed = 0;
+    bd.needed_bytes = &needed;
+    const scc_grid_build_status bs = scc_grid_build(sdfccd__allocator(), &bd, &g);
+    st = finish_build(bs, needed, def, fn);
     scc_mesh_sdf_destroy(&ms);
     if (st) return st;
     return sdfccd__grid_register(g, out_grid);
@@ -316,7 +336,10 @@ static sdfccd_Status create_grid_from_sdf_held(sdfccd_SdfId sdf, const sdfccd_Gr
     bd.sample_user = &ctx;
     bd.sample_lipschitz = isfinite(s->sdf->lipschitz) && s->sdf->lipschitz > 0.0 ? s->sdf->lipschitz : 0.0;
     scc_grid* g = NULL;
-    st = build_status(scc_grid_build(sdfccd__allocator(), &bd, &g), fn);
+    uint64_t needed = 0;
+    bd.needed_bytes = &needed;
+    const scc_grid_build_status bs = scc_grid_build(sdfccd__allocator(), &bd, &g);
+    st = finish_build(bs, needed, def, fn);
     if (st) return st;
     return sdfccd__grid_register(g, out_grid);
 }

@@ -72,11 +72,15 @@ typedef struct sdfccd_GridDef {
     sdfccd_ProgressFcn* progress; /**< May be NULL. */
     void* progress_user;    /**< Passed to `progress`. */
     int32_t internal_value; /**< Set by sdfccd_default_grid_def(); do not change. */
-    /** Memory limit of the build (bytes, >= 1). Before allocating, the build computes what the dense
-     * node array and the per-cell tables need (8 bytes per node, 8 per cell) and returns
-     * ::SDFCCD_OUT_OF_MEMORY with that figure when it exceeds the limit (a 849^3 grid asked for
-     * 32.7 GB in one request). A narrow band still samples the dense array first, so the same
-     * figure applies to it. Default 4 GiB. */
+    /** Memory limit of the build (bytes, >= 1); over it the build returns ::SDFCCD_OUT_OF_MEMORY
+     * with the figure, before allocating (a 849^3 grid once asked for 32.7 GB in one request).
+     * Dense: checked first against the node array and the per-cell tables (8 bytes per node, 8 per
+     * cell). Narrow band: it never allocates the dense node array; checked first against what it
+     * needs whatever the band (12 bytes per grid vertex, 8 per cell), then before each allocation
+     * of its node storage (56 bytes per vertex of a cell near the surface, then per vertex of a
+     * kept cell) against the total it holds at that moment. Not counted: the source's own
+     * structures (a mesh's distance hierarchy) and the derived tables of the finished grid.
+     * Default 4 GiB. */
     int64_t max_bytes;
 } sdfccd_GridDef;
 
