@@ -164,6 +164,28 @@ static void band_free(band_scratch* b)
     scc_free(b->a, b->list, (size_t)b->listed * sizeof(uint32_t));
 }
 
+/* Visits the candidate cells (a corner below skip_at; every cell when skip_at is infinite) and
+ * marks their 8 corner vertices in b->vb (0), or (edges) their 24 edge nodes in b->cblocks
+ * (INFINITY). */
+static void mark_candidates(band_scratch* b, const uint32_t res[3], double skip_at, int edges)
+{
+    uint64_t cb[32];
+    for (uint32_t k = 0; k < res[2]; ++k)
+        for (uint32_t j = 0; j < res[1]; ++j)
+            for (uint32_t i = 0; i < res[0]; ++i) {
+                cell_blocks(res, i, j, k, cb);
+                if (isfinite(skip_at)) {
+                    double cmin = INFINITY;
+                    for (int s = 0; s < 8; ++s) cmin = fmin(cmin, fabs(b->corners[cb[s] / 7]));
+                    if (!(cmin < skip_at)) continue; /* NaN corner values fall through to sampling */
+                }
+                if (edges)
+                    for (int s = 8; s < 32; ++s) b->cblocks[band_slot(b->vb, cb[s])] = INFINITY;
+                else
+                    for (int s = 0; s < 8; ++s) b->vb[cb[s] / 7] = 0;
+            }
+}
+
 /* Narrow band without the dense node array. Sample the nv cell corners; a cell is a candidate
  * when a corner lies below skip_at (with a Lipschitz bound L an edge node lies within 2h/3 of a
  * corner of every cell using it, so when all 8 corners have |v| >= keep_below + L hmax none of
@@ -206,18 +228,7 @@ static scc_grid_build_status build_band(const scc_allocator* a, const scc_grid_b
     /* candidate cells -> candidate vertices (all 8 corners; every edge of a cell starts at one) */
     const double skip_at = lipschitz ? keep_below + def->sample_lipschitz * hmax : INFINITY;
     memset(b.vb, 0xFF, (size_t)b.nv * sizeof(uint32_t));
-    uint64_t cb[32];
-    for (uint32_t k = 0; k < res[2]; ++k)
-        for (uint32_t j = 0; j < res[1]; ++j)
-            for (uint32_t i = 0; i < res[0]; ++i) {
-                cell_blocks(res, i, j, k, cb);
-                if (lipschitz) {
-                    double cmin = INFINITY;
-                    for (int s = 0; s < 8; ++s) cmin = fmin(cmin, fabs(b.corners[cb[s] / 7]));
-                    if (!(cmin < skip_at)) continue; /* NaN corner values fall through to sampling */
-                }
-                for (int s = 0; s < 8; ++s) b.vb[cb[s] / 7] = 0; /* mark */
-            }
+    mark_candidates(&b, res, skip_at, 0);
     for (uint64_t v = 0; v < b.nv; ++v)
         if (b.vb[v] == 0) b.vb[v] = (uint32_t)b.ncand++;
     if (!band_reserve(&b, 56 * b.ncand)) { st = SCC_GRID_BUILD_OVER_LIMIT; goto done; }
@@ -227,17 +238,7 @@ static scc_grid_build_status build_band(const scc_allocator* a, const scc_grid_b
     for (uint64_t v = 0; v < b.nv; ++v)
         if (b.vb[v] != UINT32_MAX) b.cblocks[7 * (uint64_t)b.vb[v]] = b.corners[v];
     /* mark the edge nodes of candidate cells, list them in node order, sample them */
-    for (uint32_t k = 0; k < res[2]; ++k)
-        for (uint32_t j = 0; j < res[1]; ++j)
-            for (uint32_t i = 0; i < res[0]; ++i) {
-                cell_blocks(res, i, j, k, cb);
-                if (lipschitz) {
-                    double cmin = INFINITY;
-                    for (int s = 0; s < 8; ++s) cmin = fmin(cmin, fabs(b.corners[cb[s] / 7]));
-                    if (!(cmin < skip_at)) continue;
-                }
-                for (int s = 8; s < 32; ++s) b.cblocks[band_slot(b.vb, cb[s])] = INFINITY;
-            }
+    mark_candidates(&b, res, skip_at, 1);
     int bad_corner = 0;
     for (uint64_t v = 0; v < b.nv; ++v) bad_corner |= !(fabs(b.corners[v]) <= SCC_GRID_MAX_COORDINATE);
     scc_free(a, b.corners, (size_t)b.nv * sizeof(double));
@@ -260,6 +261,7 @@ static scc_grid_build_status build_band(const scc_allocator* a, const scc_grid_b
      * corners and the samples are exact distances). A cell with a vertex outside the candidates
      * has no sampled node below keep_below (its corners are at least skip_at) and is culled. */
     if (!band_reserve(&b, 4 * n_cells + b.ncand)) { st = SCC_GRID_BUILD_OVER_LIMIT; goto done; }
+    uint64_t cb[32];
     fd->map = scc_alloc(a, (size_t)n_cells * sizeof(uint32_t));
     b.used = b.ncand ? scc_alloc(a, (size_t)b.ncand) : NULL;
     if (!fd->map || (b.ncand && !b.used)) goto done;
