@@ -49,7 +49,7 @@ BulletWorld::BulletWorld(const btVector3& gravity, sdfccd_bullet::Bridge* bridge
     else btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
 }
 
-BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_axis, double patch_band, double hard_clamp)
+BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_axis, const BridgeSetup& setup)
     : m_opt(opt), m_gravity(gravity), m_up(up_axis)
 {
     up[0] = up[1] = up[2] = 0;
@@ -59,7 +59,9 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     cfg.query.method = opt.method;
     cfg.query.subdivision = opt.subdivision ? 1 : 0;
     if (opt.margin >= 0) cfg.contact_margin = opt.margin;
-    cfg.patch_band = std::isnan(opt.patch_band) ? patch_band : opt.patch_band;
+    cfg.patch_band = std::isnan(opt.patch_band) ? setup.patch_band : opt.patch_band;
+    const double sds = std::isnan(opt.spread_depth_scale) ? setup.spread_depth_scale : opt.spread_depth_scale;
+    if (sds >= 0) cfg.spread_depth_scale = sds;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
     if (m_bridge && cfg.patch_band >= 0) {
@@ -67,10 +69,15 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
         std::snprintf(buf, sizeof buf, " [patch manifold, band %g m]", cfg.patch_band);
         m_description += buf;
     }
-    const double clamp = std::isnan(opt.hard_clamp) ? hard_clamp : opt.hard_clamp;
+    const double clamp = std::isnan(opt.hard_clamp) ? setup.hard_clamp : opt.hard_clamp;
     if (m_bridge && clamp > 0) {
         char buf[96];
         std::snprintf(buf, sizeof buf, " [hard clamp %g m]", clamp);
+        m_description += buf;
+    }
+    if (m_bridge && sds >= 0) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, " [spread depth scale %g m]", sds);
         m_description += buf;
     }
     m_bullet.reset(new BulletWorld(gravity, m_bridge.get()));

@@ -36,11 +36,18 @@ struct BulletWorld {
     sdfccd_bullet::Status status = sdfccd_bullet::Status::Ok;
 };
 
+/** A scene's defaults of the bridge set-up, used where Options leaves them NaN (negative: the
+ * bridge's own default / off). */
+struct BridgeSetup {
+    double patch_band = -1;         /**< Config::patch_band. */
+    double hard_clamp = -1;         /**< Bridge::setHardClamp tolerance (<= 0: off). */
+    double spread_depth_scale = -1; /**< Config::spread_depth_scale. */
+};
+
 class BulletScene : public Scene {
 public:
-    /** `patch_band` and `hard_clamp`: the scene's defaults of the bridge's Config::patch_band and hard
-     * clamp tolerance (Bridge::setHardClamp; <= 0: off), used where Options leaves them NaN. */
-    BulletScene(const Options& opt, const btVector3& gravity, int up_axis, double patch_band = -1, double hard_clamp = -1);
+    /** `setup`: the scene's defaults of the bridge set-up (BridgeSetup). */
+    BulletScene(const Options& opt, const btVector3& gravity, int up_axis, const BridgeSetup& setup = BridgeSetup());
     ~BulletScene() override;
 
     void step(int i, double dt) override;

@@ -58,7 +58,19 @@ struct Measure {
     std::vector<double> body_min;                // per body
     std::vector<std::vector<double>> sample_phi; // per body, per sample (for snapshots)
     std::vector<char> tunnelled;                 // per body, this step
+    std::vector<std::array<double, 3>> centre;   // per body, after the last step (swept kill planes)
 };
+
+// Where each body's centre is now (before the first step: the swept kill planes' start).
+void recordCentres(const Scene& scene, Measure& m)
+{
+    m.centre.resize(scene.bodies.size());
+    std::vector<double> pts;
+    for (size_t bi = 0; bi < scene.bodies.size(); ++bi) {
+        worldSamples(scene.bodies[bi], pts);
+        m.centre[bi] = { pts[pts.size() - 3], pts[pts.size() - 2], pts[pts.size() - 1] };
+    }
+}
 
 void measure(Scene& scene, Measure& m)
 {
@@ -86,11 +98,30 @@ void measure(Scene& scene, Measure& m)
             c.frame.applyInverse(&pts[3 * (n - 1)], lc);
             // Past the kill plane counts only over the collider's footprint (a body that leaves a
             // floor over its edge and falls has not tunnelled).
-            bool over = true;
             const double blo[3] = { c.bounds.lo.x, c.bounds.lo.y, c.bounds.lo.z }, bhi[3] = { c.bounds.hi.x, c.bounds.hi.y, c.bounds.hi.z };
-            for (int k = 0; k < 3; ++k)
-                if (std::fabs(c.kill_normal[k]) < 0.5 && (lc[k] < blo[k] || lc[k] > bhi[k])) over = false;
-            if (over && dot3(&pts[3 * (n - 1)], c.kill_normal) > c.kill_offset) m.tunnelled[bi] = 1;
+            auto overFootprint = [&](const double* local) {
+                for (int k = 0; k < 3; ++k)
+                    if (std::fabs(c.kill_normal[k]) < 0.5 && (local[k] < blo[k] || local[k] > bhi[k])) return false;
+                return true;
+            };
+            const double* cur = &pts[3 * (n - 1)];
+            if (!c.kill_swept) {
+                if (overFootprint(lc) && dot3(cur, c.kill_normal) > c.kill_offset) m.tunnelled[bi] = 1;
+            } else if (bi < m.centre.size() && c.exact.index1) {
+                // The centre's path over the step, every 2 mm: deeper inside than the body's
+                // half-thickness anywhere on it = it went through.
+                const double* prev = m.centre[bi].data();
+                double d[3] = { cur[0] - prev[0], cur[1] - prev[1], cur[2] - prev[2] };
+                const int ns = (int)std::min(20000.0, std::ceil(std::sqrt(dot3(d, d)) / 0.002)) + 1;
+                for (int j = 0; j <= ns && !m.tunnelled[bi]; ++j) {
+                    double x[3], xl[3], phi = 1e300;
+                    for (int k = 0; k < 3; ++k) x[k] = prev[k] + d[k] * j / ns;
+                    c.frame.applyInverse(x, xl);
+                    if (sdfccd_sdf_eval(c.exact, sdfccd_Vec3{ xl[0], xl[1], xl[2] }, &phi, nullptr) == SDFCCD_OK &&
+                        phi < -b.mesh->half_thickness)
+                        m.tunnelled[bi] = 1;
+                }
+            }
             double reach = b.deformable ? 1e300 : b.mesh->radius;
             if (boxDistance(c.bounds, lc) > reach + 0.05) continue;
             owner.push_back(std::make_pair(bi, batch.size()));
@@ -148,6 +179,7 @@ void measure(Scene& scene, Measure& m)
     for (size_t bi = 0; bi < nb; ++bi)
         for (double p : m.sample_phi[bi])
             if (p < kDeepPhi) ++m.deep;
+    recordCentres(scene, m);
 }
 
 double speedBound(const Body& b, const std::vector<double>& prev_world, double dt)
@@ -253,6 +285,7 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
         std::fprintf(csv, "step,time,min_phi,deep_samples,contacts,ccd_ms,step_ms,ccd_queries,hits,energy,max_speed,tunnelled,"
                      "b0_x,b0_y,b0_z,b0_vx,b0_vy,b0_vz,b0_w,deepest_sample,deepest_x,deepest_y,deepest_z,min_phi_ccd_sdf\n");
     Measure m;
+    recordCentres(scene, m);
     std::vector<char> tunnelled(scene.bodies.size(), 0);
     int window = std::max(1, (int)std::lround(1.0 / cfg.dt));
     int window_start = std::max(0, cfg.steps - window);

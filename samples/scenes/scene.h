@@ -37,6 +37,8 @@ struct Options {
     double margin = -1;   /**< Contact margin (m) of the bridge / queries; < 0: the scene's default. */
     double patch_band = NAN; /**< Bullet scenes: the bridge's Config::patch_band (< 0: off; NaN: the scene's default,
                                   0.02 in the paper's rigid scenes, off in the Bullet re-creations). */
+    double spread_depth_scale = NAN; /**< Bullet scenes: the bridge's Config::spread_depth_scale (m); < 0: the bridge's
+                                          default (0.3); NaN: the scene's default (0.01 in the paper's rigid scenes). */
     int solver_iterations = -1; /**< Bullet scenes: btContactSolverInfo::m_numIterations; < 0: the scene's default. */
     double hard_clamp = NAN; /**< Bullet scenes: Bridge::setHardClamp with this tolerance (m); <= 0: off; NaN: the scene's
                                   default (0.5 mm in the paper's rigid scenes, off in the Bullet re-creations). */
@@ -119,6 +121,10 @@ struct Collider {
      * below a floor, or beyond a plate it was thrown at. Default: never. */
     double kill_normal[3] = { 0, 0, 0 };
     double kill_offset = 1e300;
+    /** Instead of the kill plane: a body whose centre's path over a step (sampled every 2 mm)
+     * passes deeper inside `exact` than the body's half-thickness went through it (a thin plate
+     * passed in one step, which a body may also fly around: the shuriken's breastplate). */
+    bool kill_swept = false;
     /** The SDF the CCD queries use (what the bridge's shape wraps); for Table 4's probe queries. */
     sdfccd_SdfId ccd{};
     /** Sets the kill plane to "centre below height h along up". */
