@@ -292,6 +292,11 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     sdfccd_QueryParams params = cfg.query;
     params.margin = margin;
 
+    // With SDFCCD_METHOD_DCD (the discrete baseline the scenes compare against) the main query
+    // runs first and alone decides whether the step has contact (the order before the start-pose
+    // query was moved first).
+    const bool continuous = params.method != SDFCCD_METHOD_DCD;
+
     // One query into `buf` (grown to the whole contact set, asked again when it was too small).
     auto run = [&](std::vector<sdfccd_Contact>& buf, const sdfccd_RigidMotion* s, const sdfccd_RigidMotion* m, double t1,
                    const sdfccd_QueryParams& p, sdfccd_QueryResult* r) {
@@ -321,6 +326,11 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         sdfccd_QueryParams dcd = params;
         dcd.method = SDFCCD_METHOD_DCD;
         dcd.margin = dcd_margin;
+        // Subdivision regions below (discrete_subdivision_scale x the mesh radius)^2 are not split:
+        // their points lie that close to the triangle's vertices, which are candidates already.
+        // (Not for the DCD baseline, which keeps the library's subdivision.)
+        const double sub = cfg.discrete_subdivision_scale * G.me->radius;
+        if (continuous && sub > 0) dcd.subdivision_min_area = std::max(dcd.subdivision_min_area, sub * sub);
         stats.end_pose_queries++;
         return run(buf, static_sdf ? nullptr : &s1, &m1, 0.0, dcd, r) == SDFCCD_OK;
     };
@@ -332,9 +342,6 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // margin means the step starts in contact: the CCD query would only report "penetrating at
     // t0" with the same features, so it is skipped (it costs as much as both discrete queries
     // together on a resting body). Otherwise (2) the CCD query over the step; no hit, no contact.
-    // With SDFCCD_METHOD_DCD (the discrete baseline the scenes compare against) the old order is
-    // kept: the main query decides alone whether the step has contact.
-    const bool continuous = params.method != SDFCCD_METHOD_DCD;
     sdfccd_QueryResult r0{};
     bool start_ran = false, start_ok = false, starts_touching = false;
     double start_margin = margin, travel = 0;

@@ -153,6 +153,14 @@ struct Config {
      * 25.8 mm to 4.9 mm. Off by default: the extra points make a dropped triangulated sphere roll
      * (test sdf_on_sdf) and change what the DCD baseline does in the hoop scene. Negative: off. */
     double patch_band = -1;
+    /** In the discrete queries (start and end pose), adaptive subdivision does not split regions
+     * smaller than (discrete_subdivision_scale x the mesh's radius)^2: such regions' points lie
+     * within about that distance of the triangle's vertices, which are contact candidates
+     * already. Large triangles (a bar's face across a torus's two tube tops) still give their
+     * interior contacts. Cuts the landscape's SDF evaluations per step by 2.5x (its 1,002-triangle
+     * tori are no longer subdivided) with the same penetration; the CCD query keeps the library's
+     * subdivision. 0: the library's subdivision_min_area everywhere. Default 0.1. */
+    double discrete_subdivision_scale = 0.1;
     /** Handle convex shapes (box, sphere, capsule, hulls...) against SdfShape with the same
      * CCD (box: its 12 triangles; others: their btShapeHull). Off: Bullet's convex-concave
      * algorithm against the shape's triangulation (no CCD). Default on. */
