@@ -46,11 +46,12 @@ public:
     ~MeshSdfAlgorithm() override
     {
         if (m_manifold && m_own) m_dispatcher->releaseManifold(m_manifold);
-        if (m_patch) {
-            // Its points never fire started/ended (the first manifold speaks for the pair).
-            for (int i = 0; i < m_patch->getNumContacts(); ++i) m_patch->clearUserCache(m_patch->getContactPoint(i));
-            m_patch->setNumContacts(0);
-            m_dispatcher->releaseManifold(m_patch);
+        for (btPersistentManifold* m : m_extra) {
+            if (!m) continue;
+            // Their points never fire started/ended (the first manifold speaks for the pair).
+            for (int i = 0; i < m->getNumContacts(); ++i) m->clearUserCache(m->getContactPoint(i));
+            m->setNumContacts(0);
+            m_dispatcher->releaseManifold(m);
         }
     }
 
@@ -67,10 +68,15 @@ public:
             m_manifold = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
             m_own = true;
         }
-        if (!m_patch && !m_closest && m_bridge->cfg.patch_band >= 0 && m_bridge->cfg.max_contacts >= MANIFOLD_CACHE_SIZE)
-            m_patch = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
+        btPersistentManifold* all[1 + kMaxExtra] = { m_manifold };
+        int count = 1;
+        if (!m_closest && m_bridge->cfg.max_contacts >= MANIFOLD_CACHE_SIZE)
+            for (int i = 0; i < m_bridge->cfg.extra_manifolds; ++i) {
+                if (!m_extra[i]) m_extra[i] = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
+                all[count++] = m_extra[i];
+            }
         resultOut->setPersistentManifold(m_manifold);
-        m_bridge->process(mw, sw, dispatchInfo, resultOut, m_manifold, m_patch, m_closest);
+        m_bridge->process(mw, sw, dispatchInfo, resultOut, all, count, m_closest);
     }
 
     btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1, const btDispatcherInfo& dispatchInfo,
@@ -83,13 +89,16 @@ public:
     void getAllContactManifolds(btManifoldArray& manifoldArray) override
     {
         if (m_manifold && m_own) manifoldArray.push_back(m_manifold);
-        if (m_patch) manifoldArray.push_back(m_patch);
+        for (btPersistentManifold* m : m_extra)
+            if (m) manifoldArray.push_back(m);
     }
+
+    static const int kMaxExtra = 3;
 
 private:
     BridgeImpl* m_bridge;
     btPersistentManifold* m_manifold;
-    btPersistentManifold* m_patch = nullptr; // the contact patch's 4 more points (Config::patch_band)
+    btPersistentManifold* m_extra[kMaxExtra] = { nullptr, nullptr, nullptr }; // Config::extra_manifolds
     bool m_own;
     bool m_mesh_is_body1;
     bool m_closest;
@@ -138,6 +147,9 @@ struct BridgeImpl::CreateFunc : public btCollisionAlgorithmCreateFunc {
 BridgeImpl::BridgeImpl(const Config& c) : cfg(c)
 {
     cfg.max_contacts = std::max(1, std::min(cfg.max_contacts, 4));
+    cfg.extra_manifolds = std::max(0, std::min(cfg.extra_manifolds, 3));
+    if (!(cfg.kick_angular_speed >= 0)) cfg.kick_angular_speed = 0;
+    if (!(cfg.cover_depth >= 0)) cfg.cover_depth = 0;
     if (!(cfg.contact_margin >= 0)) cfg.contact_margin = 0;
     if (!(cfg.vertex_distance >= 0)) cfg.vertex_distance = 0;
 }
@@ -302,7 +314,9 @@ Status Bridge::registerWith(btCollisionWorld* world)
             m_impl->isOurSdf(s))
             return Status::TooLate;
     }
-    return registerWith(d);
+    const Status s = registerWith(d);
+    if (s == Status::Ok) projectionAttach(m_impl, world);
+    return s;
 }
 
 Status Bridge::registerWith(btCollisionDispatcher* d)
@@ -432,6 +446,7 @@ void Bridge::unregister()
         d->registerCollisionCreateFunc(s.first, s.second, cc->getCollisionAlgorithmCreateFunc(s.first, s.second));
         d->registerClosestPointsCreateFunc(s.first, s.second, cc->getClosestPointsAlgorithmCreateFunc(s.first, s.second));
     }
+    projectionDetach(m_impl);
     std::lock_guard<std::mutex> lock(g_registry_mutex);
     g_registered.erase(d);
     m_impl->dispatcher = nullptr;

@@ -132,6 +132,49 @@ std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double t
     return out;
 }
 
+std::vector<int> coverContacts(const std::vector<Candidate>& c, const std::vector<int>& chosen, int limit, double slope,
+                               double depth, double tol)
+{
+    std::vector<int> out;
+    const int n = (int)c.size();
+    if (chosen.empty() || n == 0) return out;
+    // bound[i]: the smallest end gap candidate i is guaranteed by the points held so far (their
+    // gap plus the slope times the distance, among points of similar normal); +inf if none.
+    std::vector<double> bound(n, INFINITY);
+    std::vector<char> taken(n, 0);
+    const btScalar similar = btScalar(0.9);
+    auto hold = [&](int j) {
+        taken[j] = 1;
+        for (int i = 0; i < n; ++i) {
+            if (taken[i]) continue;
+            const double dist = (double)(c[i].pB0 - c[j].pB0).length();
+            if (dist <= tol) {
+                taken[i] = 1; // never two points at one place
+                continue;
+            }
+            if (c[i].n0.dot(c[j].n0) < similar) continue;
+            bound[i] = std::min(bound[i], c[j].d + slope * dist);
+        }
+    };
+    for (int j : chosen) hold(j);
+    while ((int)out.size() < limit) {
+        int pick = -1;
+        double worst = depth;
+        for (int i = 0; i < n; ++i) {
+            if (taken[i]) continue;
+            const double deficit = bound[i] - c[i].d; // how deep i may end while the held points stay out
+            if (deficit > worst || (pick >= 0 && deficit == worst && c[i].d < c[pick].d)) {
+                worst = deficit;
+                pick = i;
+            }
+        }
+        if (pick < 0) break;
+        out.push_back(pick);
+        hold(pick);
+    }
+    return out;
+}
+
 namespace {
 
 double seconds(std::chrono::steady_clock::time_point a)
@@ -257,7 +300,7 @@ struct Gatherer {
 using namespace detail;
 
 bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin,
-                        std::vector<Candidate>& cands, double* out_radius)
+                        std::vector<Candidate>& cands, double* out_radius, btVector3* out_w)
 {
     cands.clear();
     Gatherer G;
@@ -271,6 +314,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     if (out_radius) *out_radius = G.me->radius;
     G.M = motionOf(mw->getCollisionObject(), mw->getWorldTransform(), dt);
     G.S = motionOf(sw->getCollisionObject(), sw->getWorldTransform(), dt);
+    if (out_w) *out_w = G.M.w - G.S.w;
     // A static SDF (the usual case): work in its frame, so the library evaluates the field without
     // moving it (no pose per evaluation); the candidates go back to the world at the end.
     const bool static_sdf = G.S.v.isZero() && G.S.w.isZero() && G.S.t0 == G.S.t1;
@@ -297,6 +341,18 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // query was moved first).
     const bool continuous = params.method != SDFCCD_METHOD_DCD;
 
+    // The candidates back in the world frame, counted.
+    auto finish = [&]() {
+        stats.own_evaluations += G.evals;
+        if (static_sdf)
+            for (Candidate& c : cands) {
+                c.pA0 = sdf_world * c.pA0;
+                c.pB0 = sdf_world * c.pB0;
+                c.n0 = sdf_world.getBasis() * c.n0;
+            }
+        stats.candidates += (int64_t)cands.size();
+        return !cands.empty();
+    };
     // One query into `buf` (grown to the whole contact set, asked again when it was too small).
     auto run = [&](std::vector<sdfccd_Contact>& buf, const sdfccd_RigidMotion* s, const sdfccd_RigidMotion* m, double t1,
                    const sdfccd_QueryParams& p, sdfccd_QueryResult* r) {
@@ -344,11 +400,16 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // together on a resting body). Otherwise (2) the CCD query over the step; no hit, no contact.
     sdfccd_QueryResult r0{};
     bool start_ran = false, start_ok = false, starts_touching = false;
-    double start_margin = margin, travel = 0;
+    double start_margin = margin, travel = 0, kick = 0;
     if (dt > 0) {
         const double reach = G.me->radius + (double)(G.M.t0.getOrigin() - G.S.t0.getOrigin()).length();
         travel = dt * ((double)(G.M.v - G.S.v).length() + (double)G.M.w.length() * G.me->radius + (double)G.S.w.length() * reach);
-        start_margin = margin + travel;
+        // A kick (a velocity change from another contact solved in the same step, e.g. a body
+        // landing on this one) is not in the predicted motion: the start-pose query also reaches
+        // as far as kick_angular_speed about the body's centre carries its farthest point in the
+        // step, and its features count even when the predicted motion has no contact.
+        kick = dt * cfg.kick_angular_speed * G.me->radius;
+        start_margin = margin + travel + kick;
     }
     if (dt > 0 && continuous) {
         start_ran = true;
@@ -378,12 +439,17 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.last_state = (int)res.state;
         if (!res.hit) {
             stats.last_toi_fraction = 1;
+            // The predicted motion is clear: only a kick can bring the start pose's features in.
+            if (kick > 0 && start_ok && r0.hit) {
+                G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, start_margin);
+                return finish();
+            }
             return false;
         }
         stats.hits++;
         stats.last_toi_fraction = res.fraction;
         G.addContacts(contacts.data(), res.contact_count, margin + std::max(cfg.vertex_distance, params.contact_slop));
-        if (dt > 0 && !start_ran && (res.toi > 0 || travel > margin)) {
+        if (dt > 0 && !start_ran && (res.toi > 0 || travel + kick > margin)) {
             start_ran = true;
             start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0);
         }
@@ -404,49 +470,37 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         sdfccd_QueryResult r1;
         if (discrete(contacts, G.M.t1, G.S.t1, margin, &r1) && r1.hit) G.addPose(contacts.data(), r1.contact_count, G.M.t1, G.S.t1, margin);
     }
-    stats.own_evaluations += G.evals;
-    if (static_sdf)
-        for (Candidate& c : cands) {
-            c.pA0 = sdf_world * c.pA0;
-            c.pB0 = sdf_world * c.pB0;
-            c.n0 = sdf_world.getBasis() * c.n0;
-        }
-    stats.candidates += (int64_t)cands.size();
-    return !cands.empty();
+    return finish();
 }
 
 namespace {
 
-// Writes the candidates `pick` into `manifold` (A = mesh, B = SDF) the way btManifoldResult and
-// btPersistentManifold::refreshContactPoints do it: a point of the same material point as one of
-// the last step keeps its warm start and lifetime; added / processed callbacks fire for every
-// point, started when the manifold gains its first point (primary manifold only: the patch
-// manifold never fires started or ended, the first one speaks for the pair).
-void writeManifold(btPersistentManifold* manifold, const std::vector<Candidate>& cands, const std::vector<int>& pick,
-                   const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, bool primary, Stats& stats)
+// Writes the candidates `pick` into the pair's manifolds (A = mesh, B = SDF), 4 per manifold in
+// order, the way btManifoldResult and btPersistentManifold::refreshContactPoints do it: a point
+// of the same material point as one of the last step (in any of the pair's manifolds) keeps its
+// warm start and lifetime; added / processed callbacks fire for every point; started fires when
+// the first manifold gains its first point and ended when it empties (the first manifold speaks
+// for the pair: the others never fire started or ended).
+void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, const std::vector<Candidate>& cands,
+                    const std::vector<int>& pick, const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw,
+                    Stats& stats)
 {
+    const int per = (int)MANIFOLD_CACHE_SIZE;
     const btCollisionObject* mo = mw->getCollisionObject();
     const btCollisionObject* so = sw->getCollisionObject();
-    const int n_old = manifold->getNumContacts();
-    const int n = std::min((int)pick.size(), (int)MANIFOLD_CACHE_SIZE);
-    if (n == 0) {
-        if (primary) {
-            manifold->clearManifold(); // fires the contact-ended callback if it had points
-        } else {
-            for (int i = 0; i < n_old; ++i) manifold->clearUserCache(manifold->getContactPoint(i));
-            manifold->setNumContacts(0);
-        }
-        return;
-    }
-    // The new points, in the manifold's order (A = mesh, B = SDF) and its bodies' frames.
+    const int n = std::min((int)pick.size(), per * manifold_count);
+    // The last step's points of every manifold of the pair.
+    std::vector<btManifoldPoint> old;
+    std::vector<char> matched;
+    for (int m = 0; m < manifold_count; ++m)
+        for (int i = 0; i < manifolds[m]->getNumContacts(); ++i) old.push_back(manifolds[m]->getContactPoint(i));
+    matched.assign(old.size(), 0);
+    const int primary_old = manifolds[0]->getNumContacts();
+    const btScalar match = manifolds[0]->getContactBreakingThreshold();
     const btTransform& worldA = mo->getWorldTransform();
     const btTransform& worldB = so->getWorldTransform();
-    btManifoldPoint old[MANIFOLD_CACHE_SIZE];
-    for (int i = 0; i < n_old; ++i) old[i] = manifold->getContactPoint(i);
-    bool matched[MANIFOLD_CACHE_SIZE] = { false, false, false, false };
-    const btScalar match = manifold->getContactBreakingThreshold();
-    btManifoldPoint pts[MANIFOLD_CACHE_SIZE];
     const int flags = mo->getCollisionFlags() | so->getCollisionFlags();
+    std::vector<btManifoldPoint> pts((size_t)n);
     for (int k = 0; k < n; ++k) {
         const Candidate& c = cands[pick[k]];
         btManifoldPoint pt(worldA.invXform(c.pA0), worldB.invXform(c.pB0), c.n0, (btScalar)c.d);
@@ -470,15 +524,15 @@ void writeManifold(btPersistentManifold* manifold, const std::vector<Candidate>&
         // (btPersistentManifold::getCacheEntry / replaceContactPoint).
         int best = -1;
         btScalar best_d2 = match * match;
-        for (int j = 0; j < n_old; ++j) {
+        for (size_t j = 0; j < old.size(); ++j) {
             const btScalar d2 = (old[j].m_localPointA - pt.m_localPointA).length2();
             if (!matched[j] && d2 < best_d2) {
                 best_d2 = d2;
-                best = j;
+                best = (int)j;
             }
         }
         if (best >= 0) {
-            matched[best] = true;
+            matched[best] = 1;
             pt.m_appliedImpulse = old[best].m_appliedImpulse;
             pt.m_prevRHS = old[best].m_prevRHS;
             pt.m_appliedImpulseLateral1 = old[best].m_appliedImpulseLateral1;
@@ -490,46 +544,73 @@ void writeManifold(btPersistentManifold* manifold, const std::vector<Candidate>&
         if (c.speculative) stats.speculative_contacts++;
         else stats.ordinary_contacts++;
     }
-    // Points that did not persist are dropped as refreshContactPoints drops them; the manifold
-    // never passes through 0 points here, so there is no ended callback while contact goes on.
-    manifold->setNumContacts(n);
-    for (int k = 0; k < n; ++k) manifold->getContactPoint(k) = pts[k];
-    if (gContactAddedCallback && (flags & btCollisionObject::CF_CUSTOM_MATERIAL_CALLBACK))
-        for (int k = 0; k < n; ++k)
-            gContactAddedCallback(manifold->getContactPoint(k), mw, pts[k].m_partId0, pts[k].m_index0, sw, pts[k].m_partId1,
-                                  pts[k].m_index1);
-    if (primary && gContactStartedCallback && n_old == 0) gContactStartedCallback(manifold);
-    if (gContactProcessedCallback)
-        for (int k = 0; k < n; ++k)
-            gContactProcessedCallback(manifold->getContactPoint(k), (void*)manifold->getBody0(), (void*)manifold->getBody1());
+    // Points that did not persist are dropped as refreshContactPoints drops them (their user data
+    // released through the contact-destroyed callback).
+    size_t o = 0;
+    for (int m = 0; m < manifold_count; ++m)
+        for (int i = 0; i < manifolds[m]->getNumContacts(); ++i, ++o)
+            if (!matched[o] && n > 0) manifolds[m]->clearUserCache(manifolds[m]->getContactPoint(i));
+    if (n == 0) manifolds[0]->clearManifold(); // fires the contact-ended callback if it had points
+    for (int m = n == 0 ? 1 : 0; m < manifold_count; ++m) {
+        btPersistentManifold* manifold = manifolds[m];
+        const int lo = std::min(n, m * per), hi = std::min(n, lo + per);
+        // The first manifold never passes through 0 points while contact goes on, so there is
+        // no ended callback then.
+        if (n == 0)
+            for (int i = 0; i < manifold->getNumContacts(); ++i) manifold->clearUserCache(manifold->getContactPoint(i));
+        manifold->setNumContacts(hi - lo);
+        for (int k = lo; k < hi; ++k) manifold->getContactPoint(k - lo) = pts[k];
+        if (gContactAddedCallback && (flags & btCollisionObject::CF_CUSTOM_MATERIAL_CALLBACK))
+            for (int k = lo; k < hi; ++k) {
+                const btManifoldPoint& p = pts[k];
+                gContactAddedCallback(manifold->getContactPoint(k - lo), mw, p.m_partId0, p.m_index0, sw, p.m_partId1, p.m_index1);
+            }
+        if (m == 0 && gContactStartedCallback && primary_old == 0 && hi > lo) gContactStartedCallback(manifold);
+        if (gContactProcessedCallback)
+            for (int k = lo; k < hi; ++k)
+                gContactProcessedCallback(manifold->getContactPoint(k - lo), (void*)manifold->getBody0(), (void*)manifold->getBody1());
+    }
 }
 
 } // namespace
 
 void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
-                         btManifoldResult* out, btPersistentManifold* manifold, btPersistentManifold* patch, bool closest)
+                         btManifoldResult* out, btPersistentManifold* const* manifolds, int manifold_count, bool closest)
 {
     const btCollisionObject* mo = mw->getCollisionObject();
     const btCollisionObject* so = sw->getCollisionObject();
     const double dt = closest ? 0.0 : (double)info.m_timeStep;
     const double margin = closest ? std::max(0.0, (double)out->m_closestPointDistanceThreshold) : cfg.contact_margin;
-    if (!closest && clamp_world) {
+    double radius = 0;
+    btVector3 w(0, 0, 0);
+    const bool any = gather(mw, sw, dt, margin, scratch, &radius, &w);
+    // The clamp and the projection look at pairs with candidates (a body farther from the SDF
+    // than its travel and kick reach cannot end the step inside it).
+    if (!closest && any && (clamp_world || projection_world)) {
         PairRecord r;
         r.mesh = mo;
         r.sdf = so;
+        r.start = mo->getWorldTransform();
         r.child = mo->getWorldTransform().inverseTimes(mw->getWorldTransform());
         r.shape = mw->getCollisionShape();
+        r.top = mo->getCollisionShape();
         pairs.push_back(r);
     }
-    double radius = 0;
-    const bool any = gather(mw, sw, dt, margin, scratch, &radius);
     const double tol = std::max(1e-6, 1e-3 * radius);
     std::vector<int> pick;
     if (any) pick = reduceContacts(scratch, cfg.max_contacts, tol, cfg.spread_depth_scale, -1);
-    // The contact patch: the candidates within patch_band of the deepest gap that are not within
-    // tol of a point already picked, spread over 4 more points.
-    std::vector<int> pick2;
-    if (any && patch && cfg.patch_band >= 0 && !pick.empty()) {
+    if (closest) {
+        for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
+        return;
+    }
+    // More points where the first ones leave the body free to sink: every candidate that could end
+    // deeper than cover_depth while the points held so far stay out, for any rotation of the body
+    // (relative to the SDF) about an axis in the contact plane up to its angular speed plus
+    // kick_angular_speed during the step (a kick from another contact solved in the same step).
+    const int extra_limit = (manifold_count - 1) * (int)MANIFOLD_CACHE_SIZE;
+    if (any && !pick.empty() && extra_limit > 0 && cfg.patch_band >= 0) {
+        // The older rule (Config::patch_band): up to 4 points spread over the candidates within
+        // the band of the deepest gap that are not within tol of a point already picked.
         const double d0 = scratch[pick[0]].d;
         std::vector<Candidate> sub;
         std::vector<int> from;
@@ -541,14 +622,14 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
             sub.push_back(scratch[i]);
             from.push_back(i);
         }
-        for (int i : reduceContacts(sub, (int)MANIFOLD_CACHE_SIZE, tol, cfg.spread_depth_scale, -1)) pick2.push_back(from[i]);
+        for (int i : reduceContacts(sub, (int)MANIFOLD_CACHE_SIZE, tol, cfg.spread_depth_scale, -1)) pick.push_back(from[i]);
+    } else if (any && !pick.empty() && extra_limit > 0) {
+        const btVector3& n = scratch[pick[0]].n0;
+        const double w_tilt = (double)(w - n * n.dot(w)).length();
+        const double slope = dt * (w_tilt + cfg.kick_angular_speed);
+        for (int i : coverContacts(scratch, pick, extra_limit, slope, cfg.cover_depth, tol)) pick.push_back(i);
     }
-    if (closest) {
-        for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
-        return;
-    }
-    writeManifold(manifold, scratch, pick, mw, sw, true, stats);
-    if (patch) writeManifold(patch, scratch, pick2, mw, sw, false, stats);
+    writeManifolds(manifolds, manifold_count, scratch, pick, mw, sw, stats);
 }
 
 double BridgeImpl::timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt)

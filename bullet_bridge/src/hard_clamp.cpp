@@ -9,6 +9,7 @@
 #include "internal.h"
 
 #include <mutex>
+#include <unordered_set>
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
@@ -53,66 +54,106 @@ void clampPostTick(btDynamicsWorld* world, btScalar dt)
 
 using namespace detail;
 
-void BridgeImpl::clampPre(btDynamicsWorld* world)
+void BridgeImpl::clampPre(btDynamicsWorld*) { pairs.clear(); }
+
+void BridgeImpl::clampPost(btDynamicsWorld* world, double dt)
 {
-    starts.clear();
+    stats.clamps += projectPairs(world, dt, clamp_tolerance);
     pairs.clear();
-    const btCollisionObjectArray& objs = world->getCollisionObjectArray();
-    for (int i = 0; i < objs.size(); ++i) {
-        const btCollisionObject* o = objs[i];
-        if (!o->isStaticOrKinematicObject()) starts[o] = o->getWorldTransform();
-    }
 }
 
-void BridgeImpl::clampPost(btDynamicsWorld*, double dt)
+int BridgeImpl::projectPairs(btCollisionWorld* world, double dt, double tolerance)
 {
+    (void)dt;
+    // Records from a collision pass whose objects have left the world since are skipped.
+    std::unordered_set<const btCollisionObject*> alive;
+    const btCollisionObjectArray& objs = world->getCollisionObjectArray();
+    for (int i = 0; i < objs.size(); ++i) alive.insert(objs[i]);
+    int moved = 0;
+    std::vector<sdfccd_Contact> cs(64);
     for (const PairRecord& p : pairs) {
-        auto it = starts.find(p.mesh);
-        if (it == starts.end()) continue;
+        if (!alive.count(p.mesh) || !alive.count(p.sdf) || p.mesh->getCollisionShape() != p.top) continue;
         btRigidBody* body = const_cast<btRigidBody*>(btRigidBody::upcast(p.mesh));
-        if (!body) continue;
+        if (!body || body->isStaticOrKinematicObject()) continue;
         const MeshEntry* me = shapes.meshFor(p.shape);
         sdfccd_SdfId sdf = shapes.sdfFor(p.sdf->getCollisionShape(), cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
         if (!me || !sdf.index1) continue;
         sdfccd_RigidMotion sm = sdfccd_default_rigid_motion();
         sm.pose = toPose(p.sdf->getWorldTransform());
-        // 1. Does the end pose penetrate deeper than the tolerance?
-        sdfccd_RigidMotion end = sdfccd_default_rigid_motion();
-        end.pose = toPose(body->getWorldTransform() * p.child);
         sdfccd_QueryParams params = cfg.query;
-        params.margin = -clamp_tolerance;
-        sdfccd_QueryResult res;
-        if (sdfccd_query_mesh(sdf, &sm, me->id, &end, 0, 0, &params, nullptr, 0, &res) != SDFCCD_OK || !res.hit) continue;
-        // 2. Back to where the penetration was half the tolerance along the step's motion (or
-        //    the tolerance itself if the step began deeper); a body that started the step that
-        //    deep is left to the ordinary contacts.
-        BodyMotion M;
-        M.t0 = it->second * p.child;
-        M.t1 = body->getWorldTransform() * p.child;
-        btTransformUtil::calculateVelocity(M.t0, M.t1, (btScalar)dt, M.v, M.w);
-        sdfccd_RigidMotion mm = M.rigid();
-        sdfccd_Contact c[4];
-        bool found = false;
-        const double margins[2] = { -0.5 * clamp_tolerance, -clamp_tolerance };
-        for (double mg : margins) {
-            params.margin = mg;
-            sdfccd_Status cst = sdfccd_query_mesh(sdf, &sm, me->id, &mm, 0, dt, &params, c, 4, &res);
-            if (cst == SDFCCD_OK && res.hit && res.state != SDFCCD_STATE_PENETRATING) {
-                found = true;
-                break;
-            }
+        params.method = SDFCCD_METHOD_DCD;
+        params.margin = -tolerance;
+        // The deepest feature of the mesh at pose `t` deeper than the tolerance (false if none).
+        auto deepest = [&](const btTransform& t, sdfccd_Contact* out) {
+            sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+            m.pose = toPose(t * p.child);
+            sdfccd_QueryResult res;
+            if (sdfccd_query_mesh(sdf, &sm, me->id, &m, 0, 0, &params, cs.data(), (int32_t)cs.size(), &res) != SDFCCD_OK || !res.hit ||
+                res.contact_count <= 0)
+                return false;
+            int k = 0;
+            for (int i = 1; i < res.contact_count; ++i)
+                if (cs[i].distance < cs[k].distance) k = i;
+            if (out) *out = cs[k];
+            return true;
+        };
+        sdfccd_Contact c;
+        if (!deepest(body->getWorldTransform(), &c)) continue;
+        // A body that started the step that deep is left to the contacts (no jump out of a deep
+        // start, e.g. a body created inside the SDF).
+        if (deepest(p.start, nullptr)) continue;
+        // Out along the deepest feature's normal to half the tolerance, like a positional (split
+        // impulse) correction: the velocity is left to the contacts.
+        for (int it = 0; it < 3; ++it) {
+            btTransform t = body->getWorldTransform();
+            t.setOrigin(t.getOrigin() + bt(c.normal) * (btScalar)(-c.distance - 0.5 * tolerance));
+            body->setCenterOfMassTransform(t);
+            if (!deepest(t, &c)) break;
         }
-        if (!found) continue;
-        body->setCenterOfMassTransform(M.at(res.toi) * p.child.inverse());
-        if (res.contact_count > 0) {
-            btVector3 nrm = bt(c[0].normal);
-            btVector3 v = body->getLinearVelocity();
-            btScalar vn = v.dot(nrm);
-            if (vn < 0) body->setLinearVelocity(v - nrm * vn);
-        }
-        stats.clamps++;
+        ++moved;
     }
+    return moved;
 }
+
+namespace detail {
+
+// The end-of-step projection: Bullet calls actions after it integrates the step (before it
+// synchronises motion states), so this sees each body's final pose of the step.
+class ProjectionAction : public btActionInterface
+{
+public:
+    explicit ProjectionAction(BridgeImpl* b) : m_bridge(b) {}
+    void updateAction(btCollisionWorld* world, btScalar dt) override
+    {
+        // The hard clamp, when on, does the same after the step with its own tolerance.
+        if (!m_bridge->clamp_world) {
+            m_bridge->stats.projections += m_bridge->projectPairs(world, (double)dt, m_bridge->cfg.projection_tolerance);
+            m_bridge->pairs.clear();
+        }
+    }
+    void debugDraw(btIDebugDraw*) override {}
+
+private:
+    BridgeImpl* m_bridge;
+};
+
+void projectionAttach(BridgeImpl* impl, btCollisionWorld* world)
+{
+    btDynamicsWorld* dw = dynamic_cast<btDynamicsWorld*>(world);
+    if (!dw || !(impl->cfg.projection_tolerance > 0) || impl->projection_world) return;
+    impl->projection.reset(new ProjectionAction(impl));
+    dw->addAction(impl->projection.get());
+    impl->projection_world = dw;
+}
+
+void projectionDetach(BridgeImpl* impl)
+{
+    if (impl->projection_world && impl->projection) impl->projection_world->removeAction(impl->projection.get());
+    impl->projection_world = nullptr;
+    impl->pairs.clear();
+}
+
+} // namespace detail
 
 Status Bridge::setHardClamp(btDiscreteDynamicsWorld* world, bool on, double tolerance)
 {
@@ -148,7 +189,6 @@ Status Bridge::setHardClamp(btDiscreteDynamicsWorld* world, bool on, double tole
         m_impl->clamp_world = nullptr;
         m_impl->user_pre = m_impl->user_post = nullptr;
         m_impl->pairs.clear();
-        m_impl->starts.clear();
     }
     return Status::Ok;
 }

@@ -3,9 +3,10 @@
 //   shape_cache.cpp    Bullet shapes -> sdfccd meshes (GImpact, convex hulls, SDF triangulations)
 //                      and SDF handles (SdfShape, btSdfCollisionShape)
 //   contact_policy.cpp the queries of one pair and step, the contact set, its reduction to the
-//                      manifold's 4 points, and writing them with Bullet's callbacks
+//                      manifolds' points, and writing them with Bullet's callbacks
 //   algorithm.cpp      the collision algorithm, its create functions, registration, check()
-//   hard_clamp.cpp     the optional post-step clamp (chained internal tick callbacks)
+//   hard_clamp.cpp     the end-of-step projection (an action) and the optional hard clamp (chained
+//                      internal tick callbacks), one correction
 #ifndef SDFCCD_BULLET_INTERNAL_H
 #define SDFCCD_BULLET_INTERNAL_H
 
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include <btBulletDynamicsCommon.h>
+#include <BulletDynamics/Dynamics/btActionInterface.h>
 #include <BulletCollision/CollisionDispatch/btCollisionObjectWrapper.h>
 #include <BulletCollision/CollisionShapes/btSdfCollisionShape.h>
 #include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
@@ -107,6 +109,15 @@ struct Candidate {
  * Ties go to the smaller gap, then to the lower index: deterministic for a given input. */
 std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, double band);
 
+/** More points after `chosen` (at most `limit`), where the points held so far leave the body
+ * free to sink: a candidate's end gap is bounded below by d_i - min_j (d_j + slope * |pB_i - pB_j|)
+ * over held points j of similar normal (the gap change of a rigid body turning by at most `slope`
+ * radians in the step about an axis in the contact plane, with each held point ending out of
+ * the surface). The candidate with the largest possible depth beyond `depth` is held next (ties:
+ * the smaller gap, then the lower index), until none is left. Never two points within `tol`. */
+std::vector<int> coverContacts(const std::vector<Candidate>& c, const std::vector<int>& chosen, int limit, double slope,
+                               double depth, double tol);
+
 class MeshSdfAlgorithm;
 
 Status clampCheck(const BridgeImpl* impl, const btCollisionWorld* world);
@@ -118,6 +129,10 @@ bool isGImpactCallback(const btTriangleCallback* callback);
  * handler unless the diagnosis equals the last one reported for the shape (`last_reported`:
  * 0 = none, else the Status + 1; updated). */
 void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported);
+// The end-of-step projection's action (Config::projection_tolerance): added to a dynamics world
+// at registration, removed by unregister().
+void projectionAttach(BridgeImpl* impl, btCollisionWorld* world);
+void projectionDetach(BridgeImpl* impl);
 void clampForget(BridgeImpl* impl);
 
 } // namespace detail
@@ -135,9 +150,11 @@ public:
 
     // contact_policy.cpp
     bool gather(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin,
-                std::vector<detail::Candidate>& cands, double* out_radius);
+                std::vector<detail::Candidate>& cands, double* out_radius, btVector3* out_w);
+    // Writes the pair's points into manifolds[0..manifold_count) (4 each; the first one is the
+    // pair's primary manifold, which fires started/ended).
     void process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
-                 btManifoldResult* out, btPersistentManifold* manifold, btPersistentManifold* patch, bool closest);
+                 btManifoldResult* out, btPersistentManifold* const* manifolds, int manifold_count, bool closest);
     double timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt);
 
     // hard_clamp.cpp
@@ -151,9 +168,21 @@ public:
     btDiscreteDynamicsWorld* clamp_world = nullptr;
     btInternalTickCallback user_pre = nullptr, user_post = nullptr; // chained by the clamp
     double clamp_tolerance = 1e-3;
-    struct PairRecord { const btCollisionObject* mesh; const btCollisionObject* sdf; btTransform child; const btCollisionShape* shape; };
-    std::unordered_map<const btCollisionObject*, btTransform> starts;
+    // The pairs of the step, for the clamp and the projection: the mesh body's pose at the start
+    // of the step, the wrapper's offset in it (compound child), the shapes.
+    struct PairRecord {
+        const btCollisionObject* mesh;
+        const btCollisionObject* sdf;
+        btTransform start, child;
+        const btCollisionShape* shape;
+        const btCollisionShape* top;
+    };
     std::vector<PairRecord> pairs;
+    // Moves bodies of the recorded pairs that end the step deeper than `tolerance` back out; returns
+    // how many it moved. Only objects still in `world` are touched.
+    int projectPairs(btCollisionWorld* world, double dt, double tolerance);
+    btDynamicsWorld* projection_world = nullptr;
+    std::unique_ptr<btActionInterface> projection;
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
     std::vector<sdfccd_Contact> contacts, start_contacts;

@@ -62,6 +62,12 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     cfg.patch_band = std::isnan(opt.patch_band) ? setup.patch_band : opt.patch_band;
     const double sds = std::isnan(opt.spread_depth_scale) ? setup.spread_depth_scale : opt.spread_depth_scale;
     if (sds >= 0) cfg.spread_depth_scale = sds;
+    // --patch-band -1 (B < 0 given) is Bullet's single 4-point manifold: no extra points either.
+    if (!std::isnan(opt.patch_band) && opt.patch_band < 0) cfg.extra_manifolds = 0;
+    if (opt.extra_manifolds >= 0) cfg.extra_manifolds = opt.extra_manifolds;
+    if (opt.kick >= 0) cfg.kick_angular_speed = opt.kick;
+    if (opt.cover_depth >= 0) cfg.cover_depth = opt.cover_depth;
+    if (opt.projection >= 0) cfg.projection_tolerance = opt.projection;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
     if (m_bridge && cfg.patch_band >= 0) {

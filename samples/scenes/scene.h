@@ -42,6 +42,10 @@ struct Options {
     int solver_iterations = -1; /**< Bullet scenes: btContactSolverInfo::m_numIterations; < 0: the scene's default. */
     double hard_clamp = NAN; /**< Bullet scenes: Bridge::setHardClamp with this tolerance (m); <= 0: off; NaN: the scene's
                                   default (0.5 mm in the paper's rigid scenes, off in the Bullet re-creations). */
+    int extra_manifolds = -1;   /**< Bullet scenes: the bridge's Config::extra_manifolds (< 0: its default). */
+    double kick = -1;           /**< Bullet scenes: the bridge's Config::kick_angular_speed (< 0: its default). */
+    double cover_depth = -1;    /**< Bullet scenes: the bridge's Config::cover_depth (< 0: its default). */
+    double projection = -1;     /**< Bullet scenes: the bridge's Config::projection_tolerance (< 0: its default; 0: off). */
     std::string data_dir; /**< The project's data/ folder. */
 };
 

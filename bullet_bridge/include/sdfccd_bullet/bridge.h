@@ -144,14 +144,29 @@ struct Config {
      * exp(-(its gap - the deepest gap) / spread_depth_scale): points about to touch are preferred
      * to features that might only reach the surface late in the step. Default 0.3 m. */
     double spread_depth_scale = 0.3;
-    /** Opt-in: a second manifold per pair holds up to 4 more points, spread among the candidates
-     * within this distance (m) of the deepest gap that the first 4 points leave out (the contact
-     * patch around the deepest point). The first 4 points span the whole candidate set, far
-     * speculative points included, so a body tipping flat has ONE point in its patch, pivots
-     * about it and the rest of the patch sinks (gimpact-demo: a torus tipping flat went 0.8 cm ->
-     * 5.4 cm deep in 4 steps with nothing else touching it). 0.02 cuts gimpact-demo --quick from
-     * 25.8 mm to 4.9 mm. Off by default: the extra points make a dropped triangulated sphere roll
-     * (test sdf_on_sdf) and change what the DCD baseline does in the hoop scene. Negative: off. */
+    /** Extra manifolds per pair (0..3), for up to 4 more points each. The first 4 points (the
+     * deepest and the points spreading the contact polygon) span the whole candidate set, far
+     * speculative points included, so a body tipping flat can have ONE point in its contact patch,
+     * pivot about it and sink the rest of the patch. The extra points go where the held points
+     * still leave the body free to sink: the candidate that could end deepest, for any rotation
+     * about an axis in the contact plane up to the body's angular speed (relative to the SDF) plus
+     * kick_angular_speed, while every held point ends out of the surface, is held next, until no
+     * candidate could end deeper than cover_depth (see contact_policy.cpp). Default 3. */
+    int extra_manifolds = 3;
+    /** Angular speed (rad/s) a body may gain within a step from contacts solved with it (another
+     * body landing on it, a mesh-mesh pair) on top of its own. It widens the extra points' bound
+     * and the start-pose query's reach (kick_angular_speed x the mesh's radius x dt), and that
+     * query then also runs in steps whose predicted motion has no contact. Default 0: with the
+     * end-of-step projection it changes no penetration figure of the Bullet re-creations, and
+     * 1 rad/s costs the landscape scene about 30% more per step (more queries and candidates);
+     * it lets piles settle sooner (gimpact-demo: rest speed over the last second 0.06 -> 0 m/s). */
+    double kick_angular_speed = 0.0;
+    /** Depth (m) a candidate may reach, under that bound, without being held. Default 0.002. */
+    double cover_depth = 0.002;
+    /** Opt-in (negative: off, the default): the older rule for the extra points, used instead of
+     * the one above: ONE extra manifold with up to 4 points spread over the candidates within
+     * this distance (m) of the deepest gap that the first 4 points leave out (the contact patch
+     * around the deepest point). The paper's rigid scenes (samples/scenes) use 0.02. */
     double patch_band = -1;
     /** In the discrete queries (start and end pose), adaptive subdivision does not split regions
      * smaller than (discrete_subdivision_scale x the mesh's radius)^2: such regions' points lie
@@ -161,6 +176,17 @@ struct Config {
      * tori are no longer subdivided) with the same penetration; the CCD query keeps the library's
      * subdivision. 0: the library's subdivision_min_area everywhere. Default 0.1. */
     double discrete_subdivision_scale = 0.1;
+    /** End-of-step projection (m; <= 0: off). When the bridge is registered with a dynamics world
+     * (registerWith(btCollisionWorld*)), it adds an action (btActionInterface, run after Bullet
+     * integrates the step) that moves a mesh body ending the step deeper than this in an SDF back
+     * along the step's motion to where it was half as deep, and removes its velocity into the
+     * surface. The contacts hold the surface in Bullet's velocity solve, but Bullet's split-impulse
+     * position pass (on by default) only solves contacts deeper than the world's
+     * m_splitImpulsePenetrationThreshold (-0.04 m): a deep contact between two GImpact meshes
+     * there pushes a body into the SDF with nothing resisting (gimpact-demo: 18 mm with
+     * m_splitImpulse on, 8 mm with it off, 5.6 mm with this projection). A body that starts the
+     * step deeper is left to the contacts. Costs one discrete query per pair and step. Default 0.002. */
+    double projection_tolerance = 0.002;
     /** Handle convex shapes (box, sphere, capsule, hulls...) against SdfShape with the same
      * CCD (box: its 12 triangles; others: their btShapeHull). Off: Bullet's convex-concave
      * algorithm against the shape's triangulation (no CCD). Default on. */
@@ -196,6 +222,7 @@ struct Stats {
     int64_t query_errors = 0;          /**< Queries that failed or had no mesh/SDF to work with (no contacts written). */
     int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
     int64_t clamps = 0;                /**< Hard-clamp corrections. */
+    int64_t projections = 0;           /**< End-of-step projections (Config::projection_tolerance). */
     double last_toi_fraction = 1;      /**< Fraction of the last hit (1 when none). */
     int last_state = 0;                /**< sdfccd_ResultState of the last query. */
 };
@@ -250,10 +277,12 @@ public:
     Status check(btCollisionWorld* world, std::string* message = nullptr) const;
 
     /** Restores the dispatcher's slots to the collision configuration's defaults (note: this also
-     * drops GImpact's registration for those pairs) and forgets the dispatcher. */
+     * drops GImpact's registration for those pairs), removes the end-of-step projection's action
+     * from the world and forgets the dispatcher. */
     void unregister();
 
-    /** Optional hard clamp (off by default). With it on, internal pre- and post-tick callbacks
+    /** Optional hard clamp (off by default; while it is on it replaces the end-of-step
+     * projection, see Config::projection_tolerance, with its own tolerance). With it on, internal pre- and post-tick callbacks
      * of `world` save each GImpact body's start pose and, after integration, move a mesh that
      * ends a step inside an SDF by more than `tolerance` (m) back to its time of impact and
      * remove its velocity into the surface. Tick callbacks installed before are chained (called
