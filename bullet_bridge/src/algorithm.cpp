@@ -71,7 +71,7 @@ public:
         btPersistentManifold* all[1 + kMaxExtra] = { m_manifold };
         int count = 1;
         if (!m_closest && m_bridge->cfg.max_contacts >= MANIFOLD_CACHE_SIZE)
-            for (int i = 0; i < m_bridge->cfg.extra_manifolds; ++i) {
+            for (int i = 0; i < (m_bridge->cfg.patch_band >= 0 ? 1 : m_bridge->cfg.extra_manifolds); ++i) {
                 if (!m_extra[i]) m_extra[i] = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
                 all[count++] = m_extra[i];
             }

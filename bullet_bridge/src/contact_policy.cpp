@@ -475,25 +475,30 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
 
 namespace {
 
-// Writes the candidates `pick` into the pair's manifolds (A = mesh, B = SDF), 4 per manifold in
-// order, the way btManifoldResult and btPersistentManifold::refreshContactPoints do it: a point
+// Writes the candidates `pick` into the pair's manifolds (A = mesh, B = SDF): the first `first`
+// (at most 4) into the first manifold, the rest 4 per manifold in order, the way btManifoldResult and btPersistentManifold::refreshContactPoints do it: a point
 // of the same material point as one of the last step (in any of the pair's manifolds) keeps its
 // warm start and lifetime; added / processed callbacks fire for every point; started fires when
 // the first manifold gains its first point and ended when it empties (the first manifold speaks
 // for the pair: the others never fire started or ended).
 void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, const std::vector<Candidate>& cands,
-                    const std::vector<int>& pick, const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw,
-                    Stats& stats)
+                    const std::vector<int>& pick, int first, bool own_manifold_only, const btCollisionObjectWrapper* mw,
+                    const btCollisionObjectWrapper* sw, Stats& stats)
 {
     const int per = (int)MANIFOLD_CACHE_SIZE;
+    first = std::max(0, std::min(first, per));
     const btCollisionObject* mo = mw->getCollisionObject();
     const btCollisionObject* so = sw->getCollisionObject();
-    const int n = std::min((int)pick.size(), per * manifold_count);
+    const int n = std::min((int)pick.size(), first + per * (manifold_count - 1));
     // The last step's points of every manifold of the pair.
     std::vector<btManifoldPoint> old;
     std::vector<char> matched;
+    std::vector<int> old_m;
     for (int m = 0; m < manifold_count; ++m)
-        for (int i = 0; i < manifolds[m]->getNumContacts(); ++i) old.push_back(manifolds[m]->getContactPoint(i));
+        for (int i = 0; i < manifolds[m]->getNumContacts(); ++i) {
+            old.push_back(manifolds[m]->getContactPoint(i));
+            old_m.push_back(m);
+        }
     matched.assign(old.size(), 0);
     const int primary_old = manifolds[0]->getNumContacts();
     const btScalar match = manifolds[0]->getContactBreakingThreshold();
@@ -524,7 +529,9 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
         // (btPersistentManifold::getCacheEntry / replaceContactPoint).
         int best = -1;
         btScalar best_d2 = match * match;
+        const int target = k < first ? 0 : 1 + (k - first) / per;
         for (size_t j = 0; j < old.size(); ++j) {
+            if (own_manifold_only && old_m[j] != target) continue; // the patch rule: per manifold
             const btScalar d2 = (old[j].m_localPointA - pt.m_localPointA).length2();
             if (!matched[j] && d2 < best_d2) {
                 best_d2 = d2;
@@ -553,7 +560,7 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
     if (n == 0) manifolds[0]->clearManifold(); // fires the contact-ended callback if it had points
     for (int m = n == 0 ? 1 : 0; m < manifold_count; ++m) {
         btPersistentManifold* manifold = manifolds[m];
-        const int lo = std::min(n, m * per), hi = std::min(n, lo + per);
+        const int lo = m == 0 ? 0 : std::min(n, first + (m - 1) * per), hi = m == 0 ? std::min(n, first) : std::min(n, lo + per);
         // The first manifold never passes through 0 points while contact goes on, so there is
         // no ended callback then.
         if (n == 0)
@@ -584,9 +591,9 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     double radius = 0;
     btVector3 w(0, 0, 0);
     const bool any = gather(mw, sw, dt, margin, scratch, &radius, &w);
-    // The clamp and the projection look at pairs with candidates (a body farther from the SDF
-    // than its travel and kick reach cannot end the step inside it).
-    if (!closest && any && (clamp_world || projection_world)) {
+    // The clamp looks at every pair, the projection at pairs with candidates (a body farther
+    // from the SDF than its travel and kick reach cannot end the step inside it unless kicked).
+    if (!closest && (clamp_world || (any && projection_world))) {
         PairRecord r;
         r.mesh = mo;
         r.sdf = so;
@@ -603,6 +610,7 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;
     }
+    const int first = (int)pick.size();
     // More points where the first ones leave the body free to sink: every candidate that could end
     // deeper than cover_depth while the points held so far stay out, for any rotation of the body
     // (relative to the SDF) about an axis in the contact plane up to its angular speed plus
@@ -629,7 +637,7 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         const double slope = dt * (w_tilt + cfg.kick_angular_speed);
         for (int i : coverContacts(scratch, pick, extra_limit, slope, cfg.cover_depth, tol)) pick.push_back(i);
     }
-    writeManifolds(manifolds, manifold_count, scratch, pick, mw, sw, stats);
+    writeManifolds(manifolds, manifold_count, scratch, pick, first, cfg.patch_band >= 0, mw, sw, stats);
 }
 
 double BridgeImpl::timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt)

@@ -58,13 +58,12 @@ void BridgeImpl::clampPre(btDynamicsWorld*) { pairs.clear(); }
 
 void BridgeImpl::clampPost(btDynamicsWorld* world, double dt)
 {
-    stats.clamps += projectPairs(world, dt, clamp_tolerance);
+    stats.clamps += projectPairs(world, dt, clamp_tolerance, true);
     pairs.clear();
 }
 
-int BridgeImpl::projectPairs(btCollisionWorld* world, double dt, double tolerance)
+int BridgeImpl::projectPairs(btCollisionWorld* world, double dt, double tolerance, bool to_impact)
 {
-    (void)dt;
     // Records from a collision pass whose objects have left the world since are skipped.
     std::unordered_set<const btCollisionObject*> alive;
     const btCollisionObjectArray& objs = world->getCollisionObjectArray();
@@ -97,11 +96,49 @@ int BridgeImpl::projectPairs(btCollisionWorld* world, double dt, double toleranc
             if (out) *out = cs[k];
             return true;
         };
+        if (to_impact) {
+            // 1. Does the end pose penetrate deeper than the tolerance?
+            sdfccd_RigidMotion end = sdfccd_default_rigid_motion();
+            end.pose = toPose(body->getWorldTransform() * p.child);
+            sdfccd_QueryParams q = cfg.query;
+            q.margin = -tolerance;
+            sdfccd_QueryResult r;
+            if (sdfccd_query_mesh(sdf, &sm, me->id, &end, 0, 0, &q, nullptr, 0, &r) != SDFCCD_OK || !r.hit) continue;
+            // The hard clamp: back along the step's motion to where the penetration was half the
+            // tolerance (or the tolerance itself if the step began deeper), and no velocity into
+            // the surface; a body that started the step that deep is left to the contacts.
+            BodyMotion M;
+            M.t0 = p.start * p.child;
+            M.t1 = body->getWorldTransform() * p.child;
+            btTransformUtil::calculateVelocity(M.t0, M.t1, (btScalar)dt, M.v, M.w);
+            sdfccd_RigidMotion mm = M.rigid();
+            sdfccd_QueryParams ccd = cfg.query;
+            sdfccd_QueryResult res;
+            bool found = false;
+            const double margins[2] = { -0.5 * tolerance, -tolerance };
+            for (double mg : margins) {
+                ccd.margin = mg;
+                sdfccd_Status cst = sdfccd_query_mesh(sdf, &sm, me->id, &mm, 0, dt, &ccd, cs.data(), 4, &res);
+                if (cst == SDFCCD_OK && res.hit && res.state != SDFCCD_STATE_PENETRATING) {
+                    found = true;
+                    break;
+                }
+            }
+            if (!found) continue;
+            body->setCenterOfMassTransform(M.at(res.toi) * p.child.inverse());
+            if (res.contact_count > 0) {
+                btVector3 nrm = bt(cs[0].normal);
+                btVector3 v = body->getLinearVelocity();
+                btScalar vn = v.dot(nrm);
+                if (vn < 0) body->setLinearVelocity(v - nrm * vn);
+            }
+            ++moved;
+            continue;
+        }
+        // The projection. A body that started the step that deep is left to the contacts (no
+        // jump out of a deep start, e.g. a body created inside the SDF).
         sdfccd_Contact c;
-        if (!deepest(body->getWorldTransform(), &c)) continue;
-        // A body that started the step that deep is left to the contacts (no jump out of a deep
-        // start, e.g. a body created inside the SDF).
-        if (deepest(p.start, nullptr)) continue;
+        if (!deepest(body->getWorldTransform(), &c) || deepest(p.start, nullptr)) continue;
         // Out along the deepest feature's normal to half the tolerance, like a positional (split
         // impulse) correction: the velocity is left to the contacts.
         for (int it = 0; it < 3; ++it) {
@@ -127,7 +164,7 @@ public:
     {
         // The hard clamp, when on, does the same after the step with its own tolerance.
         if (!m_bridge->clamp_world) {
-            m_bridge->stats.projections += m_bridge->projectPairs(world, (double)dt, m_bridge->cfg.projection_tolerance);
+            m_bridge->stats.projections += m_bridge->projectPairs(world, (double)dt, m_bridge->cfg.projection_tolerance, false);
             m_bridge->pairs.clear();
         }
     }

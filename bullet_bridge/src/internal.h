@@ -179,8 +179,10 @@ public:
     };
     std::vector<PairRecord> pairs;
     // Moves bodies of the recorded pairs that end the step deeper than `tolerance` back out; returns
-    // how many it moved. Only objects still in `world` are touched.
-    int projectPairs(btCollisionWorld* world, double dt, double tolerance);
+    // how many it moved. Only objects still in `world` are touched. to_impact (the hard clamp):
+    // back along the step's motion to its time of impact, normal velocity removed; otherwise (the
+    // projection) out along the deepest feature's normal, velocity unchanged.
+    int projectPairs(btCollisionWorld* world, double dt, double tolerance, bool to_impact);
     btDynamicsWorld* projection_world = nullptr;
     std::unique_ptr<btActionInterface> projection;
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
