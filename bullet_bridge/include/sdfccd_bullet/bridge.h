@@ -178,9 +178,9 @@ struct Config {
     double discrete_subdivision_scale = 0.1;
     /** End-of-step projection (m; <= 0: off). When the bridge is registered with a dynamics world
      * (registerWith(btCollisionWorld*)), it adds an action (btActionInterface, run after Bullet
-     * integrates the step) that moves a mesh body ending the step deeper than this in an SDF back
-     * along the step's motion to where it was half as deep, and removes its velocity into the
-     * surface. The contacts hold the surface in Bullet's velocity solve, but Bullet's split-impulse
+     * integrates the step) that moves a mesh body ending the step deeper than this in an SDF out
+     * along the normal of its deepest feature until it is half as deep; its velocity is left
+     * unchanged (the contacts deal with it, like a split-impulse position correction). The contacts hold the surface in Bullet's velocity solve, but Bullet's split-impulse
      * position pass (on by default) only solves contacts deeper than the world's
      * m_splitImpulsePenetrationThreshold (-0.04 m): a deep contact between two GImpact meshes
      * there pushes a body into the SDF with nothing resisting (gimpact-demo: 18 mm with
