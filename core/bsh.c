@@ -209,9 +209,7 @@ SCC_MIN_HEAP(item_heap, item, key)
 typedef struct trav {
     const scc_bsh* bsh;
     const scc_bsh_moving_node* moving;
-    const scc_sdf* sdf;
-    const scc_mesh_motion* mm;
-    const scc_params* p;
+    const scc_mesh_query_in* in;
     double lipschitz;
     double w_body2;           /* |w_body|^2 */
     segment* seg;
@@ -227,20 +225,21 @@ static double node_radius(const trav* tr, uint32_t i)
 static scc_vec3 centre_at(const trav* tr, uint32_t i, double t, const scc_quat* q, const scc_vec3* p)
 {
     scc_vec3 w;
+    const scc_mesh_motion* mm = tr->in->mm;
     if (tr->moving) {
-        double span = tr->mm->t1 - tr->mm->t0;
-        double s = span > 0.0 ? (t - tr->mm->t0) / span : 0.0;
+        double span = mm->t1 - mm->t0;
+        double s = span > 0.0 ? (t - mm->t0) / span : 0.0;
         w = scc_lerp(tr->moving[i].c0, tr->moving[i].c1, s);
     } else {
         w = scc_add(scc_quat_rotate(*q, tr->bsh->nodes[i].center), *p);
     }
-    return scc_sdf_frame_point(tr->mm->sdf, t, w);
+    return scc_sdf_frame_point(mm->sdf, t, w);
 }
 
 /* Upper bound on the acceleration (SDF frame) of a node's centre. */
 static double centre_accel_bound(const trav* tr, uint32_t i)
 {
-    const scc_mesh_motion* mm = tr->mm;
+    const scc_mesh_motion* mm = tr->in->mm;
     if (!mm->sdf) {
         if (tr->moving) return 0.0;
         return tr->w_body2 * scc_dist(tr->bsh->nodes[i].center, mm->body->c_local);
@@ -264,7 +263,7 @@ static double centre_accel_bound(const trav* tr, uint32_t i)
 static double field(trav* tr, scc_vec3 x)
 {
     tr->stats->evals += 1;
-    return scc_sdf_eval(tr->sdf, x, NULL);
+    return scc_sdf_eval(tr->in->sdf, x, NULL);
 }
 
 /* Marches node i's padded sphere along the chord of segment s from time `from` to `to`.
@@ -288,7 +287,7 @@ static int march(trav* tr, uint32_t i, uint32_t s, double from, double to, doubl
     for (int it = 0; it < MARCH_MAX_STEPS; ++it) {
         double f = span > 0.0 ? (t - sg->ta) / span : 0.0;
         double phi = field(tr, scc_madd(A, D, f));
-        double clear = (phi - tr->p->margin) / tr->lipschitz - R;
+        double clear = (phi - tr->in->p->margin) / tr->lipschitz - R;
         if (!(clear > tol)) { *out_tc = t; return 1; }
         if (!(len > 0.0) || !(span > 0.0)) return 0;
         t += clear * span / len;
@@ -298,14 +297,15 @@ static int march(trav* tr, uint32_t i, uint32_t s, double from, double to, doubl
     return 1;
 }
 
-static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void* user, scc_workspace* ws)
+static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void* user)
 {
     /* DCD: the pose at t_end only. Depth-first with an explicit stack (depth <= 64 for a
      * median-split tree of up to 2^30 triangles, but grow it anyway). */
     const scc_bsh* b = tr->bsh;
+    scc_workspace* ws = tr->in->ws;
     scc_quat q = scc_quat_identity();
     scc_vec3 p = scc_v3(0, 0, 0);
-    if (!tr->moving) scc_rigid_pose_at(tr->mm->body, t_end, &q, &p);
+    if (!tr->moving) scc_rigid_pose_at(tr->in->mm->body, t_end, &q, &p);
     size_t n = 0;
     uint32_t* stack = scc_ws_get(ws, SCC_WS_STACK, 128 * sizeof *stack);
     if (!stack) return 0;
@@ -318,7 +318,7 @@ static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void
         uint32_t i = stack[--n];
         tr->stats->nodes_visited += 1;
         scc_vec3 c = centre_at(tr, i, t_end, &q, &p);
-        double clear = (field(tr, c) - tr->p->margin) / tr->lipschitz - node_radius(tr, i) * (1.0 + 1e-12);
+        double clear = (field(tr, c) - tr->in->p->margin) / tr->lipschitz - node_radius(tr, i) * (1.0 + 1e-12);
         if (clear > 0.0) continue;
         if (b->nodes[i].is_leaf) {
             tr->stats->candidates += 1;
@@ -340,24 +340,24 @@ static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void
     return ok;
 }
 
-int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_sdf* sdf,
-                     const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws, double t_end,
+int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_mesh_query_in* in, double t_end,
                      scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats)
 {
+    const scc_mesh_motion* mm = in->mm;
+    const scc_params* p = in->p;
+    scc_workspace* ws = in->ws;
     stats->evals = stats->nodes_visited = stats->candidates = 0;
     if (!bsh || bsh->node_count == 0) return 1;
     if (!mm->body && !moving) return 0; /* linear motion needs the refit */
     trav tr;
     tr.bsh = bsh;
     tr.moving = moving;
-    tr.sdf = sdf;
-    tr.mm = mm;
-    tr.p = p;
-    tr.lipschitz = sdf->lipschitz > 0.0 ? sdf->lipschitz : 1.0;
+    tr.in = in;
+    tr.lipschitz = in->sdf->lipschitz > 0.0 ? in->sdf->lipschitz : 1.0;
     tr.w_body2 = mm->body && !moving ? scc_len2(mm->body->w) : 0.0;
     tr.stats = stats;
     tr.seg = NULL;
-    if (p->method == SCC_METHOD_DCD) return traverse_static(&tr, t_end, visit, user, ws);
+    if (p->method == SCC_METHOD_DCD) return traverse_static(&tr, t_end, visit, user);
 
     /* Segments: no more than min(pi, max_rotation) of relative rotation each. */
     double w = (mm->body && !moving ? scc_len(mm->body->w) : 0.0) + (mm->sdf ? scc_len(mm->sdf->w) : 0.0);

@@ -84,13 +84,13 @@ typedef struct scc_bsh_stats {
  * *io_t_end (the end of the searched interval). Return 0 to abort the traversal (out of memory). */
 typedef int scc_bsh_visit_fn(void* user, uint32_t triangle, double t_candidate, double* io_t_end);
 
-/* Traverses `bsh` for the motion `mm` over [mm->t0, t_end]: continuous (padded sphere tracing)
- * unless `p->method` is DCD, which tests the pose at t_end only. `moving` is the refit for linear
- * motion (NULL for rigid motion; required when mm->body is NULL). Scratch storage comes from `ws`
- * (workspace.h), which keeps it for the next traversal. Returns 0 on allocation failure,
- * when the visitor aborts, or when linear motion comes without its refit. */
-int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_sdf* sdf,
-                     const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws, double t_end,
+/* Traverses `bsh` for the query `in` (field, motion `in->mm`, parameters `in->p`) over
+ * [in->mm->t0, t_end]: continuous (padded sphere tracing) unless `in->p->method` is DCD, which
+ * tests the pose at t_end only. `moving` is the refit for linear motion (NULL for rigid motion;
+ * required when in->mm->body is NULL). Scratch storage comes from `in->ws` (workspace.h), which
+ * keeps it for the next traversal. Returns 0 on allocation failure, when the visitor aborts, or
+ * when linear motion comes without its refit. */
+int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_mesh_query_in* in, double t_end,
                      scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats);
 
 #endif

@@ -116,6 +116,17 @@ typedef struct scc_mesh_motion {
     const scc_rigid* sdf;       /* NULL: static SDF */
     double t0, t1;
 } scc_mesh_motion;
+
+/* The inputs of one mesh query: the field, the mesh's motion, the parameters and the scratch
+ * storage (workspace.h). The narrow phase (mesh_query.c) and the broad phase it hands them to
+ * (scc_bsh_traverse, bsh.h) read the same ones. */
+typedef struct scc_mesh_query_in {
+    const scc_sdf* sdf;
+    const scc_mesh_motion* mm;
+    const scc_params* p;
+    scc_workspace* ws;
+} scc_mesh_query_in;
+
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum);
 /* The motion of triangle t of the mesh motion `mm` (what the mesh query tests per triangle). */

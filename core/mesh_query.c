@@ -60,11 +60,7 @@ void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_mot
 }
 
 typedef struct mesh_ctx {
-    scc_workspace* ws;
-    const scc_sdf* sdf;
-    const scc_mesh_motion* mm;
-    const scc_params* p;
-    const scc_allocator* alloc;
+    scc_mesh_query_in in;        /* the query's inputs, handed to the broad phase as they are */
     contact_buf buf;
     double best, lower;
     scc_state best_state;
@@ -81,14 +77,15 @@ typedef struct mesh_ctx {
 /* Evaluations left of the query's budget (narrow phase so far plus the broad phase's marching). */
 static int64_t budget_left(const mesh_ctx* c)
 {
-    return c->p->max_evals - c->sum->evals - (c->broad ? c->broad->evals : 0);
+    return c->in.p->max_evals - c->sum->evals - (c->broad ? c->broad->evals : 0);
 }
 
 /* Narrow phase of triangle t on [ta, min(t1, best + window)], where ta is t0 or the broad phase's
  * candidate time (a proven lower bound of the triangle's contacts). Returns 0 on allocation failure. */
 static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
 {
-    scc_params tp = *c->p;
+    const scc_mesh_motion* mm = c->in.mm;
+    scc_params tp = *c->in.p;
     const scc_params* p = &tp;
     tp.max_evals = budget_left(c);
     if (tp.max_evals <= 0) {
@@ -96,15 +93,15 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
         return 1;
     }
     scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
-    double tb = fmin(c->mm->t1, c->best + p->toi_window);
+    double tb = fmin(mm->t1, c->best + p->toi_window);
     scc_tri_motion m;
-    scc_mesh_triangle_motion(c->mm, t, &m);
+    scc_mesh_triangle_motion(mm, t, &m);
     if (c->traces) {
-        const uint32_t* f = c->mm->mesh->indices + 3 * t;
+        const uint32_t* f = mm->mesh->indices + 3 * t;
         for (int i = 0; i < 3; ++i) {
             scc_vertex_trace* r = &c->traces[f[i]];
-            if (r->epoch != c->ws->trace_epoch) {
-                r->epoch = c->ws->trace_epoch;
+            if (r->epoch != c->in.ws->trace_epoch) {
+                r->epoch = c->in.ws->trace_epoch;
                 r->speed = -1.0;
                 r->from = r->to = 0.0;
                 r->hit_t = r->hit_phi = INFINITY;
@@ -114,15 +111,15 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
     }
     scc_query_summary s;
     if (c->probe) c->probe(c->probe_user, t, 1);
-    if (!(ta < tb)) ta = c->mm->t0;
-    int ok = scc_query_triangle(c->sdf, &m, ta, tb, p, c->alloc, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s);
+    if (!(ta < tb)) ta = mm->t0;
+    int ok = scc_query_triangle(c->in.sdf, &m, ta, tb, p, c->in.ws->alloc, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s);
     if (c->probe) c->probe(c->probe_user, t, 0);
     if (!ok) return 0;
     c->sum->iterations += s.iterations;
     c->sum->evals += s.evals;
     c->sum->triangles_tested += 1;
     /* Touching at a candidate time after t0 is a hit there, not a penetration at the query's start. */
-    if (s.state == SCC_PENETRATING && ta > c->mm->t0) s.state = SCC_HIT;
+    if (s.state == SCC_PENETRATING && ta > mm->t0) s.state = SCC_HIT;
     c->lower = fmin(c->lower, s.toi_lower);
     if (!s.hit) {
         c->any_not_converged |= s.state == SCC_NOT_CONVERGED;
@@ -142,12 +139,13 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
 static int visit_candidate(void* user, uint32_t triangle, double t_candidate, double* io_t_end)
 {
     mesh_ctx* c = user;
+    const scc_mesh_motion* mm = c->in.mm;
     /* The candidate time is a proven lower bound of the triangle's contacts, so the narrow phase
      * searches from there. FW (the paper's Section 4.2 baseline) keeps the whole interval: it is a
      * local method whose step sizes scale with the interval. */
-    double ta = c->p->method == SCC_METHOD_FW ? c->mm->t0 : fmax(c->mm->t0, t_candidate);
+    double ta = c->in.p->method == SCC_METHOD_FW ? mm->t0 : fmax(mm->t0, t_candidate);
     if (!test_triangle(c, triangle, ta)) return 0;
-    *io_t_end = fmin(*io_t_end, fmin(c->mm->t1, c->best + c->p->toi_window));
+    *io_t_end = fmin(*io_t_end, fmin(mm->t1, c->best + c->in.p->toi_window));
     if (c->budget_exhausted) *io_t_end = -INFINITY; /* stops the traversal */
     return 1;
 }
@@ -155,8 +153,8 @@ static int visit_candidate(void* user, uint32_t triangle, double t_candidate, do
 /* Broad phase: the mesh's own hierarchy or a temporary one, refitted for linear motion. */
 static int run_broad_phase(mesh_ctx* c)
 {
-    const scc_mesh_motion* mm = c->mm;
-    const scc_allocator* alloc = c->alloc;
+    const scc_mesh_motion* mm = c->in.mm;
+    const scc_allocator* alloc = c->in.ws->alloc;
     const scc_bsh* bsh = mm->mesh->bsh;
     scc_bsh* own = NULL;
     if (!bsh) {
@@ -167,14 +165,14 @@ static int run_broad_phase(mesh_ctx* c)
     scc_bsh_moving_node* moving = NULL;
     int ok = 1;
     if (!mm->body) {
-        moving = scc_ws_get(c->ws, SCC_WS_MOVING, (size_t)bsh->node_count * sizeof *moving);
+        moving = scc_ws_get(c->in.ws, SCC_WS_MOVING, (size_t)bsh->node_count * sizeof *moving);
         if (!moving) ok = 0;
         else scc_bsh_refit_linear(bsh, mm->mesh, mm->start, mm->end, moving);
     }
     if (ok) {
         scc_bsh_stats st = { 0, 0, 0 };
         c->broad = &st;
-        ok = scc_bsh_traverse(bsh, moving, c->sdf, mm, c->p, c->ws, mm->t1, visit_candidate, c, &st);
+        ok = scc_bsh_traverse(bsh, moving, &c->in, mm->t1, visit_candidate, c, &st);
         if (budget_left(c) <= 0) c->budget_exhausted = 1;
         c->broad = NULL;
         c->sum->evals += st.evals;
@@ -206,11 +204,10 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
 {
     const scc_allocator* alloc = ws->alloc;
     mesh_ctx c;
-    c.ws = ws;
-    c.sdf = sdf;
-    c.mm = mm;
-    c.p = p;
-    c.alloc = alloc;
+    c.in.sdf = sdf;
+    c.in.mm = mm;
+    c.in.p = p;
+    c.in.ws = ws;
     /* the contact buffer grows in its workspace slot and is handed back at the end */
     c.buf.a = ws->slot[SCC_WS_CONTACTS].p;
     c.buf.n = 0;

@@ -299,7 +299,8 @@ static void run_case(test_rng* rng, const fields* fl, int kind, sweep_stats* st)
     scc_bsh_stats bst;
     scc_workspace ws;
     scc_ws_init(&ws, &k_alloc);
-    ck_assert(scc_bsh_traverse(bsh, mv, sdf, &mm, &pc, &ws, DT, record_visit, &rec, &bst));
+    const scc_mesh_query_in qc = { sdf, &mm, &pc, &ws };
+    ck_assert(scc_bsh_traverse(bsh, mv, &qc, DT, record_visit, &rec, &bst));
 
     /* Brute force: the certified TOI of every triangle over the whole step. */
     double* cert = malloc(nt * sizeof *cert);
@@ -371,7 +372,8 @@ skip_exact:
     /* DCD: the static descent keeps every triangle whose end pose touches, and agrees with the loop. */
     scc_params pd = default_params(SCC_METHOD_DCD);
     for (uint32_t t = 0; t < nt; ++t) rec.tc[t] = INFINITY;
-    ck_assert(scc_bsh_traverse(bsh, mv, sdf, &mm, &pd, &ws, DT, record_visit, &rec, &bst));
+    const scc_mesh_query_in qd = { sdf, &mm, &pd, &ws };
+    ck_assert(scc_bsh_traverse(bsh, mv, &qd, DT, record_visit, &rec, &bst));
     for (uint32_t t = 0; t < nt; ++t) {
         scc_tri_motion m;
         memset(&m, 0, sizeof m);
