@@ -77,16 +77,17 @@ int scc_mesh_topology_check(const scc_allocator* a, const scc_mesh* mesh, scc_me
 
 static double mesh_sdf_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
 {
-    scc_mesh_distance_result r;
-    scc_mesh_sdf_query((const scc_mesh_sdf*)self, p, &r);
+    scc_tri_nearest nr;
+    scc_vec3 normal;
+    const double dist = scc_mesh_sdf_query((const scc_mesh_sdf*)self, p, &nr, &normal);
     if (out_grad) {
-        const scc_vec3 d = scc_sub(p, r.closest);
+        const scc_vec3 d = scc_sub(p, nr.point);
         const double l = scc_len(d);
         /* grad of the signed distance: sign * (p - closest) / |p - closest|; on the surface,
          * the pseudonormal. */
-        *out_grad = l > 0.0 ? scc_scale(d, (r.distance < 0.0 ? -1.0 : 1.0) / l) : r.normal;
+        *out_grad = l > 0.0 ? scc_scale(d, (dist < 0.0 ? -1.0 : 1.0) / l) : normal;
     }
-    return r.distance;
+    return dist;
 }
 
 int scc_mesh_sdf_init(scc_mesh_sdf* m, const scc_allocator* a, const scc_mesh* mesh)
@@ -157,16 +158,10 @@ void scc_mesh_sdf_destroy(scc_mesh_sdf* m)
     scc_tri_bvh_destroy(&m->bvh);
 }
 
-size_t scc_mesh_sdf_memory(const scc_mesh_sdf* m)
-{
-    return sizeof *m + scc_tri_bvh_memory(&m->bvh) + (size_t)m->mesh->triangle_count * 4 * sizeof(scc_vec3)
-         + (size_t)m->mesh->vertex_count * sizeof(scc_vec3);
-}
-
-void scc_mesh_sdf_query(const scc_mesh_sdf* m, scc_vec3 p, scc_mesh_distance_result* out)
+double scc_mesh_sdf_query(const scc_mesh_sdf* m, scc_vec3 p, scc_tri_nearest* out_nearest, scc_vec3* out_normal)
 {
     uint32_t hint = UINT32_MAX;
-    scc_mesh_sdf_query_hint(m, p, &hint, out);
+    return scc_mesh_sdf_query_hint(m, p, &hint, out_nearest, out_normal);
 }
 
 static scc_vec3 feature_normal(const scc_mesh_sdf* m, uint32_t t, scc_tri_feature f)
@@ -192,22 +187,21 @@ double scc_mesh_sdf_distance_capped(const scc_mesh_sdf* m, scc_vec3 p, uint32_t*
     return scc_dot(scc_sub(p, nr.point), feature_normal(m, nr.triangle, nr.feature)) >= 0.0 ? d : -d;
 }
 
-void scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, scc_mesh_distance_result* out)
+double scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, scc_tri_nearest* out_nearest,
+                               scc_vec3* out_normal)
 {
     scc_tri_nearest nr;
-    if (!scc_tri_bvh_nearest_hint(&m->bvh, p, *hint, &nr)) {
-        memset(out, 0, sizeof *out);
-        out->distance = INFINITY;
-        out->normal = scc_v3(0, 0, 1);
-        return;
+    scc_vec3 n = scc_v3(0, 0, 1);
+    double dist = INFINITY;
+    if (scc_tri_bvh_nearest_hint(&m->bvh, p, *hint, &nr)) {
+        *hint = nr.slot;
+        n = feature_normal(m, nr.triangle, nr.feature);
+        const double d = sqrt(nr.dist2);
+        dist = scc_dot(scc_sub(p, nr.point), n) >= 0.0 ? d : -d;
+    } else {
+        memset(&nr, 0, sizeof nr);
     }
-    *hint = nr.slot;
-    const uint32_t t = nr.triangle;
-    const scc_vec3 n = feature_normal(m, t, nr.feature);
-    const double d = sqrt(nr.dist2);
-    out->distance = scc_dot(scc_sub(p, nr.point), n) >= 0.0 ? d : -d;
-    out->closest = nr.point;
-    out->normal = n;
-    out->triangle = t;
-    out->feature = nr.feature;
+    if (out_nearest) *out_nearest = nr;
+    if (out_normal) *out_normal = n;
+    return dist;
 }

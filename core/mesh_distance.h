@@ -33,21 +33,15 @@ typedef struct scc_mesh_sdf {
  * topology.closed is set; the caller decides what to do otherwise. 1 on success, 0 on OOM. */
 int scc_mesh_sdf_init(scc_mesh_sdf* m, const scc_allocator* a, const scc_mesh* mesh);
 void scc_mesh_sdf_destroy(scc_mesh_sdf* m);
-size_t scc_mesh_sdf_memory(const scc_mesh_sdf* m);
 
-typedef struct scc_mesh_distance_result {
-    double distance;          /* signed: < 0 inside */
-    scc_vec3 closest;         /* nearest point on the mesh */
-    scc_vec3 normal;          /* pseudonormal of the nearest feature */
-    uint32_t triangle;
-    scc_tri_feature feature;
-} scc_mesh_distance_result;
-
-/* Signed distance with the nearest point and feature. */
-void scc_mesh_sdf_query(const scc_mesh_sdf* m, scc_vec3 p, scc_mesh_distance_result* out);
+/* Signed distance of p (< 0 inside). *out_nearest (may be NULL) receives the nearest triangle,
+ * its closest point and feature, and *out_normal (may be NULL) that feature's pseudonormal. An
+ * empty mesh gives INFINITY, a zeroed nearest and the normal (0, 0, 1). */
+double scc_mesh_sdf_query(const scc_mesh_sdf* m, scc_vec3 p, scc_tri_nearest* out_nearest, scc_vec3* out_normal);
 /* The same with a caller-kept hint (start with UINT32_MAX; updated to the answer's BVH slot):
  * queries at nearby points in sequence run much faster. The result does not depend on it. */
-void scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, scc_mesh_distance_result* out);
+double scc_mesh_sdf_query_hint(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, scc_tri_nearest* out_nearest,
+                               scc_vec3* out_normal);
 /* Signed distance when |distance| < cap; otherwise returns cap (sign not computed) without
  * searching further than cap. */
 double scc_mesh_sdf_distance_capped(const scc_mesh_sdf* m, scc_vec3 p, uint32_t* hint, double cap);

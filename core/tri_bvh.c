@@ -161,11 +161,6 @@ void scc_tri_bvh_destroy(scc_tri_bvh* bvh)
     bvh->tri_count = 0; bvh->node_count = 0; bvh->node_capacity = 0;
 }
 
-size_t scc_tri_bvh_memory(const scc_tri_bvh* bvh)
-{
-    return (size_t)bvh->node_capacity * sizeof *bvh->nodes + (size_t)bvh->tri_count * (3 * sizeof(scc_vec3) + sizeof(uint32_t) + sizeof(scc_aabb));
-}
-
 /* ---- query ---- */
 
 /* Squared distance from p to a box (0 inside). Plain comparisons: fmax is a libm call here. */

@@ -41,7 +41,6 @@ typedef struct scc_tri_bvh {
  * to 8 triangles). Returns 1 on success, 0 when out of memory. */
 int scc_tri_bvh_build(scc_tri_bvh* bvh, const scc_allocator* a, const scc_mesh* mesh);
 void scc_tri_bvh_destroy(scc_tri_bvh* bvh);
-size_t scc_tri_bvh_memory(const scc_tri_bvh* bvh);
 
 typedef struct scc_tri_nearest {
     double dist2;             /* squared distance */

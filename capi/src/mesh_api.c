@@ -191,10 +191,9 @@ static sdfccd_Status mesh_signed_distance_held(sdfccd_MeshId mesh, const sdfccd_
     }
     uint32_t hint = UINT32_MAX;
     for (int32_t i = 0; i < count; ++i) {
-        scc_mesh_distance_result r;
-        scc_mesh_sdf_query_hint(&ms, sdfccd__v(points[i]), &hint, &r);
-        out_distances[i] = r.distance;
-        if (out_closest) out_closest[i] = sdfccd__pv(r.closest);
+        scc_tri_nearest nr;
+        out_distances[i] = scc_mesh_sdf_query_hint(&ms, sdfccd__v(points[i]), &hint, &nr, NULL);
+        if (out_closest) out_closest[i] = sdfccd__pv(nr.point);
     }
     scc_mesh_sdf_destroy(&ms);
     return SDFCCD_OK;
