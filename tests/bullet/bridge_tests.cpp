@@ -1081,6 +1081,20 @@ static void userPre(btDynamicsWorld* w, btScalar)
 }
 static void userPost(btDynamicsWorld*, btScalar) { ++g_user_post; }
 
+// The pair the misuse tests register the bridge for (or not, or too late): a GImpact cube 5 cm above
+// an SDF slab at the origin, their boxes overlapping from the start with no contact yet. Declare it
+// after the World it is added to.
+struct CubeOverSlab {
+    SdfShape shape;
+    std::unique_ptr<TriMesh> cube;
+    btRigidBody* body;
+    CubeOverSlab(World& w, sdfccd_SdfId slab) : shape(slab), cube(makeBox(btVector3(0.5, 0.5, 0.5)))
+    {
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        body = w.add(cube->shape.get(), 1, btVector3(0, 0, 0.6), btVector3(0.5, 0.5, 0.5));
+    }
+};
+
 static void test_misuse()
 {
     sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
@@ -1103,10 +1117,7 @@ static void test_misuse()
         Bridge bridge;
         World w;
         btGImpactCollisionAlgorithm::registerAlgorithm(&w.dispatcher);
-        SdfShape shape(slab);
-        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
-        w.add(&shape, 0, btVector3(0, 0, 0));
-        w.add(cube->shape.get(), 1, btVector3(0, 0, 0.6), btVector3(0.5, 0.5, 0.5)); // boxes overlap, no contact yet
+        CubeOverSlab pair(w, slab);
         w.world.performDiscreteCollisionDetection();
         CHECK(bridge.registerWith(&w.dispatcher) == Status::Ok, "register on the dispatcher");
         CHECK(bridge.check(&w.world, &msg) == Status::TooLate, "too late: %s", msg.c_str());
@@ -1169,8 +1180,7 @@ static void test_misuse()
 
 enum MisuseMode { kRegistered, kNotRegistered, kOverwritten, kTooLate };
 
-// A GImpact cube 5 cm above an SDF slab (their boxes overlap from the start), stepped 5 times,
-// with the bridge used as `mode` says. Returns the log; *first_step = step of the first report.
+// CubeOverSlab stepped 5 times, with the bridge used as `mode` says. Returns the log; *first_step = step of the first report.
 static MisuseLog misuseRun(MisuseMode mode, sdfccd_SdfId slab, int* first_step, bool* ray_hit = nullptr)
 {
     MisuseLog log;
@@ -1181,11 +1191,8 @@ static MisuseLog misuseRun(MisuseMode mode, sdfccd_SdfId slab, int* first_step, 
         World w;
         if (mode == kRegistered || mode == kOverwritten) CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
         if (mode != kRegistered) btGImpactCollisionAlgorithm::registerAlgorithm(&w.dispatcher); // overwrites the bridge's slots
-        SdfShape shape(slab);
-        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
-        w.add(&shape, 0, btVector3(0, 0, 0));
-        btRigidBody* body = w.add(cube->shape.get(), 1, btVector3(0, 0, 0.6), btVector3(0.5, 0.5, 0.5));
-        body->setActivationState(DISABLE_DEACTIVATION);
+        CubeOverSlab pair(w, slab);
+        pair.body->setActivationState(DISABLE_DEACTIVATION);
         for (int i = 0; i < 5; ++i) {
             if (mode == kTooLate && i == 1) {
                 // The pair's (GImpact) algorithm exists (no contact point yet, so the dispatcher
@@ -1196,7 +1203,7 @@ static MisuseLog misuseRun(MisuseMode mode, sdfccd_SdfId slab, int* first_step, 
             int before = log.calls;
             w.step();
             if (log.calls > before && *first_step < 0) *first_step = i;
-            if (log.calls > before) CHECK(log.shape == &shape, "the report names another shape");
+            if (log.calls > before) CHECK(log.shape == &pair.shape, "the report names another shape");
         }
         if (ray_hit) {
             // Ray tests use the shape's triangulation by design: not misuse.
@@ -1243,10 +1250,7 @@ static void test_misuse_handler()
         Bridge bridge;
         World w;
         btGImpactCollisionAlgorithm::registerAlgorithm(&w.dispatcher);
-        SdfShape shape(slab);
-        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
-        w.add(&shape, 0, btVector3(0, 0, 0));
-        w.add(cube->shape.get(), 1, btVector3(0, 0, 0.6), btVector3(0.5, 0.5, 0.5));
+        CubeOverSlab pair(w, slab);
         for (int i = 0; i < 3; ++i) w.step(); // the default handler in a release build: no abort
     }
 #endif
