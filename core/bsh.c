@@ -390,7 +390,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
     segment* seg = scc_ws_get(ws, SCC_WS_SEGMENTS, nseg * sizeof *seg);
     uint8_t* tested = scc_ws_get(ws, SCC_WS_TESTED, ((size_t)bsh->triangle_count + 7) / 8);
     /* the heap grows in its workspace slot (its storage is handed back at the end) */
-    item_heap heap = { ws->slot[SCC_WS_HEAP].p, 0, ws->slot[SCC_WS_HEAP].bytes / sizeof(item), ws->alloc };
+    item_heap heap = { ws->slot[SCC_WS_HEAP].p, 0, ws->slot[SCC_WS_HEAP].bytes / sizeof(item), ws->alloc, 0, 0 };
     if (heap.cap * sizeof(item) != ws->slot[SCC_WS_HEAP].bytes) { /* not the heap's own storage: start afresh */
         scc_free(ws->alloc, heap.a, ws->slot[SCC_WS_HEAP].bytes);
         heap.a = NULL;

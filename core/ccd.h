@@ -31,6 +31,7 @@ typedef struct scc_params {
     double max_rotation;    /* rad per segment */
     double cert_time_tol;   /* s */
     int64_t cert_max_regions;
+    int64_t cert_max_bytes; /* bytes the region store of one certified search may hold (0: no limit) */
     int broad_phase;
     int fwgss_secant;       /* FWGSS entry time by Illinois regula falsi once a sign change is bracketed */
     int fwgss_speed_tol;    /* FWGSS spatial tolerance = speed bound x time_tol (else dist_tol) */

@@ -34,15 +34,22 @@ static scc_vec3 corner(const scc_tri_state* st, double u, double v)
 int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                   const scc_allocator* alloc, scc_tri_hit* out)
 {
-    region_heap h = { NULL, 0, 0, alloc };
+    /* The region store never holds more than cert_max_bytes (0: no limit); when it is full the
+     * search stops like at the other caps: NOT_CONVERGED, the earliest witness so far, and the
+     * popped region's start as the proven lower bound. */
+    region_heap h = { NULL, 0, 0, alloc, 0, 0 };
+    if (p->cert_max_bytes > 0) h.max_bytes = (uint64_t)p->cert_max_bytes > SIZE_MAX ? SIZE_MAX : (size_t)p->cert_max_bytes;
     region root = { ta, tb, { 1, 0, 0 }, { 0, 1, 0 } };
-    if (!region_heap_push(&h, root)) return 0;
+    int capped = 0, ok = 1;
+    if (!region_heap_push(&h, root)) {
+        if (!h.full) return 0;
+        capped = 1;
+    }
     const double speed = scc_tri_speed_bound(m);
     const double accel = scc_tri_accel_bound(m);
     double hi = INFINITY, lo = ta;
     double hit_b[3] = { 1, 0, 0 };
     int64_t processed = 0, evals = 0;
-    int capped = 0, ok = 1;
     while (h.n) {
         region r = region_heap_pop(&h);
         lo = r.ta;
@@ -125,7 +132,11 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
             region a = r, b = r;
             a.tb = tm;
             b.ta = tm;
-            if (!region_heap_push(&h, a) || (b.ta < hi && !region_heap_push(&h, b))) { ok = 0; break; }
+            if (!region_heap_push(&h, a) || (b.ta < hi && !region_heap_push(&h, b))) {
+                if (h.full) capped = 1;
+                else ok = 0;
+                break;
+            }
         } else {
             double mu[3], mv[3];
             for (int i = 0; i < 3; ++i) {
@@ -140,7 +151,10 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
                 { r.ta, r.tb, { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] } },
             };
             for (int i = 0; i < 4 && ok; ++i) ok = region_heap_push(&h, k[i]);
-            if (!ok) break;
+            if (!ok) {
+                if (h.full) ok = capped = 1;
+                break;
+            }
         }
     }
     if (!h.n && ok && !capped) lo = isfinite(hi) ? hi : tb;

@@ -263,6 +263,7 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     }
     sum->hit = isfinite(best);
     sum->toi = sum->hit ? best : mm->t1;
+    if (c.budget_exhausted) lower = fmin(lower, mm->t0); /* triangles left untested prove nothing */
     sum->toi_lower = fmin(lower, sum->toi); /* certified: no triangle touches before this */
     sum->state = sum->hit ? (c.budget_exhausted ? SCC_NOT_CONVERGED : best_state)
                           : (any_not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT);

@@ -40,12 +40,17 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
         }
         h.hit = 0;
         h.state = SCC_NO_HIT;
+        double unresolved = tb; /* certified: the earliest time a stopped search left unproven */
         /* One evaluation budget for all segments: each solver gets what the earlier ones left. */
         scc_params sp = *p;
         for (int k = 0; k < segments; ++k) {
-            if (evals >= p->max_evals) { not_converged = 1; break; }
-            sp.max_evals = p->max_evals - evals;
             double sa = ta + (tb - ta) * k / segments;
+            if (evals >= p->max_evals) {
+                not_converged = 1;
+                unresolved = fmin(unresolved, sa);
+                break;
+            }
+            sp.max_evals = p->max_evals - evals;
             double sb = k + 1 == segments ? tb : ta + (tb - ta) * (k + 1) / segments;
             scc_tri_hit seg;
             if (p->method == SCC_METHOD_FWGSS) scc_fwgss(sdf, m, sa, sb, &sp, &seg);
@@ -59,13 +64,19 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
                 if (not_converged && h.state == SCC_HIT) h.state = SCC_NOT_CONVERGED;
                 break;
             }
-            if (seg.state == SCC_NOT_CONVERGED) not_converged = 1;
+            if (seg.state == SCC_NOT_CONVERGED) {
+                not_converged = 1;
+                unresolved = fmin(unresolved, seg.toi_lower);
+            }
             h = seg;
         }
         if (!h.hit) {
             h.state = not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT;
             h.toi = h.toi_lower = tb;
         }
+        /* A certified search stopped by a cap proves nothing after its lower bound, nor does a
+         * segment never searched: the bracket's lower end must not claim more. */
+        if (p->method == SCC_METHOD_CERTIFIED) h.toi_lower = fmin(h.toi_lower, unresolved);
     }
 
     int n = 0;

@@ -11,23 +11,23 @@
 #include <string.h>
 #include "test_util.h"
 
-/* A flat sheet of n x n quads (2 n^2 triangles) of side `size` in the plane z = height. */
-static sdfccd_MeshId make_sheet(int n, double size, double height)
+/* A flat sheet of nx x ny quads (2 nx ny triangles), `size` x `size`, in the plane z = height. */
+static sdfccd_MeshId make_sheet_xy(int nx, int ny, double size, double height)
 {
-    int nv = (n + 1) * (n + 1);
+    int nv = (nx + 1) * (ny + 1);
     double* v = malloc(sizeof(double) * 3 * (size_t)nv);
-    uint32_t* idx = malloc(sizeof(uint32_t) * 6 * (size_t)(n * n));
-    for (int j = 0; j <= n; ++j)
-        for (int i = 0; i <= n; ++i) {
-            double* p = v + 3 * (j * (n + 1) + i);
-            p[0] = size * ((double)i / n - 0.5);
-            p[1] = size * ((double)j / n - 0.5);
+    uint32_t* idx = malloc(sizeof(uint32_t) * 6 * (size_t)(nx * ny));
+    for (int j = 0; j <= ny; ++j)
+        for (int i = 0; i <= nx; ++i) {
+            double* p = v + 3 * (j * (nx + 1) + i);
+            p[0] = size * ((double)i / nx - 0.5);
+            p[1] = size * ((double)j / ny - 0.5);
             p[2] = height;
         }
     uint32_t* f = idx;
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            uint32_t a = (uint32_t)(j * (n + 1) + i), b = a + 1, c = a + (uint32_t)(n + 1), d = c + 1;
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            uint32_t a = (uint32_t)(j * (nx + 1) + i), b = a + 1, c = a + (uint32_t)(nx + 1), d = c + 1;
             *f++ = a; *f++ = b; *f++ = d;
             *f++ = a; *f++ = d; *f++ = c;
         }
@@ -35,12 +35,18 @@ static sdfccd_MeshId make_sheet(int n, double size, double height)
     d.vertices = v;
     d.vertex_count = (uint32_t)nv;
     d.indices = idx;
-    d.triangle_count = (uint32_t)(2 * n * n);
+    d.triangle_count = (uint32_t)(2 * nx * ny);
     sdfccd_MeshId mesh;
     ck_assert_int_eq(sdfccd_create_mesh(&d, &mesh), SDFCCD_OK);
     free(v);
     free(idx);
     return mesh;
+}
+
+/* A flat sheet of n x n quads (2 n^2 triangles) of side `size` in the plane z = height. */
+static sdfccd_MeshId make_sheet(int n, double size, double height)
+{
+    return make_sheet_xy(n, n, size, height);
 }
 
 static const sdfccd_Vec3 k_tri[3] = { { 2, 0, 0 }, { 2.5, 0, 0 }, { 2, 0.5, 0 } };
@@ -518,6 +524,154 @@ START_TEST(test_memory_limits)
 }
 END_TEST
 
+
+/* Peak of the library's allocations, through the allocator hooks. */
+typedef struct peak_counter { int64_t now, peak; } peak_counter;
+static void* peak_alloc(size_t n, void* user)
+{
+    peak_counter* c = user;
+    c->now += (int64_t)n;
+    if (c->now > c->peak) c->peak = c->now;
+    return malloc(n);
+}
+static void peak_free(void* p, size_t n, void* user)
+{
+    peak_counter* c = user;
+    c->now -= (int64_t)n;
+    free(p);
+}
+
+/* Finding "memory": CERTIFIED on a triangle sliding 1 nm above a non-convex surface (the torus's
+ * top circle, which the Lipschitz bound cannot prune) held 96 MiB of regions before the
+ * evaluation budget stopped it, and on a 1,656-triangle sheet it ran 23.7 s. The region store is
+ * now capped by certified_max_bytes: the query stops there with NOT_CONVERGED and the earliest
+ * witness, and nothing it allocates at once passes the cap. */
+START_TEST(test_certified_memory_cap)
+{
+    peak_counter c = { 0, 0 };
+    ck_assert_int_eq(sdfccd_byte_count(), 0);
+    ck_assert_int_eq(sdfccd_set_allocator(peak_alloc, peak_free, &c), SDFCCD_OK);
+    sdfccd_SdfId torus;
+    ck_assert_int_eq(sdfccd_create_torus(1.0, 0.25, &torus), SDFCCD_OK);
+    const double z = 0.25 + 1e-9;
+    const sdfccd_Vec3 tri[3] = { { 0.5, -0.3, z }, { 1.5, -0.3, z }, { 1.0, 0.4, z } };
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.linear_velocity.x = 0.5;
+    sdfccd_QueryParams p = sdfccd_default_query_params();
+    p.method = SDFCCD_METHOD_CERTIFIED;
+    ck_assert_int_eq(p.certified_max_bytes, SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES);
+    sdfccd_QueryResult r;
+    sdfccd_Contact ct[8];
+
+    /* The default cap, then smaller ones: the peak stays under each, and the cap (not the
+     * evaluation budget) is what stopped the search. No contact: the triangle stays 1 nm above,
+     * and the search never got past the start, so nothing later than t0 is claimed. */
+    const int64_t caps[3] = { SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES, 1 << 20, 100000 };
+    for (int k = 0; k < 3; ++k) {
+        p.certified_max_bytes = caps[k];
+        const int64_t before = c.now;
+        c.peak = c.now;
+        ck_assert_int_eq(sdfccd_query_triangle(torus, NULL, tri, &m, 0, 1, &p, ct, 8, &r), SDFCCD_OK);
+        const int64_t peak = c.peak - before;
+        fprintf(stderr, "sliding 1 nm above the torus, cap %lld: peak %lld bytes, %lld evaluations, state %d\n", (long long)caps[k],
+                (long long)peak, (long long)r.sdf_evaluations, (int)r.state);
+        ck_assert_int_le(peak, caps[k]);
+        ck_assert_int_gt(peak, caps[k] / 2); /* it did fill the store (the cap is what bounds it) */
+        ck_assert_int_lt(r.sdf_evaluations, p.max_sdf_evaluations);
+        ck_assert_int_eq(r.state, SDFCCD_STATE_NOT_CONVERGED);
+        ck_assert_int_eq(r.hit, 0);
+        ck_assert(r.toi == 1.0 && r.fraction == 1.0);
+        ck_assert(r.toi_lower == 0.0);
+    }
+    /* A cap below one region: nothing is allocated, nothing is proven. */
+    p.certified_max_bytes = 1;
+    c.peak = c.now;
+    int64_t before = c.now;
+    ck_assert_int_eq(sdfccd_query_triangle(torus, NULL, tri, &m, 0, 1, &p, ct, 8, &r), SDFCCD_OK);
+    ck_assert_int_eq(c.peak, before);
+    ck_assert_int_eq(r.state, SDFCCD_STATE_NOT_CONVERGED);
+    ck_assert(r.toi == 1.0 && r.toi_lower == 0.0 && r.hit == 0);
+    p.certified_max_bytes = 0;
+    ck_assert_int_eq(sdfccd_query_triangle(torus, NULL, tri, &m, 0, 1, &p, ct, 8, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "certified_max_bytes"));
+    p.certified_max_bytes = SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES;
+
+    /* The same slide with a ball ahead (union with the torus): the capped search keeps its
+     * witness. The true TOI is the ball's alone (the torus is never touched), which the convex
+     * ball's own certified search brackets; the witness is a real contact at or after it. */
+    sdfccd_SdfId sphere, ball, both;
+    ck_assert_int_eq(sdfccd_create_sphere(0.3, &sphere), SDFCCD_OK);
+    sdfccd_Pose pose = { { 1.8, 0.0, 0.5 }, { 1, 0, 0, 0 } };
+    ck_assert_int_eq(sdfccd_create_transformed(sphere, pose, 1.0, &ball), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_UNION, torus, ball, &both), SDFCCD_OK);
+    sdfccd_QueryResult alone;
+    ck_assert_int_eq(sdfccd_query_triangle(ball, NULL, tri, &m, 0, 1, &p, NULL, 0, &alone), SDFCCD_OK);
+    ck_assert_int_eq(alone.state, SDFCCD_STATE_HIT);
+    p.certified_max_bytes = 1 << 20;
+    c.peak = c.now;
+    before = c.now;
+    ck_assert_int_eq(sdfccd_query_triangle(both, NULL, tri, &m, 0, 1, &p, ct, 8, &r), SDFCCD_OK);
+    ck_assert_int_le(c.peak - before, p.certified_max_bytes);
+    ck_assert_int_eq(r.state, SDFCCD_STATE_NOT_CONVERGED);
+    ck_assert_int_eq(r.hit, 1);
+    ck_assert_int_ge(r.contact_count, 1);
+    ck_assert(r.toi >= alone.toi_lower && r.toi <= 1.0);
+    ck_assert(r.toi_lower <= alone.toi_lower);
+    ck_assert(ct[0].distance <= p.margin && ct[0].toi == r.toi);
+    double v;
+    ck_assert_int_eq(sdfccd_sdf_eval(ball, ct[0].point, &v, NULL), SDFCCD_OK);
+    ck_assert(v <= 1e-12);
+    p.certified_max_bytes = SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES;
+
+    /* The 1,656-triangle sheet 1 nm above the torus, through a workspace warmed by the same query,
+     * so that the second query's allocations are the certified searches alone: their peak stays
+     * under the cap; no contact; the untested triangles prove nothing, so toi_lower is t0. */
+    sdfccd_MeshId sheet = make_sheet_xy(36, 23, 3.0, z);
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    p.certified_max_bytes = 131072;
+    ck_assert_int_eq(sdfccd_query_mesh_ws(ws, torus, NULL, sheet, &m, 0, 1, &p, ct, 8, &r), SDFCCD_OK);
+    c.peak = c.now;
+    before = c.now;
+    sdfccd_QueryResult again;
+    ck_assert_int_eq(sdfccd_query_mesh_ws(ws, torus, NULL, sheet, &m, 0, 1, &p, ct, 8, &again), SDFCCD_OK);
+    fprintf(stderr, "1,656-triangle sheet 1 nm above the torus, cap %lld: peak %lld bytes, %lld evaluations, %lld triangles\n",
+            (long long)p.certified_max_bytes, (long long)(c.peak - before), (long long)again.sdf_evaluations,
+            (long long)again.triangles_tested);
+    ck_assert_int_le(c.peak - before, p.certified_max_bytes);
+    ck_assert_int_gt(c.peak - before, p.certified_max_bytes / 2);
+    ck_assert_int_eq(again.state, SDFCCD_STATE_NOT_CONVERGED);
+    ck_assert_int_eq(again.hit, 0);
+    ck_assert(again.toi == 1.0 && again.toi_lower == 0.0);
+    ck_assert_int_eq(again.sdf_evaluations, r.sdf_evaluations); /* deterministic */
+    sdfccd_destroy_workspace(ws);
+
+    /* A certified query that converges gives the same result bit for bit with any cap it does
+     * not reach: the cap changes nothing until the store is full. */
+    sdfccd_RigidMotion fall = sdfccd_default_rigid_motion();
+    fall.pose.position.z = 0.3;
+    fall.local_center = (sdfccd_Vec3){ 1.0, 0.0, z };
+    fall.linear_velocity = (sdfccd_Vec3){ 0.3, 0.1, -0.6 };
+    fall.angular_velocity = (sdfccd_Vec3){ 0.4, -1.1, 0.7 };
+    sdfccd_QueryResult capped, free_run;
+    p.certified_max_bytes = SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES;
+    ck_assert_int_eq(sdfccd_query_triangle(torus, NULL, tri, &fall, 0, 1, &p, NULL, 0, &capped), SDFCCD_OK);
+    p.certified_max_bytes = INT64_MAX;
+    ck_assert_int_eq(sdfccd_query_triangle(torus, NULL, tri, &fall, 0, 1, &p, NULL, 0, &free_run), SDFCCD_OK);
+    ck_assert_int_eq(capped.state, SDFCCD_STATE_HIT);
+    ck_assert(capped.toi == free_run.toi && capped.toi_lower == free_run.toi_lower);
+    ck_assert_int_eq(capped.sdf_evaluations, free_run.sdf_evaluations);
+
+    ck_assert_int_eq(sdfccd_destroy_mesh(sheet), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(both), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(ball), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(sphere), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(torus), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_byte_count(), 0);
+    ck_assert_int_eq(sdfccd_set_allocator(NULL, NULL, NULL), SDFCCD_OK);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("hardening");
@@ -535,6 +689,7 @@ int main(void)
     tcase_add_test(tc, test_destroy_while_querying);
     tcase_add_test(tc, test_registry_in_user_allocator);
     tcase_add_test(tc, test_memory_limits);
+    tcase_add_test(tc, test_certified_memory_cap);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -35,6 +35,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.fwgss_clear_proof = 64;
     p.fwgss_brent_spatial = 0;
     p.fwgss_gap_tolerance = 0.5;
+    p.certified_max_bytes = SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES;
     return p;
 }
 
@@ -98,6 +99,10 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     out->max_rotation = in->max_rotation_per_segment;
     out->cert_time_tol = in->certified_time_tolerance;
     out->cert_max_regions = in->certified_max_regions;
+    if (in->certified_max_bytes < 1)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->certified_max_bytes must be >= 1 (got %lld)", fn,
+                             (long long)in->certified_max_bytes);
+    out->cert_max_bytes = in->certified_max_bytes;
     out->broad_phase = in->broad_phase != 0;
     out->max_evals = in->max_sdf_evaluations;
     out->fwgss_secant = in->fwgss_secant_entry != 0;

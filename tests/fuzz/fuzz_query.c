@@ -203,6 +203,10 @@ static void fz_params(fuzz_in* in, sdfccd_QueryParams* p)
         if (p->max_sdf_evaluations > SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS) p->max_sdf_evaluations = SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS;
     }
     if (mask & 64) p->internal_value = (int32_t)fz_u32(in);
+    if (mask & 128) { /* log-uniform, from -1 (refused) up to 2 GiB */
+        const int e = fz_u8(in) % 32;
+        p->certified_max_bytes = (int64_t)(fz_u32(in) % (1u << e)) - 1;
+    }
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)

@@ -100,10 +100,20 @@ typedef struct sdfccd_QueryParams {
                                         speed bound), which cannot hide a contact of the searched path (phi stays above
                                         (1 - g) x that gap on the bracket). Searches at contact keep the full precision.
                                         Finite, >= 0; 0 = off. Default 0.5. */
+    int64_t certified_max_bytes;   /**< CERTIFIED: most bytes the region store of one triangle's search may hold (>= 1),
+                                        counted at its peak, when a growing store holds its old and new arrays (64 bytes
+                                        per region). Checked before growing: when the next growth would pass it the search
+                                        stops with ::SDFCCD_STATE_NOT_CONVERGED, the earliest contact witnessed so far
+                                        (`hit` = 1) or none, and `toi_lower` the time before which no contact is proven.
+                                        A mesh query searches one triangle at a time, so this bounds the whole query's
+                                        region store. Default SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
 #define SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS 5000000
+/** Default of sdfccd_QueryParams::certified_max_bytes: 32 MiB, i.e. at most 262,144 regions in the store after
+ * its last doubling (24 MiB while it doubles). */
+#define SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES 33554432
 /** Largest total rotation (rad) of a query's motions over [t0, t1] (sum of the angular speeds of the
  * body and the SDF times t1 - t0). Beyond it the rotation angle's rounding error exceeds about
  * 1e-10 rad and the motion model is no longer accurate: the query returns ::SDFCCD_INVALID_ARGUMENT. */
