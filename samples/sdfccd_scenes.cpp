@@ -6,7 +6,8 @@
 //                 [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]
 //                 [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]
 //                 [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]
-//                 [--projection T] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]
+//                 [--projection T] [--spread-depth-fraction F] [--data DIR] [--check KEY=LIMIT,...]
+//                 [--quiet] [--table4]
 //
 // --patch-band B / --hard-clamp T / --spread-depth-scale D / --solver-iterations N override the
 // Bullet scenes' set-up (the bridge's Config::patch_band, Bridge::setHardClamp tolerance,
@@ -15,7 +16,9 @@
 // (off with DCD) and D = 0.01, the Bullet re-creations to the bridge's defaults.
 // B < 0 given also drops the extra manifolds (Bullet's single 4-point manifold). --extra-manifolds N / --kick W / --cover-depth D /
 // --projection T override the bridge's Config::extra_manifolds, kick_angular_speed, cover_depth
-// and projection_tolerance (0: off); by default the bridge's own defaults.
+// and projection_tolerance (0: off); by default the bridge's own defaults. --spread-depth-fraction F
+// overrides Config::spread_depth_fraction (0: off); a depth scale D >= 0 (given or the scene's)
+// turns it off unless F is given, so D is the scale used.
 // --table4 adds the paper's Table 4 figures (the CCD of the coming step through the C ABI, timed,
 // up to the first contact; see runner.h) as a "table4" line of the summary.
 // The Bullet build (float or double btScalar) is a separate library, so this program is built
@@ -61,7 +64,7 @@ void usage(std::FILE* f)
                  "                     [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]\n"
                  "                     [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]\n"
                  "                     [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]\n"
-                 "                     [--projection T] [--data DIR]\n"
+                 "                     [--projection T] [--spread-depth-fraction F] [--data DIR]\n"
                  "                     [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
                  "check keys: max_pen max_pen_ccd min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
 }
@@ -138,6 +141,7 @@ int main(int argc, char** argv)
         else if (a == "--extra-manifolds") opt.extra_manifolds = std::atoi(value("a count (0-3)"));
         else if (a == "--kick") opt.kick = std::atof(value("rad/s"));
         else if (a == "--cover-depth") opt.cover_depth = std::atof(value("metres"));
+        else if (a == "--spread-depth-fraction") opt.spread_depth_fraction = std::atof(value("a fraction of the mesh's radius (0: off)"));
         else if (a == "--projection") opt.projection = std::atof(value("metres (0: off)"));
         else if (a == "--data") opt.data_dir = value("a folder");
         else if (a == "--check") check = value("limits");

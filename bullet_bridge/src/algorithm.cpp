@@ -150,6 +150,7 @@ BridgeImpl::BridgeImpl(const Config& c) : cfg(c)
     cfg.extra_manifolds = std::max(0, std::min(cfg.extra_manifolds, 3));
     if (!(cfg.kick_angular_speed >= 0)) cfg.kick_angular_speed = 0;
     if (!(cfg.cover_depth >= 0)) cfg.cover_depth = 0;
+    if (!(cfg.spread_depth_fraction >= 0)) cfg.spread_depth_fraction = 0;
     if (!(cfg.contact_margin >= 0)) cfg.contact_margin = 0;
     if (!(cfg.vertex_distance >= 0)) cfg.vertex_distance = 0;
 }

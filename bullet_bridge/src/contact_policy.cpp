@@ -604,8 +604,10 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         pairs.push_back(r);
     }
     const double tol = std::max(1e-6, 1e-3 * radius);
+    double depth_scale = cfg.spread_depth_scale;
+    if (cfg.spread_depth_fraction > 0) depth_scale = std::min(depth_scale, cfg.spread_depth_fraction * radius);
     std::vector<int> pick;
-    if (any) pick = reduceContacts(scratch, cfg.max_contacts, tol, cfg.spread_depth_scale, -1);
+    if (any) pick = reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, -1);
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;
@@ -630,7 +632,7 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
             sub.push_back(scratch[i]);
             from.push_back(i);
         }
-        for (int i : reduceContacts(sub, (int)MANIFOLD_CACHE_SIZE, tol, cfg.spread_depth_scale, -1)) pick.push_back(from[i]);
+        for (int i : reduceContacts(sub, (int)MANIFOLD_CACHE_SIZE, tol, depth_scale, -1)) pick.push_back(from[i]);
     } else if (any && !pick.empty() && extra_limit > 0) {
         const btVector3& n = scratch[pick[0]].n0;
         const double w_tilt = (double)(w - n * n.dot(w)).length();

@@ -61,7 +61,11 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     if (opt.margin >= 0) cfg.contact_margin = opt.margin;
     cfg.patch_band = std::isnan(opt.patch_band) ? setup.patch_band : opt.patch_band;
     const double sds = std::isnan(opt.spread_depth_scale) ? setup.spread_depth_scale : opt.spread_depth_scale;
-    if (sds >= 0) cfg.spread_depth_scale = sds;
+    if (sds >= 0) {
+        cfg.spread_depth_scale = sds; // the scale used as given
+        cfg.spread_depth_fraction = 0;
+    }
+    if (opt.spread_depth_fraction >= 0) cfg.spread_depth_fraction = opt.spread_depth_fraction;
     // --patch-band -1 (B < 0 given) is Bullet's single 4-point manifold: no extra points either.
     if (!std::isnan(opt.patch_band) && opt.patch_band < 0) cfg.extra_manifolds = 0;
     if (opt.extra_manifolds >= 0) cfg.extra_manifolds = opt.extra_manifolds;

@@ -46,6 +46,8 @@ struct Options {
     double kick = -1;           /**< Bullet scenes: the bridge's Config::kick_angular_speed (< 0: its default). */
     double cover_depth = -1;    /**< Bullet scenes: the bridge's Config::cover_depth (< 0: its default). */
     double projection = -1;     /**< Bullet scenes: the bridge's Config::projection_tolerance (< 0: its default; 0: off). */
+    double spread_depth_fraction = -1; /**< Bullet scenes: the bridge's Config::spread_depth_fraction (< 0: its default, or
+                                            0 when a spread depth scale >= 0 is set; 0: off). */
     std::string data_dir; /**< The project's data/ folder. */
 };
 

@@ -141,9 +141,16 @@ struct Config {
      * corners). Default 0.02 m. */
     double vertex_distance = 0.02;
     /** The reduction to 4 points weighs a candidate's spread (distance, area) by
-     * exp(-(its gap - the deepest gap) / spread_depth_scale): points about to touch are preferred
-     * to features that might only reach the surface late in the step. Default 0.3 m. */
+     * exp(-(its gap - the deepest gap) / scale): points about to touch are preferred to features
+     * that might only reach the surface late in the step. The scale is the smaller of this
+     * (default 0.3 m) and spread_depth_fraction times the mesh's radius. */
     double spread_depth_scale = 0.3;
+    /** The reduction's depth scale relative to the mesh's radius (the largest distance of a vertex
+     * from the mesh's origin); <= 0: spread_depth_scale alone. Default 0.1: for a body a few
+     * centimetres across, a fixed 0.3 m scale lets features millimetres above the surface win the
+     * manifold by their larger spread (a 9 cm torus lying flat held its outer rim 4-6 mm up
+     * instead of its bottom ring in contact, stood on one point and wobbled like Euler's disk). */
+    double spread_depth_fraction = 0.1;
     /** Extra manifolds per pair (0..3), for up to 4 more points each. The first 4 points (the
      * deepest and the points spreading the contact polygon) span the whole candidate set, far
      * speculative points included, so a body tipping flat can have ONE point in its contact patch,
