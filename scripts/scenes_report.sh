@@ -128,7 +128,7 @@ echo
 echo "| scene | variant | max pen. mm | tunnelled | moving at end | rest speed m/s | step ms | CCD ms (share) |"
 echo "|---|---|---|---|---|---|---|---|"
 } >> "$MD"
-bullet_scenes="gimpact-demo gimpact-shot-50 gimpact-shot-200 gimpact-shot-500 sdf-box sdf-box-btsdf sdf-box-torus"
+bullet_scenes="gimpact-demo gimpact-shot-50 gimpact-shot-200 gimpact-shot-500 sdf-box sdf-box-btsdf sdf-box-torus sdf-box-btsdf-torus"
 [ "${SCENES_REPORT_FAST:-0}" = 1 ] || bullet_scenes="$bullet_scenes landscape"
 for scene in $bullet_scenes; do
   for v in "bridge:" "stock:--stock"; do

@@ -17,7 +17,9 @@
 //                 9 cm torus (torus x0.06, mass 0.1) and small GImpact meshes (bunny x0.05 = 10 cm,
 //                 cube x0.08, torus x0.06; 9 bodies, quick: 3) dropped in.
 //  sdf-box-btsdf  the same through Bullet's own btSdfCollisionShape read from the same file.
-//  sdf-box-torus  the 9 cm torus dropped alone (the bridge issue's 5 mm limit).
+//  sdf-box-torus  the 9 cm torus dropped alone (the bridge issue's 5 mm limit and rest).
+//  sdf-box-btsdf-torus  the torus alone through btSdfCollisionShape (the bridge samples it
+//                 through queryPoint: Config::handle_bt_sdf_shape).
 //  landscape      BenchmarkDemo "landscape": Y up, g = -10, 1/60 s, 5 solver iterations; 200
 //                 GImpact bodies (cubes x2, tori x2, alternating) on a 10 x 10 grid 6 m apart,
 //                 two layers at y = 20 and 26, dropped on the wavy landscape
@@ -122,11 +124,14 @@ private:
 template <int kShot> Scene* createGImpactDemo(const Options& opt) { return built(new GImpactDemo(opt, kShot)); }
 
 // ---------------------------------------------------------------------------------------------
-enum SdfBoxVariant { kOurShape, kBtSdfShape, kTorusAlone };
-
 class SdfBox : public BulletScene {
 public:
-    SdfBox(const Options& opt, SdfBoxVariant v) : BulletScene(opt, btVector3(0, 0, -10), 2), m_variant(v) {}
+    /** `bt_sdf`: the tray is Bullet's btSdfCollisionShape (else our SdfShape); `torus_alone`: only
+     * the 9 cm torus is dropped. */
+    SdfBox(const Options& opt, bool bt_sdf, bool torus_alone)
+        : BulletScene(opt, btVector3(0, 0, -10), 2), m_btSdf(bt_sdf), m_torusAlone(torus_alone)
+    {
+    }
 
     bool build()
     {
@@ -138,7 +143,7 @@ public:
             return false;
         }
         Collider* c;
-        if (m_variant == kBtSdfShape) {
+        if (m_btSdf) {
             c = &addStaticBtSdf("concave_box", cdf, grid, btVector3(0, 0, 0), 96);
         } else {
             sdfccd_GridInfo gi;
@@ -152,7 +157,7 @@ public:
         if (!torus || !bunny || !cube) return false;
         btRigidBody* t = addMeshBody(torus, 0.1, btVector3(0.5f, 0, 0.5f), axisAngle(1, 0.3, 0, 0.7));
         t->setActivationState(DISABLE_DEACTIVATION);
-        if (m_variant != kTorusAlone) {
+        if (!m_torusAlone) {
             int n = o.quick ? 3 : 9;
             for (int i = 0; i < n; ++i) {
                 const std::shared_ptr<MeshData>& m = i % 3 == 0 ? bunny : i % 3 == 1 ? cube : torus;
@@ -164,10 +169,10 @@ public:
     }
 
 private:
-    SdfBoxVariant m_variant;
+    bool m_btSdf, m_torusAlone;
 };
 
-template <SdfBoxVariant kV> Scene* createSdfBox(const Options& opt) { return built(new SdfBox(opt, kV)); }
+template <bool kBtSdf, bool kTorusAlone> Scene* createSdfBox(const Options& opt) { return built(new SdfBox(opt, kBtSdf, kTorusAlone)); }
 
 // ---------------------------------------------------------------------------------------------
 // The landscape: the normalised height-field distance (y - h) / sqrt(1 + |grad h|^2) (first-order
@@ -262,11 +267,13 @@ void appendBulletRecreations(std::vector<SceneEntry>& t)
     t.push_back({ "gimpact-shot-200", "gimpact-demo plus a torus shot at 200 m/s", createGImpactDemo<200>, 480, 1.0 / 60 });
     t.push_back({ "gimpact-shot-500", "gimpact-demo plus a torus shot at 500 m/s", createGImpactDemo<500>, 480, 1.0 / 60 });
     t.push_back({ "sdf-box", "pybullet's SDF example: small GImpact meshes into concave_box.cdf through our SdfShape (Z up, 1/240 s)",
-                  createSdfBox<kOurShape>, 480, 1.0 / 240 });
-    t.push_back({ "sdf-box-btsdf", "sdf-box through Bullet's own btSdfCollisionShape (same .cdf file)", createSdfBox<kBtSdfShape>, 480,
+                  createSdfBox<false, false>, 480, 1.0 / 240 });
+    t.push_back({ "sdf-box-btsdf", "sdf-box through Bullet's own btSdfCollisionShape (same .cdf file)", createSdfBox<true, false>, 480,
                   1.0 / 240 });
-    t.push_back({ "sdf-box-torus", "the 9 cm GImpact torus dropped alone into concave_box.cdf", createSdfBox<kTorusAlone>, 480,
+    t.push_back({ "sdf-box-torus", "the 9 cm GImpact torus dropped alone into concave_box.cdf", createSdfBox<false, true>, 480,
                   1.0 / 240 });
+    t.push_back({ "sdf-box-btsdf-torus", "sdf-box-torus through Bullet's own btSdfCollisionShape (same .cdf file)",
+                  createSdfBox<true, true>, 480, 1.0 / 240 });
     t.push_back({ "landscape", "BenchmarkDemo landscape: 200 GImpact cubes and tori on a wavy SDF landscape (Y up, 1/60 s)", createLandscape,
                   300, 1.0 / 60 });
 }
