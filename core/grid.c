@@ -339,9 +339,15 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
     locate(g, clamp_box(box->lo, &dom), a);
     locate(g, clamp_box(box->hi, &dom), b);
     const uint64_t count = (uint64_t)(b[0] - a[0] + 1) * (b[1] - a[1] + 1) * (b[2] - a[2] + 1);
+    /* Blocks (4^3 cells) the box touches. The cost of one call is bounded: at most 512 cells or
+     * 512 blocks are read, and a box touching more takes the global bound (a true bound, only
+     * looser), so a query's time stays proportional to its evaluations at any grid resolution
+     * (a box over a 256^3 grid used to read up to 262,144 blocks per call). */
+    const uint64_t blocks = (uint64_t)(b[0] / 4 - a[0] / 4 + 1) * (b[1] / 4 - a[1] / 4 + 1) * (b[2] / 4 - a[2] / 4 + 1);
     double L = 0.0;
-    if (count > 512 && g->block_lipschitz) {
-        /* large boxes: the per-block maxima (4^3 cells) of the blocks the box touches */
+    if (count > 512 && g->block_lipschitz && blocks > 512) L = global;
+    else if (count > 512 && g->block_lipschitz) {
+        /* large boxes: the per-block maxima of the blocks the box touches */
         const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4;
         for (uint32_t k = a[2] / 4; k <= b[2] / 4; ++k)
             for (uint32_t j = a[1] / 4; j <= b[1] / 4; ++j)
