@@ -559,6 +559,7 @@ START_TEST(test_certified_memory_cap)
     m.linear_velocity.x = 0.5;
     sdfccd_QueryParams p = sdfccd_default_query_params();
     p.method = SDFCCD_METHOD_CERTIFIED;
+    p.max_sdf_evaluations = 5000000; /* the budget of the 96 MiB finding: the memory cap must stop it first */
     ck_assert_int_eq(p.certified_max_bytes, SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES);
     sdfccd_QueryResult r;
     sdfccd_Contact ct[8];

@@ -150,7 +150,9 @@ START_TEST(test_random_sweep)
             p.subdivision = 0;
             sdfccd_QueryResult ref, r1, r2;
             p.method = SDFCCD_METHOD_CERTIFIED;
+            p.max_sdf_evaluations = 5000000; /* the reference: 3 of these cases need more than the 2M default */
             ck_assert_int_eq(sdfccd_query_triangle(sdfs[k], NULL, tri, &m, 0.0, DT, &p, NULL, 0, &ref), SDFCCD_OK);
+            p.max_sdf_evaluations = SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS;
             p.method = SDFCCD_METHOD_FWGSS;
             ck_assert_int_eq(sdfccd_query_triangle(sdfs[k], NULL, tri, &m, 0.0, DT, &p, NULL, 0, &r1), SDFCCD_OK);
             p.method = SDFCCD_METHOD_FW;

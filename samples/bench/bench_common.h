@@ -290,6 +290,7 @@ static sdfccd_QueryParams certified_params(void)
     sdfccd_QueryParams p = sdfccd_default_query_params();
     p.method = SDFCCD_METHOD_CERTIFIED;
     p.subdivision = 0;
+    p.max_sdf_evaluations = 5000000; /* the budget the data set's ground truth was made with (the default is 2M since issue 11) */
     return p;
 }
 

@@ -70,10 +70,13 @@ typedef struct sdfccd_QueryParams {
                                         ::SDFCCD_STATE_NOT_CONVERGED with the earliest contact witnessed so far
                                         (`hit` = 1) or none. The solvers check it once per iteration, so a query
                                         may exceed it by about one iteration (a few line searches). Default
-                                        SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS: on the 2-core machine of the README's
-                                        figures the slowest case, CERTIFIED, spends about 150 ns per evaluation
-                                        (0.8 s), FWGSS on an analytic SDF about 25 ns (0.13 s); SDFs slower to
-                                        evaluate take proportionally longer. */
+                                        SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS, chosen so that no query on the built-in
+                                        SDFs runs longer than about a second on the 2-core machine of the README's
+                                        figures, even loaded: the costliest evaluations there take about 400 ns (a
+                                        triangle spinning at 0.9e6 rad over a 32^3 grid, FWGSS; samples/sdfccd_worst),
+                                        analytic fields 80-150 ns. The time of a query is about this budget times
+                                        the cost of one evaluation, so callback SDFs and deep CSG or transform trees
+                                        (one evaluation evaluates every node) take proportionally longer. */
     int32_t fwgss_secant_entry;    /**< FWGSS: once the current point is in contact at the iterate's time and not at the
                                         interval start, its entry time is found by regula falsi with the Illinois
                                         modification on that sign change (a handful of evaluations) instead of the
@@ -110,7 +113,7 @@ typedef struct sdfccd_QueryParams {
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
-#define SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS 5000000
+#define SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS 2000000
 /** Default of sdfccd_QueryParams::certified_max_bytes: 32 MiB, i.e. at most 262,144 regions in the store after
  * its last doubling (24 MiB while it doubles). */
 #define SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES 33554432
