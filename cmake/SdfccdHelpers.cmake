@@ -19,6 +19,11 @@ function(sdfccd_target_defaults target)
     if(_type STREQUAL "STATIC_LIBRARY")
       # Whoever links an instrumented archive needs the sanitizer runtimes too.
       target_link_options(${target} INTERFACE -fsanitize=address,undefined)
+    elseif(_type STREQUAL "SHARED_LIBRARY")
+      # An instrumented shared library needs ASan's runtime first in the executable's library list
+      # ("ASan runtime does not come first"), so whoever links it is linked with the flags too
+      # (also through the installed package: sdfccd::sdfccd_shared, and sdfccd.pc's Libs).
+      target_link_options(${target} PUBLIC -fsanitize=address,undefined)
     elseif(NOT _type STREQUAL "OBJECT_LIBRARY")
       target_link_options(${target} PRIVATE -fsanitize=address,undefined)
     endif()

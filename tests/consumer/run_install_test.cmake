@@ -38,9 +38,15 @@ if("sdfccd_bullet" IN_LIST BULLET_TARGETS)
 elseif(BULLET_TARGETS)
   list(GET BULLET_TARGETS 0 with_bullet)
 endif()
+# The C++ compiler is passed only when the build tree has one (it enables C++ only for the bridge);
+# an empty -DCMAKE_CXX_COMPILER= made the consumer's configure step fail.
+set(cxx_arg "")
+if(CXX_COMPILER)
+  set(cxx_arg "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}")
+endif()
 execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${WORK_DIR}/build" -DCMAKE_PREFIX_PATH=${prefix}
                 -DCMAKE_BUILD_TYPE=Release -DREQUIRE_VERSION=${VERSION} -DWITH_BULLET=${with_bullet}
-                -DBULLET_SOURCE=${bullet_source} -DCMAKE_C_COMPILER=${C_COMPILER} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+                -DBULLET_SOURCE=${bullet_source} -DCMAKE_C_COMPILER=${C_COMPILER} ${cxx_arg}
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(rc)
   message(FATAL_ERROR "consumer configure (find_package(sdfccd ${VERSION})) failed:\n${out}\n${err}")
