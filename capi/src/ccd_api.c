@@ -7,46 +7,6 @@
 #include <stdio.h>
 #include <string.h>
 
-
-sdfccd_QueryParams sdfccd_default_query_params(void)
-{
-    sdfccd_QueryParams p;
-    SDFCCD__DEF_BEGIN(p);
-    p.method = SDFCCD_METHOD_FWGSS;
-    p.margin = 0.0;
-    p.time_tolerance = 1e-7;
-    p.distance_tolerance = 1e-7;
-    p.max_iterations = 32;
-    p.max_line_search_iterations = 64;
-    p.fwgss_restarts = 2;
-    p.fwgss_vertex_trace = 64;
-    p.subdivision = 1;
-    p.subdivision_min_area = 1e-4;
-    p.subdivision_max_depth = 3;
-    p.contact_slop = 1e-4;
-    p.toi_window = 1e-5;
-    p.max_rotation_per_segment = 3.14159265358979323846;
-    p.certified_time_tolerance = 1e-7;
-    p.certified_max_regions = 2000000;
-    p.broad_phase = 1;
-    p.max_sdf_evaluations = SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS;
-    p.fwgss_secant_entry = 1;
-    p.fwgss_speed_tolerance = 1;
-    p.fwgss_clear_proof = 64;
-    p.fwgss_brent_spatial = 0;
-    p.fwgss_gap_tolerance = 0.5;
-    p.certified_max_bytes = SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES;
-    return p;
-}
-
-sdfccd_RigidMotion sdfccd_default_rigid_motion(void)
-{
-    sdfccd_RigidMotion m;
-    memset(&m, 0, sizeof m);
-    m.pose.orientation.w = 1.0;
-    return m;
-}
-
 sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* fn, scc_params* out)
 {
     sdfccd_Status st;

@@ -135,18 +135,6 @@ int sdfccd__pool_parallel_for(void* user, int stage, uint32_t count, scc_task_fn
 
 /* ---------------- defs ---------------- */
 
-sdfccd_GridDef sdfccd_default_grid_def(void)
-{
-    sdfccd_GridDef d;
-    SDFCCD__DEF_BEGIN(d);
-    d.resolution[0] = d.resolution[1] = d.resolution[2] = 32;
-    d.fit_domain = 1;
-    d.band = 0.0;
-    d.threads = 0;
-    d.max_bytes = (int64_t)4 << 30;
-    return d;
-}
-
 static sdfccd_Status check_grid_def(const sdfccd_GridDef* def, const char* fn)
 {
     sdfccd_Status st;

@@ -88,13 +88,6 @@ sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count,
     return SDFCCD_OK;
 }
 
-sdfccd_MeshDef sdfccd_default_mesh_def(void)
-{
-    sdfccd_MeshDef d;
-    SDFCCD__DEF_BEGIN(d);
-    return d;
-}
-
 sdfccd_Status sdfccd_create_mesh(const sdfccd_MeshDef* def, sdfccd_MeshId* out_mesh)
 {
     sdfccd_Status st;

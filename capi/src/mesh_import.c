@@ -17,20 +17,6 @@
 #include <assimp/scene.h>
 #endif
 
-
-sdfccd_MeshLoadDef sdfccd_default_mesh_load_def(void)
-{
-    sdfccd_MeshLoadDef d;
-    SDFCCD__DEF_BEGIN(d);
-    d.scale = 1.0;
-    d.merge_vertices = 1;
-    d.drop_degenerate = 1;
-    d.max_file_bytes = (int64_t)256 << 20;
-    d.formats = NULL;
-    return d;
-}
-
-
 /* ---------------- welding and mesh creation shared by both readers ---------------- */
 
 /* Open-addressing table keyed by the exact bits of a position (with -0 folded into +0). */

@@ -113,17 +113,6 @@ sdfccd_Status sdfccd_create_half_space(sdfccd_Vec3 normal, double offset, sdfccd
     return sdfccd__sdf_register(s, out_sdf);
 }
 
-sdfccd_SpikeGridDef sdfccd_default_spike_grid_def(void)
-{
-    sdfccd_SpikeGridDef d;
-    SDFCCD__DEF_BEGIN(d);
-    d.spacing = 0.1;
-    d.base_radius = 0.05;
-    d.height = 0.1;
-    d.count_x = d.count_y = 20;
-    return d;
-}
-
 sdfccd_Status sdfccd_create_spike_grid(const sdfccd_SpikeGridDef* def, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
@@ -227,16 +216,6 @@ static double callback_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
         if (!scc_vfinite(*g)) *g = scc_v3(0.0, 0.0, 1.0); /* never hand NaN to a solver */
     }
     return v;
-}
-
-sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void)
-{
-    sdfccd_CallbackSdfDef d;
-    SDFCCD__DEF_BEGIN(d);
-    d.lipschitz = 1.0;
-    d.bounds.lo.x = d.bounds.lo.y = d.bounds.lo.z = -INFINITY;
-    d.bounds.hi.x = d.bounds.hi.y = d.bounds.hi.z = INFINITY;
-    return d;
 }
 
 sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfccd_SdfId* out_sdf)
