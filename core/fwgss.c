@@ -232,6 +232,15 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
     return 0;
 }
 
+/* Gradient bound for a conservative step from point x with gap phi: the field's bound in the
+ * box about the ball of radius phi (at least 1e-12). */
+static double step_lipschitz(const scc_fw_state* s, scc_vec3 x, double phi)
+{
+    scc_aabb box = { scc_sub(x, scc_v3(phi, phi, phi)), scc_add(x, scc_v3(phi, phi, phi)) };
+    double L = scc_sdf_lipschitz(s->sdf, &box);
+    return L > 1e-12 ? L : 1e-12;
+}
+
 /* The vertex path with weights b enters the margin between lo (phi - margin = flo > 0) and *io_t
  * (*io_phi <= margin), the last step of a conservative advancement; that step is short, so phi is
  * nearly linear on it and a few regula falsi steps move the witness to the crossing (otherwise it
@@ -297,8 +306,7 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
         }
         t_prev = t;
         f_prev = phi - s->p->margin;
-        scc_aabb box = { scc_sub(x, scc_v3(phi, phi, phi)), scc_add(x, scc_v3(phi, phi, phi)) };
-        double step = (phi - s->p->margin) / (fmax(scc_sdf_lipschitz(s->sdf, &box), 1e-12) * speed);
+        double step = (phi - s->p->margin) / (step_lipschitz(s, x, phi) * speed);
         /* Near the surface the steps shrink geometrically; a step of the time tolerance can then
          * pass a crossing by at most that tolerance. */
         t += fmax(step, s->p->time_tol);
@@ -315,6 +323,32 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
     }
 }
 
+#define CLEAR_STACK 32
+typedef struct clear_region { double u[3], v[3], t, rad; int depth; } clear_region;
+
+/* Radius about its centroid of the sub-triangle with barycentric corners (u[i], v[i],
+ * 1 - u[i] - v[i]) of the triangle x[0..2]. */
+static double region_radius(const scc_vec3 x[3], const double u[3], const double v[3], scc_vec3 c)
+{
+    double rad = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        scc_vec3 xi = scc_add(scc_add(scc_scale(x[0], u[i]), scc_scale(x[1], v[i])), scc_scale(x[2], 1.0 - u[i] - v[i]));
+        double d = scc_dist(xi, c);
+        if (d > rad) rad = d;
+    }
+    return rad * (1.0 + 1e-12);
+}
+
+/* A rigid motion keeps distances, so a region's radius is that of the offsets r0 (computed once
+ * per region); otherwise it is recomputed at each time (rad < 0). */
+static double region_radius_rigid(const scc_fw_state* s, const double u[3], const double v[3])
+{
+    if (!s->fast) return -1.0;
+    double cu = (u[0] + u[1] + u[2]) / 3.0, cv = (v[0] + v[1] + v[2]) / 3.0;
+    scc_vec3 c = scc_add(scc_add(scc_scale(s->r0[0], cu), scc_scale(s->r0[1], cv)), scc_scale(s->r0[2], 1.0 - cu - cv));
+    return region_radius(s->r0, u, v, c);
+}
+
 /* A proof that no point of the triangle reaches the margin during [ta, tb] (ours; the padded
  * sphere tracing of the broad phase, bsh.h, continued below the leaf): a sub-triangle (three
  * barycentric corners) whose points lie within r of its centroid c(t) cannot touch before
@@ -322,39 +356,39 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
  * a sub-triangle that cannot advance by a useful step is split in four. Returns 1 when every
  * sub-triangle reached tb within `budget` evaluations (then there is provably no contact), 0
  * otherwise (nothing is concluded; a point found in contact is recorded as a witness). */
-#define CLEAR_STACK 32
 static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int budget)
 {
-    typedef struct creg { double u[3], v[3], t; int depth; } creg;
-    creg stack[CLEAR_STACK];
+    clear_region stack[CLEAR_STACK];
     int n = 0;
-    stack[n++] = (creg){ { 1, 0, 0 }, { 0, 1, 0 }, ta, 0 };
+    stack[n] = (clear_region){ { 1, 0, 0 }, { 0, 1, 0 }, ta, 0.0, 0 };
+    stack[n].rad = region_radius_rigid(s, stack[n].u, stack[n].v);
+    ++n;
     const double margin = s->p->margin;
     while (n > 0) {
-        creg r = stack[--n];
+        clear_region r = stack[--n];
+        const double cu = (r.u[0] + r.u[1] + r.u[2]) / 3.0, cv = (r.v[0] + r.v[1] + r.v[2]) / 3.0;
+        const double bc[3] = { cu, cv, 1.0 - cu - cv };
         for (;;) {
             if (r.t >= tb) break;
             if (budget-- <= 0 || s->evals >= s->p->max_evals) return 0;
-            double cu = (r.u[0] + r.u[1] + r.u[2]) / 3.0, cv = (r.v[0] + r.v[1] + r.v[2]) / 3.0;
-            double bc[3] = { cu, cv, 1.0 - cu - cv };
-            scc_tri_state st;
-            scc_fw_tri_state(s, r.t, &st);
-            scc_vec3 c = scc_add(scc_add(scc_scale(st.x[0], bc[0]), scc_scale(st.x[1], bc[1])), scc_scale(st.x[2], bc[2]));
+            double rad = r.rad;
+            scc_vec3 c;
+            if (rad >= 0.0) {
+                c = scc_fw_point(s, bc, r.t, NULL);
+            } else {
+                scc_tri_state st;
+                scc_fw_tri_state(s, r.t, &st);
+                c = scc_add(scc_add(scc_scale(st.x[0], bc[0]), scc_scale(st.x[1], bc[1])), scc_scale(st.x[2], bc[2]));
+                rad = region_radius(st.x, r.u, r.v, c);
+            }
             double phi = scc_sdf_eval(s->sdf, c, NULL);
             s->evals++;
             if (phi <= margin) {
                 scc_fw_witness(s, r.t, bc, phi);
                 return 0;
             }
-            double rad = 0.0;
-            for (int i = 0; i < 3; ++i) {
-                scc_vec3 xi = scc_add(scc_add(scc_scale(st.x[0], r.u[i]), scc_scale(st.x[1], r.v[i])), scc_scale(st.x[2], 1.0 - r.u[i] - r.v[i]));
-                rad = fmax(rad, scc_dist(xi, c));
-            }
-            rad *= 1.0 + 1e-12;
             double R = phi - margin < phi ? phi - margin : phi; /* the bound is used inside the ball of radius phi */
-            scc_aabb box = { scc_sub(c, scc_v3(phi, phi, phi)), scc_add(c, scc_v3(phi, phi, phi)) };
-            double clear = R / fmax(scc_sdf_lipschitz(s->sdf, &box), 1e-12);
+            double clear = R / step_lipschitz(s, c, phi);
             if (clear > 2.0 * rad) {
                 r.t += (clear - rad) / speed;
                 continue;
@@ -367,10 +401,11 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
                 mu[i] = 0.5 * (r.u[i] + r.u[j]);
                 mv[i] = 0.5 * (r.v[i] + r.v[j]);
             }
-            stack[n++] = (creg){ { r.u[0], mu[0], mu[2] }, { r.v[0], mv[0], mv[2] }, r.t, r.depth + 1 };
-            stack[n++] = (creg){ { mu[0], r.u[1], mu[1] }, { mv[0], r.v[1], mv[1] }, r.t, r.depth + 1 };
-            stack[n++] = (creg){ { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] }, r.t, r.depth + 1 };
-            stack[n++] = (creg){ { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] }, r.t, r.depth + 1 };
+            stack[n++] = (clear_region){ { r.u[0], mu[0], mu[2] }, { r.v[0], mv[0], mv[2] }, r.t, 0.0, r.depth + 1 };
+            stack[n++] = (clear_region){ { mu[0], r.u[1], mu[1] }, { mv[0], r.v[1], mv[1] }, r.t, 0.0, r.depth + 1 };
+            stack[n++] = (clear_region){ { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] }, r.t, 0.0, r.depth + 1 };
+            stack[n++] = (clear_region){ { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] }, r.t, 0.0, r.depth + 1 };
+            for (int k = n - 4; k < n; ++k) stack[k].rad = region_radius_rigid(s, stack[k].u, stack[k].v);
             break;
         }
     }

@@ -31,7 +31,10 @@ static inline double scc_dist(scc_vec3 a, scc_vec3 b) { return scc_len(scc_sub(a
  * when every coordinate is in [1e-150, 1e150] or zero, else the coordinates scaled by the largest. */
 static inline double scc_hypot3(double x, double y, double z)
 {
-    double m = fmax(fabs(x), fmax(fabs(y), fabs(z)));
+    /* a NaN coordinate gives NaN either way below: plain comparisons (no libm call) suffice */
+    double ax = fabs(x), ay = fabs(y), az = fabs(z);
+    double m = ax > ay ? ax : ay;
+    m = m > az ? m : az;
     if (m <= 1e150 && m >= 1e-150) {
         double s = x * x + y * y + z * z;
         if (s >= 1e-300) return sqrt(s);
