@@ -6,8 +6,8 @@
 //                 [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]
 //                 [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]
 //                 [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]
-//                 [--projection T] [--spread-depth-fraction F] [--data DIR] [--check KEY=LIMIT,...]
-//                 [--quiet] [--table4]
+//                 [--projection T] [--spread-depth-fraction F] [--face-search S] [--data DIR]
+//                 [--check KEY=LIMIT,...] [--quiet] [--table4]
 //
 // --patch-band B / --hard-clamp T / --spread-depth-scale D / --solver-iterations N override the
 // Bullet scenes' set-up (the bridge's Config::patch_band, Bridge::setHardClamp tolerance,
@@ -18,7 +18,8 @@
 // --projection T override the bridge's Config::extra_manifolds, kick_angular_speed, cover_depth
 // and projection_tolerance (0: off); by default the bridge's own defaults. --spread-depth-fraction F
 // overrides Config::spread_depth_fraction (0: off); a depth scale D >= 0 (given or the scene's)
-// turns it off unless F is given, so D is the scale used.
+// turns it off unless F is given, so D is the scale used. --face-search S sets the bridge's
+// Config::face_search_size (0: off; the spikes scene defaults to 0.02, others to off).
 // --table4 adds the paper's Table 4 figures (the CCD of the coming step through the C ABI, timed,
 // up to the first contact; see runner.h) as a "table4" line of the summary.
 // The Bullet build (float or double btScalar) is a separate library, so this program is built
@@ -64,7 +65,7 @@ void usage(std::FILE* f)
                  "                     [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]\n"
                  "                     [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]\n"
                  "                     [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]\n"
-                 "                     [--projection T] [--spread-depth-fraction F] [--data DIR]\n"
+                 "                     [--projection T] [--spread-depth-fraction F] [--face-search S] [--data DIR]\n"
                  "                     [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
                  "check keys: max_pen max_pen_ccd min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
 }
@@ -136,6 +137,7 @@ int main(int argc, char** argv)
         else if (a == "--margin") opt.margin = std::atof(value("metres"));
         else if (a == "--patch-band") opt.patch_band = std::atof(value("metres"));
         else if (a == "--spread-depth-scale") opt.spread_depth_scale = std::atof(value("metres"));
+        else if (a == "--face-search") opt.face_search = std::atof(value("metres (0: off)"));
         else if (a == "--solver-iterations") opt.solver_iterations = std::atoi(value("a count"));
         else if (a == "--hard-clamp") opt.hard_clamp = std::atof(value("metres"));
         else if (a == "--extra-manifolds") opt.extra_manifolds = std::atoi(value("a count (0-3)"));

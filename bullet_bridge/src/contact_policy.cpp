@@ -35,6 +35,9 @@ namespace detail {
 
 // Among points giving at least this share of the best spread, the one with the smallest gap wins.
 static const double kSpreadShare = 0.95;
+// The face search keeps the field's normal at a point of a face inside the SDF when it is
+// within about 25 degrees of the face's inward direction (a face on a smooth surface).
+static const double kFaceNormalAgreement = 0.9;
 
 // Adds points to `out` (up to k) maximising the spread of the projected points P.
 static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>& P, const btVector3& nref, int k, double tol,
@@ -243,6 +246,98 @@ struct Gatherer {
             addFromStart(local, (int)vt[i].second);
         }
     }
+    // The face search (Config::face_search_size): the mesh's triangles with an edge longer than
+    // `size` at pose (Mx, Sx), split into 4 at their edge midpoints down to regions with no edge
+    // longer than `size`; a region whose centroid is farther from the surface than `lipschitz`
+    // times its radius plus `accept` has no point within `accept` and is dropped; each remaining
+    // leaf's deepest point (the library's DCD on the leaf) within `accept` is a candidate,
+    // constrained by its own closest surface point at that pose. The library's queries give one
+    // point per triangle and subdivide only around a point in contact: a face over features
+    // smaller than itself (the spike grid's tips) can have every vertex and every point they
+    // find clear of the surface while tips between them pierce it. Returns the regions visited.
+    int64_t searchFaces(double size, const btTransform& Mx, const btTransform& Sx, double accept, double lipschitz,
+                        const sdfccd_QueryParams& base)
+    {
+        sdfccd_QueryParams p = base;
+        p.method = SDFCCD_METHOD_DCD;
+        p.margin = accept;
+        p.subdivision = 0;
+        sdfccd_RigidMotion mm = sdfccd_default_rigid_motion(), sm = sdfccd_default_rigid_motion();
+        mm.pose = toPose(Mx);
+        sm.pose = toPose(Sx);
+        const btTransform rel = Sx.inverseTimes(Mx); // mesh frame -> SDF frame
+        const btMatrix3x3 sdf_basis_t = Sx.getBasis().transpose();
+        const double size2 = size * size;
+        struct Region {
+            btVector3 c[3];
+        };
+        std::vector<Region> stack;
+        int64_t visited = 0;
+        const size_t nt = me->indices.size() / 3;
+        for (size_t t = 0; t < nt; ++t) {
+            Region r;
+            for (int j = 0; j < 3; ++j) {
+                const double* v = &me->vertices[3 * (size_t)me->indices[3 * t + j]];
+                r.c[j] = btVector3((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
+            }
+            auto longest2 = [](const Region& q) {
+                return (double)std::max((q.c[1] - q.c[0]).length2(), std::max((q.c[2] - q.c[1]).length2(), (q.c[0] - q.c[2]).length2()));
+            };
+            if (!(longest2(r) > size2)) continue; // the library's queries cover it
+            stack.assign(1, r);
+            while (!stack.empty()) {
+                const Region q = stack.back();
+                stack.pop_back();
+                ++visited;
+                const btVector3 mid = (q.c[0] + q.c[1] + q.c[2]) / btScalar(3);
+                const double rad = (double)std::max((q.c[0] - mid).length(), std::max((q.c[1] - mid).length(), (q.c[2] - mid).length()));
+                double phi = 0;
+                ++evals;
+                if (sdfccd_sdf_eval(sdf, v3(rel * mid), &phi, nullptr) != SDFCCD_OK || !(phi - lipschitz * rad <= accept)) continue;
+                if (longest2(q) > size2) {
+                    const btVector3 m01 = (q.c[0] + q.c[1]) * btScalar(0.5), m12 = (q.c[1] + q.c[2]) * btScalar(0.5),
+                                    m20 = (q.c[2] + q.c[0]) * btScalar(0.5);
+                    stack.push_back(Region{ { q.c[0], m01, m20 } });
+                    stack.push_back(Region{ { m01, q.c[1], m12 } });
+                    stack.push_back(Region{ { m20, m12, q.c[2] } });
+                    stack.push_back(Region{ { m12, m20, m01 } });
+                    continue;
+                }
+                const sdfccd_Vec3 tri[3] = { v3(q.c[0]), v3(q.c[1]), v3(q.c[2]) };
+                sdfccd_Contact k;
+                sdfccd_QueryResult res;
+                if (sdfccd_query_triangle(sdf, &sm, tri, &mm, 0.0, 0.0, &p, &k, 1, &res) != SDFCCD_OK) continue;
+                evals += res.sdf_evaluations;
+                if (!res.hit || res.contact_count < 1) continue;
+                const btVector3 pt = bt(k.point);
+                const btVector3 nL = sdf_basis_t * bt(k.normal);
+                const btVector3 local = Mx.invXform(pt), qs = Sx.invXform(pt);
+                // A point of the face inside the SDF where the field's normal is far from the
+                // face's (a tip through the face: inside a cone the gradient points out of its
+                // side, mostly sideways) is pushed out along the face's normal instead, to where
+                // that line leaves the SDF (the tip's apex), as a face resting on a vertex is.
+                btVector3 u = -(rel.getBasis() * (r.c[1] - r.c[0]).cross(r.c[2] - r.c[0]));
+                const btScalar ul = u.length();
+                if (k.distance < 0 && ul > btScalar(0) && (u /= ul, (double)nL.dot(u) < kFaceNormalAgreement)) {
+                    btVector3 e = qs;
+                    double ph = k.distance, walked = 0;
+                    for (int it = 0; it < 64 && ph < 0 && walked < 4 * size; ++it) {
+                        const double stepl = std::max(-ph / lipschitz, 1e-7);
+                        e += u * (btScalar)stepl;
+                        walked += stepl;
+                        ++evals;
+                        if (sdfccd_sdf_eval(sdf, v3(e), &ph, nullptr) != SDFCCD_OK) break;
+                    }
+                    if (ph >= -1e-6 && walked < 4 * size) {
+                        add(local, e, u, (int)t);
+                        continue;
+                    }
+                }
+                add(local, qs - nL * (btScalar)k.distance, nL, (int)t);
+            }
+        }
+        return visited;
+    }
     // Each contact at its own triangle's time of impact, plus the vertices of that triangle within
     // `accept` of the surface at that time (a face landing flat gives its corners).
     void addContacts(const sdfccd_Contact* cs, int count, double accept)
@@ -423,6 +518,19 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         if (start_ok && r0.hit)
             for (int i = 0; i < r0.contact_count && !starts_touching; ++i) starts_touching = start_contacts[(size_t)i].distance <= margin;
     }
+    // The face search (Config::face_search_size; part of the subdivision, so off without it): at
+    // the start pose over the step's reach (DCD, the discrete baseline: at the end pose within
+    // the margin, as its own query). Its features count like the start-pose query's, even when
+    // the CCD query misses them (a face landing flat on tips between its FW points).
+    size_t face_found = 0;
+    if (dt > 0 && cfg.face_search_size > 0 && params.subdivision) {
+        sdfccd_SdfInfo info;
+        const double lip = sdfccd_sdf_get_info(G.sdf, &info) == SDFCCD_OK && info.lipschitz > 0 ? info.lipschitz : 1.0;
+        stats.face_regions += continuous ? G.searchFaces(cfg.face_search_size, G.M.t0, G.S.t0, start_margin, lip, params)
+                                         : G.searchFaces(cfg.face_search_size, G.M.t1, G.S.t1, margin, lip, params);
+        face_found = cands.size();
+        for (size_t i = 0; i < face_found && continuous && !starts_touching; ++i) starts_touching = cands[i].d <= margin;
+    }
     if (starts_touching) {
         stats.queries_skipped++;
         stats.last_state = (int)SDFCCD_STATE_PENETRATING;
@@ -439,12 +547,10 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.last_state = (int)res.state;
         if (!res.hit) {
             stats.last_toi_fraction = 1;
-            // The predicted motion is clear: only a kick can bring the start pose's features in.
-            if (kick > 0 && start_ok && r0.hit) {
-                G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, start_margin);
-                return finish();
-            }
-            return false;
+            // The predicted motion is clear: only a kick can bring the start pose's features in,
+            // or the face search found features the CCD query missed.
+            if ((kick > 0 || face_found > 0) && start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, start_margin);
+            return cands.empty() ? false : finish();
         }
         stats.hits++;
         stats.last_toi_fraction = res.fraction;

@@ -72,6 +72,8 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     if (opt.kick >= 0) cfg.kick_angular_speed = opt.kick;
     if (opt.cover_depth >= 0) cfg.cover_depth = opt.cover_depth;
     if (opt.projection >= 0) cfg.projection_tolerance = opt.projection;
+    const double face = std::isnan(opt.face_search) ? setup.face_search : opt.face_search;
+    cfg.face_search_size = face > 0 ? face : 0;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
     if (m_bridge && cfg.patch_band >= 0) {
@@ -88,6 +90,11 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     if (m_bridge && sds >= 0) {
         char buf[96];
         std::snprintf(buf, sizeof buf, " [spread depth scale %g m]", sds);
+        m_description += buf;
+    }
+    if (m_bridge && cfg.face_search_size > 0 && cfg.query.subdivision) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, " [face search %g m]", cfg.face_search_size);
         m_description += buf;
     }
     m_bullet.reset(new BulletWorld(gravity, m_bridge.get()));

@@ -60,6 +60,13 @@ const double kHardClamp = 5e-4;
 // face, spread wider and won the manifold, and the shuriken rested 1.9 mm deep on the ground (0.0
 // at 0.01 m). --spread-depth-scale -1 gives the bridge's default.
 const double kSpreadDepthScale = 0.01;
+// The spike grid's tips are smaller than the coarse box's faces: the library's queries give one
+// point per triangle (Frank-Wolfe from its vertices, which sit between tips) and subdivide only
+// around a point in contact, so a face could land on and sink into tips while its vertices and
+// those points stayed clear (21.7 mm). The bridge's face search (Config::face_search_size) also
+// searches each face region by region down to 2 cm for every point within the step's reach.
+// Part of the subdivision (off with --no-subdivision); --face-search 0 turns it off.
+const double kSpikesFaceSearch = 0.02;
 
 // Appends an axis-aligned box (half extents h, centre c) to v/f, triangles counter-clockwise outward.
 void appendBox(std::vector<double>& v, std::vector<uint32_t>& f, const double* h, const double* c)
@@ -122,18 +129,19 @@ Collider& addGround(BulletScene& s, double top, double half = 3)
 class PaperScene : public BulletScene {
 public:
     /** `spread_depth_scale`: the scene's Config::spread_depth_scale (< 0: the bridge's default). */
-    explicit PaperScene(const Options& opt, double spread_depth_scale = kSpreadDepthScale)
-        : BulletScene(opt, btVector3(0, 0, (btScalar)-kG), 2, setup(opt, spread_depth_scale))
+    explicit PaperScene(const Options& opt, double spread_depth_scale = kSpreadDepthScale, double face_search = -1)
+        : BulletScene(opt, btVector3(0, 0, (btScalar)-kG), 2, setup(opt, spread_depth_scale, face_search))
     {
     }
 
 private:
-    static BridgeSetup setup(const Options& opt, double spread_depth_scale)
+    static BridgeSetup setup(const Options& opt, double spread_depth_scale, double face_search)
     {
         BridgeSetup s;
         s.patch_band = kPatchBand;
         s.hard_clamp = opt.method == SDFCCD_METHOD_DCD ? -1.0 : kHardClamp;
         s.spread_depth_scale = spread_depth_scale;
+        s.face_search = face_search;
         return s;
     }
 };
@@ -305,7 +313,7 @@ public:
 // ---------------------------------------------------------------------------------------------
 class Spikes : public PaperScene {
 public:
-    using PaperScene::PaperScene;
+    explicit Spikes(const Options& opt) : PaperScene(opt, kSpreadDepthScale, kSpikesFaceSearch) {}
     bool build()
     {
         std::shared_ptr<MeshData> box = loadDataMesh(options(), "bullet3/cube.obj", 0.5, "coarse_box");
@@ -317,6 +325,12 @@ public:
         Collider& c = addStaticSdf("spike_grid", spikes, btVector3(0, 0, 0), btQuaternion::getIdentity(),
                                    sdfccd_Aabb{ { -1.05, -1.05, -0.3 }, { 1.05, 1.05, 0.12 } }, 128, spikes);
         c.killBelow(up, 0.25 + 0.05); // the box's centre within 5 cm of resting on the ground plane
+        for (int i = 0; i < def.count_x; ++i) // the tips, measured at the faces' closest points
+            for (int j = 0; j < def.count_y; ++j) {
+                c.feature_points.push_back((i - 0.5 * (def.count_x - 1)) * def.spacing);
+                c.feature_points.push_back((j - 0.5 * (def.count_y - 1)) * def.spacing);
+                c.feature_points.push_back(def.height);
+            }
         btRigidBody* b = addMeshBody(box, 1, btVector3(0.02f, 0.03f, 0.6f), axisAngle(0, 0, 1, 0.3));
         b->setActivationState(DISABLE_DEACTIVATION);
         view = sdfccd_Aabb{ { -0.5, -0.5, -0.05 }, { 0.5, 0.5, 0.5 } };

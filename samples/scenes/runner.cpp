@@ -38,6 +38,43 @@ void worldSamples(const Body& b, std::vector<double>& out)
     for (int k = 0; k < 3; ++k) out[3 * (size_t)n + k] = c[k];
 }
 
+// The point of triangle (a, b, c) closest to p (Voronoi regions of the vertices, edges, face).
+void closestOnTriangle(const double* p, const double* a, const double* b, const double* c, double* out)
+{
+    double ab[3], ac[3], ap[3];
+    for (int k = 0; k < 3; ++k) {
+        ab[k] = b[k] - a[k];
+        ac[k] = c[k] - a[k];
+        ap[k] = p[k] - a[k];
+    }
+    auto set = [&](double u, double v) { // out = a + u ab + v ac
+        for (int k = 0; k < 3; ++k) out[k] = a[k] + u * ab[k] + v * ac[k];
+    };
+    const double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return set(0, 0);
+    double bp[3], cp[3];
+    for (int k = 0; k < 3; ++k) {
+        bp[k] = p[k] - b[k];
+        cp[k] = p[k] - c[k];
+    }
+    const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return set(1, 0);
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return set(d1 / (d1 - d3), 0);
+    const double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return set(0, 1);
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return set(0, d2 / (d2 - d6));
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6)); // on edge bc
+        for (int k = 0; k < 3; ++k) out[k] = b[k] + w * (c[k] - b[k]);
+        return;
+    }
+    const double den = 1.0 / (va + vb + vc);
+    set(vb * den, vc * den);
+}
+
 // Distance from p to a box (0 inside).
 double boxDistance(const sdfccd_Aabb& b, const double* p)
 {
@@ -174,6 +211,44 @@ void measure(Scene& scene, Measure& m)
                 }
             }
             if (phi[end - 1] < -scene.bodies[bi].mesh->half_thickness) m.tunnelled[bi] = 1;
+        }
+        // The collider's sharp features: each rigid body's triangles at their points closest to
+        // them (sample index -2 in the CSV). Both fields agree here (features are given for exact SDFs).
+        if (c.feature_points.empty() || !c.exact.index1) continue;
+        for (const auto& o : owner) {
+            const Body& b = scene.bodies[o.first];
+            if (b.deformable) continue;
+            const MeshData& mesh = *b.mesh;
+            std::vector<double> tri(mesh.v.size()); // vertices in the collider's frame
+            for (int i = 0; i < mesh.vertexCount(); ++i) {
+                double w[3];
+                b.frame.apply(&mesh.v[3 * (size_t)i], w);
+                c.frame.applyInverse(w, &tri[3 * (size_t)i]);
+            }
+            double centre[3];
+            c.frame.applyInverse(b.frame.p, centre);
+            for (size_t fi = 0; fi + 2 < c.feature_points.size(); fi += 3) {
+                const double* fp = &c.feature_points[fi];
+                const double d[3] = { fp[0] - centre[0], fp[1] - centre[1], fp[2] - centre[2] };
+                if (dot3(d, d) > mesh.radius * mesh.radius * 1.01 + 1e-6) continue;
+                for (int t = 0; t < mesh.triangleCount(); ++t) {
+                    double q[3];
+                    closestOnTriangle(fp, &tri[3 * (size_t)mesh.f[3 * (size_t)t]], &tri[3 * (size_t)mesh.f[3 * (size_t)t + 1]],
+                                      &tri[3 * (size_t)mesh.f[3 * (size_t)t + 2]], q);
+                    double p = 1e300;
+                    if (sdfccd_sdf_eval(c.exact, sdfccd_Vec3{ q[0], q[1], q[2] }, &p, nullptr) != SDFCCD_OK) continue;
+                    if (p < kDeepPhi) ++m.deep;
+                    m.min_phi_ccd = std::min(m.min_phi_ccd, p);
+                    if (p < m.body_min[o.first]) m.body_min[o.first] = p;
+                    if (p < m.min_phi) {
+                        m.min_phi = p;
+                        m.min_body = (int)o.first;
+                        m.min_collider = (int)ci;
+                        m.min_sample = -2;
+                        c.frame.apply(q, m.min_where);
+                    }
+                }
+            }
         }
     }
     for (size_t bi = 0; bi < nb; ++bi)

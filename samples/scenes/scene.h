@@ -39,6 +39,8 @@ struct Options {
                                   0.02 in the paper's rigid scenes, off in the Bullet re-creations). */
     double spread_depth_scale = NAN; /**< Bullet scenes: the bridge's Config::spread_depth_scale (m); < 0: the bridge's
                                           default (0.3); NaN: the scene's default (0.01 in the paper's rigid scenes). */
+    double face_search = NAN; /**< Bullet scenes: the bridge's Config::face_search_size (m; <= 0: off; NaN: the scene's
+                                   default, 0.02 in the spikes scene, off elsewhere). */
     int solver_iterations = -1; /**< Bullet scenes: btContactSolverInfo::m_numIterations; < 0: the scene's default. */
     double hard_clamp = NAN; /**< Bullet scenes: Bridge::setHardClamp with this tolerance (m); <= 0: off; NaN: the scene's
                                   default (0.5 mm in the paper's rigid scenes, off in the Bullet re-creations). */
@@ -131,6 +133,11 @@ struct Collider {
      * passes deeper inside `exact` than the body's half-thickness went through it (a thin plate
      * passed in one step, which a body may also fly around: the shuriken's breastplate). */
     bool kill_swept = false;
+    /** Sharp convex features of the surface (local frame, 3 per point: the spike grid's tips).
+     * A lattice on a coarse face can pass between them while they pierce it, so the runner also
+     * measures each rigid body's triangles at their points closest to these (the deepest point of
+     * a face pierced by a tip, exactly when the face is square to the tip's axis). */
+    std::vector<double> feature_points;
     /** The SDF the CCD queries use (what the bridge's shape wraps); for Table 4's probe queries. */
     sdfccd_SdfId ccd{};
     /** Sets the kill plane to "centre below height h along up". */

@@ -879,6 +879,76 @@ static void test_torus_flat()
     sdfccd_destroy_sdf(slab);
 }
 
+// ---- the face search (Config::face_search_size): a coarse box on the spike grid ----
+
+// How far the spike grid's tips (def's cones) reach into the box of half extents h at t (0: none).
+static double tipIntrusion(const sdfccd_SpikeGridDef& def, const btTransform& t, double h)
+{
+    double worst = 0;
+    for (int i = 0; i < def.count_x; ++i)
+        for (int j = 0; j < def.count_y; ++j) {
+            const btVector3 tip((btScalar)((i - 0.5 * (def.count_x - 1)) * def.spacing), (btScalar)((j - 0.5 * (def.count_y - 1)) * def.spacing),
+                                (btScalar)def.height);
+            const btVector3 l = t.invXform(tip);
+            const double in = std::min(h - std::fabs((double)l.x()), std::min(h - std::fabs((double)l.y()), h - std::fabs((double)l.z())));
+            worst = std::max(worst, in);
+        }
+    return worst;
+}
+
+// The box (0.5 m, 12 triangles) dropped flat from 10 cm onto the tips (0.1 m apart, so about 25
+// under its bottom face, none under its vertices): returns the deepest tip intrusion over the
+// run; *rest: its largest speed (|v| + |w| r) over the last second.
+static double runSpikesBox(double face_search, double* rest, sdfccd_bullet::Stats* stats)
+{
+    sdfccd_SpikeGridDef def = sdfccd_default_spike_grid_def();
+    sdfccd_SdfId spikes = { 0, 0 };
+    CHECK(sdfccd_create_spike_grid(&def, &spikes) == SDFCCD_OK, "spike grid: %s", sdfccd_last_error());
+    double worst = 0;
+    *rest = 0;
+    {
+        sdfccd_bullet::Config cfg;
+        cfg.face_search_size = face_search;
+        Bridge bridge(cfg);
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(spikes);
+        std::unique_ptr<TriMesh> box = makeBox(btVector3(0.25, 0.25, 0.25));
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(box->shape.get(), 1, btVector3(0.02f, 0.03f, 0.45f), btVector3(0.25, 0.25, 0.25));
+        btTransform t = body->getWorldTransform();
+        t.setRotation(btQuaternion(btVector3(0, 0, 1), btScalar(0.3)));
+        body->setWorldTransform(t);
+        body->setActivationState(DISABLE_DEACTIVATION);
+        for (int i = 0; i < 120; ++i) {
+            w.step();
+            worst = std::max(worst, tipIntrusion(def, body->getWorldTransform(), 0.25));
+            if (i >= 60)
+                *rest = std::max(*rest, (double)body->getLinearVelocity().length() + (double)body->getAngularVelocity().length() * 0.433);
+        }
+        *stats = bridge.stats();
+    }
+    sdfccd_destroy_sdf(spikes);
+    return worst;
+}
+
+static void test_face_search()
+{
+    double rest_on = 0, rest_off = 0;
+    sdfccd_bullet::Stats on, off;
+    const double with = runSpikesBox(0.02, &rest_on, &on);
+    const double without = runSpikesBox(0, &rest_off, &off);
+    // Without the search, the library's points (one per triangle from its vertices, subdivision
+    // only around a point in contact) miss the tips between the vertices and the box sinks.
+    CHECK(without > 0.005, "without the face search the tips reach only %.4f m into the box (the case is no test)", without);
+    CHECK(off.face_regions == 0, "face search ran while off: %lld regions", (long long)off.face_regions);
+    CHECK(with <= 0.001, "with the face search the tips reach %.4f m into the box (limit 0.001)", with);
+    CHECK(rest_on <= 0.05, "with the face search the box is still moving: %.4f m/s over the last second", rest_on);
+    CHECK(on.face_regions > 0, "face search never ran");
+    std::printf("box on spikes (%s): tip intrusion %.5f m with the face search (%lld regions), %.5f m without; rest speed %.4f / %.4f m/s\n",
+                SDFCCD_BULLET_PRECISION_NAME, with, (long long)on.face_regions, without, rest_on, rest_off);
+}
+
 static void test_compound_child()
 {
     // A GImpact cube as an offset, rotated child of a btCompoundShape (the usual way to move a
@@ -1279,6 +1349,7 @@ static const Test kTests[] = {
     { "corner_cube", test_corner_cube },
     { "torus_flat", test_torus_flat },
     { "compound_child", test_compound_child },
+    { "face_search", test_face_search },
     { "callbacks", test_callbacks },
     { "convex_box_fast", test_convex_box_fast },
     { "sdf_on_sdf", test_sdf_on_sdf },

@@ -175,6 +175,18 @@ struct Config {
      * this distance (m) of the deepest gap that the first 4 points leave out (the contact patch
      * around the deepest point). The paper's rigid scenes (samples/scenes) use 0.02. */
     double patch_band = -1;
+    /** Opt-in (<= 0: off, the default): the face search. With subdivision on, the mesh's triangles
+     * with an edge longer than this (m) are also searched region by region (split at the edge
+     * midpoints down to regions with no edge longer than it; regions the SDF's Lipschitz bound
+     * shows out of reach are dropped; each leaf's deepest point from the library's DCD), at the
+     * start pose over the step's reach (the DCD baseline: at the end pose within the margin).
+     * The library's queries give one point per triangle and subdivide only around a point in
+     * contact, so a face over SDF features smaller than itself (a coarse box on a spike grid)
+     * can have its vertices and those points clear while features between them pierce it.
+     * Cost: about (edge / size)^2 regions per triangle lying within the reach of a surface (a
+     * face flat on the ground is never dropped), so only for scenes that need it: the paper's
+     * spikes scene uses 0.02. Stats::face_regions counts the regions visited. */
+    double face_search_size = 0;
     /** In the discrete queries (start and end pose), adaptive subdivision does not split regions
      * smaller than (discrete_subdivision_scale x the mesh's radius)^2: such regions' points lie
      * within about that distance of the triangle's vertices, which are contact candidates
@@ -230,6 +242,7 @@ struct Stats {
     int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
     int64_t clamps = 0;                /**< Hard-clamp corrections. */
     int64_t projections = 0;           /**< End-of-step projections (Config::projection_tolerance). */
+    int64_t face_regions = 0;          /**< Regions visited by the face search (Config::face_search_size). */
     double last_toi_fraction = 1;      /**< Fraction of the last hit (1 when none). */
     int last_state = 0;                /**< sdfccd_ResultState of the last query. */
 };
