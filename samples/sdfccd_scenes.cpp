@@ -6,8 +6,8 @@
 //                 [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]
 //                 [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]
 //                 [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]
-//                 [--projection T] [--spread-depth-fraction F] [--face-search S] [--data DIR]
-//                 [--check KEY=LIMIT,...] [--quiet] [--table4]
+//                 [--projection T] [--spread-depth-fraction F] [--face-search S]
+//                 [--discrete-subdivision-scale S] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]
 //
 // --patch-band B / --hard-clamp T / --spread-depth-scale D / --solver-iterations N override the
 // Bullet scenes' set-up (the bridge's Config::patch_band, Bridge::setHardClamp tolerance,
@@ -20,6 +20,8 @@
 // overrides Config::spread_depth_fraction (0: off); a depth scale D >= 0 (given or the scene's)
 // turns it off unless F is given, so D is the scale used. --face-search S sets the bridge's
 // Config::face_search_size (0: off; the spikes scene defaults to 0.02, others to off).
+// --discrete-subdivision-scale S overrides Config::discrete_subdivision_scale (0: the discrete
+// queries subdivide as the library does).
 // --table4 adds the paper's Table 4 figures (the CCD of the coming step through the C ABI, timed,
 // up to the first contact; see runner.h) as a "table4" line of the summary.
 // The Bullet build (float or double btScalar) is a separate library, so this program is built
@@ -65,7 +67,8 @@ void usage(std::FILE* f)
                  "                     [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]\n"
                  "                     [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]\n"
                  "                     [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]\n"
-                 "                     [--projection T] [--spread-depth-fraction F] [--face-search S] [--data DIR]\n"
+                 "                     [--projection T] [--spread-depth-fraction F] [--face-search S]\n"
+                 "                     [--discrete-subdivision-scale S] [--data DIR]\n"
                  "                     [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
                  "check keys: max_pen max_pen_ccd min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
 }
@@ -145,6 +148,7 @@ int main(int argc, char** argv)
         else if (a == "--cover-depth") opt.cover_depth = std::atof(value("metres"));
         else if (a == "--spread-depth-fraction") opt.spread_depth_fraction = std::atof(value("a fraction of the mesh's radius (0: off)"));
         else if (a == "--projection") opt.projection = std::atof(value("metres (0: off)"));
+        else if (a == "--discrete-subdivision-scale") opt.discrete_subdivision_scale = std::atof(value("a fraction of the mesh radius"));
         else if (a == "--data") opt.data_dir = value("a folder");
         else if (a == "--check") check = value("limits");
         else if (a == "--quiet") quiet = true;

@@ -74,6 +74,7 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     if (opt.projection >= 0) cfg.projection_tolerance = opt.projection;
     const double face = std::isnan(opt.face_search) ? setup.face_search : opt.face_search;
     cfg.face_search_size = face > 0 ? face : 0;
+    if (opt.discrete_subdivision_scale >= 0) cfg.discrete_subdivision_scale = opt.discrete_subdivision_scale;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
     if (m_bridge && cfg.patch_band >= 0) {

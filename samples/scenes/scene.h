@@ -50,6 +50,8 @@ struct Options {
     double projection = -1;     /**< Bullet scenes: the bridge's Config::projection_tolerance (< 0: its default; 0: off). */
     double spread_depth_fraction = -1; /**< Bullet scenes: the bridge's Config::spread_depth_fraction (< 0: its default, or
                                             0 when a spread depth scale >= 0 is set; 0: off). */
+    double discrete_subdivision_scale = -1; /**< Bullet scenes: the bridge's Config::discrete_subdivision_scale (< 0: its
+                                                 default; 0: the library's own subdivision). */
     std::string data_dir; /**< The project's data/ folder. */
 };
 
