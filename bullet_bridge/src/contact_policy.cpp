@@ -696,10 +696,18 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     const double margin = closest ? std::max(0.0, (double)out->m_closestPointDistanceThreshold) : cfg.contact_margin;
     double radius = 0;
     btVector3 w(0, 0, 0);
+    const int64_t errors_before = stats.query_errors;
     const bool any = gather(mw, sw, dt, margin, scratch, &radius, &w);
-    // The clamp looks at every pair, the projection at pairs with candidates (a body farther
-    // from the SDF than its travel and kick reach cannot end the step inside it unless kicked).
-    if (!closest && (clamp_world || (any && projection_world))) {
+    // The clamp looks at every pair. The projection looks at pairs with candidates, and at the
+    // pairs the queries found clear: a body the queries proved clear for its PREDICTED motion can
+    // still end the step inside the SDF when another contact solved in the same step (a GImpact
+    // mesh-mesh hit) changes its motion; the projection checks those when the body ends the step
+    // farther from its predicted end pose than that proof allows. (Not with the DCD baseline,
+    // whose query does not prove the motion clear.)
+    const btRigidBody* mesh_body = btRigidBody::upcast(mo);
+    const bool clear = !any && dt > 0 && stats.query_errors == errors_before && cfg.query.method != SDFCCD_METHOD_DCD &&
+                       mesh_body && !mesh_body->isStaticOrKinematicObject();
+    if (!closest && (clamp_world || (projection_world && (any || clear)))) {
         PairRecord r;
         r.mesh = mo;
         r.sdf = so;
@@ -707,6 +715,10 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         r.child = mo->getWorldTransform().inverseTimes(mw->getWorldTransform());
         r.shape = mw->getCollisionShape();
         r.top = mo->getCollisionShape();
+        r.clear = clear;
+        r.predicted = mo->getInterpolationWorldTransform();
+        r.sdf_start = so->getWorldTransform();
+        r.margin = margin;
         pairs.push_back(r);
     }
     const double tol = std::max(1e-6, 1e-3 * radius);

@@ -138,7 +138,48 @@ int BridgeImpl::projectPairs(btCollisionWorld* world, double dt, double toleranc
         // The projection. A body that started the step that deep is left to the contacts (no
         // jump out of a deep start, e.g. a body created inside the SDF).
         sdfccd_Contact c;
-        if (!deepest(body->getWorldTransform(), &c) || deepest(p.start, nullptr)) continue;
+        if (p.clear) {
+            // The queries proved every feature at least the margin away from the surface over the
+            // predicted motion, the start included (phi is 1-Lipschitz). A feature moved by at
+            // most `moved` from its predicted end position is then at least margin - moved away:
+            // only a body that ended more than margin + tolerance from its predicted end pose (a
+            // kick from another contact in the same step) can be deeper than the tolerance.
+            if (p.sdf->getWorldTransform() == p.sdf_start) {
+                const btTransform d = (p.predicted * p.child).inverseTimes(body->getWorldTransform() * p.child);
+                const double moved = (double)d.getOrigin().length() + (double)d.getRotation().getAngleShortestPath() * me->radius;
+                if (moved <= p.margin + tolerance) continue;
+            }
+            if (!deepest(body->getWorldTransform(), &c) || deepest(p.start, nullptr)) continue; // as for any body
+            // Kicked: back along the step's actual motion, from its clear start, to where the mesh
+            // first came within half the tolerance of the surface, and no velocity into the
+            // surface there: the state a contact found at that time of impact would have left
+            // (the normal projection below could push a body that a kick carried across most of a
+            // thin part of the SDF out through its far side).
+            BodyMotion M;
+            M.t0 = p.start * p.child;
+            M.t1 = body->getWorldTransform() * p.child;
+            btTransformUtil::calculateVelocity(M.t0, M.t1, (btScalar)dt, M.v, M.w);
+            const sdfccd_RigidMotion mm = M.rigid();
+            sdfccd_QueryParams ccd = cfg.query;
+            ccd.margin = -0.5 * tolerance;
+            sdfccd_QueryResult res;
+            sdfccd_Contact hit;
+            if (dt > 0 && sdfccd_query_mesh(sdf, &sm, me->id, &mm, 0, dt, &ccd, &hit, 1, &res) == SDFCCD_OK && res.hit &&
+                res.state != SDFCCD_STATE_PENETRATING) {
+                body->setCenterOfMassTransform(M.at(res.toi) * p.child.inverse());
+                if (res.contact_count > 0) {
+                    const btVector3 nrm = bt(hit.normal);
+                    const btRigidBody* sdf_body = btRigidBody::upcast(p.sdf);
+                    const btVector3 v = body->getLinearVelocity();
+                    const btScalar vn = (v - (sdf_body ? sdf_body->getLinearVelocity() : btVector3(0, 0, 0))).dot(nrm);
+                    if (vn < 0) body->setLinearVelocity(v - nrm * vn);
+                }
+                ++moved;
+                continue;
+            }
+        } else if (!deepest(body->getWorldTransform(), &c) || deepest(p.start, nullptr)) {
+            continue;
+        }
         // Out along the deepest feature's normal to half the tolerance, like a positional (split
         // impulse) correction: the velocity is left to the contacts.
         for (int it = 0; it < 3; ++it) {

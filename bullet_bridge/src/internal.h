@@ -169,13 +169,19 @@ public:
     btInternalTickCallback user_pre = nullptr, user_post = nullptr; // chained by the clamp
     double clamp_tolerance = 1e-3;
     // The pairs of the step, for the clamp and the projection: the mesh body's pose at the start
-    // of the step, the wrapper's offset in it (compound child), the shapes.
+    // of the step, the wrapper's offset in it (compound child), the shapes. A pair the queries
+    // found clear (`clear`: no feature within `margin` of the surface over the predicted motion)
+    // keeps the predicted end pose and the SDF's pose, so the projection can tell whether the
+    // body ended elsewhere (a kick from another contact solved in the same step).
     struct PairRecord {
         const btCollisionObject* mesh;
         const btCollisionObject* sdf;
         btTransform start, child;
         const btCollisionShape* shape;
         const btCollisionShape* top;
+        bool clear = false;
+        btTransform predicted, sdf_start;
+        double margin = 0;
     };
     std::vector<PairRecord> pairs;
     // Moves bodies of the recorded pairs that end the step deeper than `tolerance` back out; returns
