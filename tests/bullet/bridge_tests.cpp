@@ -839,6 +839,62 @@ static void test_corner_cube()
     sdfccd_destroy_sdf(slab);
 }
 
+static void test_kicked_into_sdf()
+{
+    // A GImpact cube hovering 3 cm above an SDF slab, hit from above by another GImpact cube at
+    // 20 m/s (Bullet's own mesh-mesh algorithm, no CCD): the hit and the push into the slab happen
+    // in ONE step. The bridge found the hovering cube's predicted motion clear of the slab, so the
+    // slab has no contact with it in that step; the end-of-step projection must still apply: a
+    // body that ends a step deeper than Config::projection_tolerance, having started it less
+    // deep, is moved out. By induction no step may end with a vertex deeper than the tolerance
+    // (the exact box SDF at the 8 vertices, after every step).
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    double worst = 0, first = 0;
+    double tolerance = 0;
+    int64_t projections = 0;
+    {
+        Bridge bridge;
+        tolerance = bridge.config().projection_tolerance;
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> target = makeBox(btVector3(0.5, 0.5, 0.5));
+        std::unique_ptr<TriMesh> shot = makeBox(btVector3(0.5, 0.5, 0.5));
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        // Slab top at z = 0.05; the target's bottom 3 cm above it; the shot overlaps its top by 1 cm.
+        btRigidBody* body = w.add(target->shape.get(), 1, btVector3(0, 0, 0.58), btVector3(0.5, 0.5, 0.5));
+        btRigidBody* hammer = w.add(shot->shape.get(), 1, btVector3(0, 0, 1.57), btVector3(0.5, 0.5, 0.5));
+        // Tilted, so it strikes the target's top face with an edge (GImpact's float build misses
+        // two coplanar faces overlapping).
+        btTransform ht = hammer->getWorldTransform();
+        ht.setRotation(btQuaternion(btVector3(1, 0, 0), btScalar(0.3)));
+        ht.setOrigin(btVector3(0, 0, btScalar(1.06 + 0.5 * (std::cos(0.3) + std::sin(0.3)) - 0.02)));
+        hammer->setCenterOfMassTransform(ht);
+        hammer->setLinearVelocity(btVector3(0, 0, -20));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        hammer->setActivationState(DISABLE_DEACTIVATION);
+        btTransform id;
+        id.setIdentity();
+        for (int i = 0; i < 60; ++i) {
+            w.step();
+            const double pen = vertexPenetration(*target, body->getWorldTransform(), slab, id);
+            if (i == 0) first = pen;
+            worst = std::max(worst, pen);
+            if (kVerbose)
+                std::printf("  kicked step %d: z %.4f vz %.3f pen %.5f (shot z %.4f vz %.3f)\n", i, body->getCenterOfMassPosition().z(),
+                            body->getLinearVelocity().z(), pen, hammer->getCenterOfMassPosition().z(), hammer->getLinearVelocity().z());
+        }
+        projections = bridge.stats().projections;
+    }
+    CHECK(tolerance > 0, "the projection is on by default");
+    CHECK(projections > 0, "no projection happened");
+    CHECK(first <= tolerance, "the kicked cube ended its first step %.4f m deep (tolerance %.4f)", first, tolerance);
+    CHECK(worst <= tolerance, "a vertex ended a step %.4f m deep (tolerance %.4f)", worst, tolerance);
+    std::printf("cube kicked into a slab by a 20 m/s GImpact cube (%s): deepest vertex after a step %.5f m (first step %.5f), %lld projections\n",
+                SDFCCD_BULLET_PRECISION_NAME, worst, first, (long long)projections);
+    sdfccd_destroy_sdf(slab);
+}
+
 static void test_torus_flat()
 {
     // A GImpact torus (1536 triangles) lying flat, at 50 m/s onto a slab: its whole ring lands at
@@ -1348,6 +1404,7 @@ static const Test kTests[] = {
     { "hard_clamp", test_hard_clamp },
     { "corner_cube", test_corner_cube },
     { "torus_flat", test_torus_flat },
+    { "kicked_into_sdf", test_kicked_into_sdf },
     { "compound_child", test_compound_child },
     { "face_search", test_face_search },
     { "callbacks", test_callbacks },
