@@ -72,11 +72,13 @@ typedef struct sdfccd_QueryParams {
                                         may exceed it by about one iteration (a few line searches). Default
                                         SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS, chosen so that no query on the built-in
                                         SDFs runs longer than about a second on the 2-core machine of the README's
-                                        figures, even loaded: the costliest evaluations there take about 400 ns (a
-                                        triangle spinning at 0.9e6 rad over a 32^3 grid, FWGSS; samples/sdfccd_worst),
-                                        analytic fields 80-150 ns. The time of a query is about this budget times
-                                        the cost of one evaluation, so callback SDFs and deep CSG or transform trees
-                                        (one evaluation evaluates every node) take proportionally longer. */
+                                        figures: the costliest evaluations there take about 200 ns of CPU (a triangle
+                                        spinning at 0.9e6 rad over a 32^3 grid, FWGSS: 0.41 s per query;
+                                        samples/sdfccd_worst), analytic fields 50-80 ns; with both cores shared by
+                                        about 11 runnable processes the same query took 1.5 s of wall time. The time
+                                        of a query is about this budget times the cost of one evaluation, so callback
+                                        SDFs and deep CSG or transform trees (one evaluation evaluates every node)
+                                        take proportionally longer. */
     int32_t fwgss_secant_entry;    /**< FWGSS: once the current point is in contact at the iterate's time and not at the
                                         interval start, its entry time is found by regula falsi with the Illinois
                                         modification on that sign change (a handful of evaluations) instead of the
