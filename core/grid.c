@@ -339,14 +339,18 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
     locate(g, clamp_box(box->lo, &dom), a);
     locate(g, clamp_box(box->hi, &dom), b);
     const uint64_t count = (uint64_t)(b[0] - a[0] + 1) * (b[1] - a[1] + 1) * (b[2] - a[2] + 1);
-    /* Blocks (4^3 cells) the box touches. The cost of one call is bounded: at most 512 cells or
+    /* Blocks (4^3 cells) the box touches. The cost of one call is bounded: at most 64 cells or
      * 512 blocks are read, and a box touching more takes the global bound (a true bound, only
      * looser), so a query's time stays proportional to its evaluations at any grid resolution
-     * (a box over a 256^3 grid used to read up to 262,144 blocks per call). */
+     * (a box over a 256^3 grid used to read up to 262,144 blocks per call). Boxes of more than
+     * 64 cells read the block maxima (at most 8 blocks per 64 cells, a bound just as true): the
+     * FWGSS vertex trace and clear proof call this once per step, and reading up to 512 cells
+     * per call was a fifth of a query against a 32^3 grid, for a bound only slightly tighter
+     * (+0.2% evaluations on the data set). */
     const uint64_t blocks = (uint64_t)(b[0] / 4 - a[0] / 4 + 1) * (b[1] / 4 - a[1] / 4 + 1) * (b[2] / 4 - a[2] / 4 + 1);
     double L = 0.0;
-    if (count > 512 && g->block_lipschitz && blocks > 512) L = global;
-    else if (count > 512 && g->block_lipschitz) {
+    if (count > 64 && g->block_lipschitz && blocks > 512) L = global;
+    else if (count > 64 && g->block_lipschitz) {
         /* large boxes: the per-block maxima of the blocks the box touches */
         const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4;
         for (uint32_t k = a[2] / 4; k <= b[2] / 4; ++k)
