@@ -29,7 +29,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.max_sdf_evaluations = SDFCCD_DEFAULT_MAX_SDF_EVALUATIONS;
     p.fwgss_secant_entry = 1;
     p.fwgss_speed_tolerance = 1;
-    p.fwgss_clear_proof = 64;
+    p.fwgss_clear_proof = 32;
     p.fwgss_brent_spatial = 0;
     p.fwgss_gap_tolerance = 0.5;
     p.certified_max_bytes = SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES;

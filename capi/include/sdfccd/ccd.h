@@ -91,7 +91,7 @@ typedef struct sdfccd_QueryParams {
                                         triangle stays clear of the field (conservative advancement of sub-triangles with
                                         the field's Lipschitz bound, split when stalled); when it succeeds the triangle
                                         has no contact and the descents are skipped. A proof, so it never loses a contact.
-                                        0 = off. Default 64. */
+                                        0 = off. Default 32. */
     int32_t fwgss_brent_spatial;   /**< FWGSS: the spatial line searches (Algorithm 2 lines 22-31) use Brent's method
                                         (parabolic steps safeguarded by golden section), which needs fewer SDF
                                         evaluations where phi is smooth along the segment (data set: 11-24 % fewer per
