@@ -215,7 +215,7 @@ public:
     bool build()
     {
         const Options& o = options();
-        world()->getSolverInfo().m_numIterations = 5;
+        if (o.solver_iterations <= 0) world()->getSolverInfo().m_numIterations = 5; /* the benchmark demo's */
         world()->getSolverInfo().m_solverMode |= SOLVER_ENABLE_FRICTION_DIRECTION_CACHING;
         sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
         def.eval = landscapeEval;
