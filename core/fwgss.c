@@ -118,6 +118,22 @@ static double phi_on_segment(double l, void* c)
     return phi;
 }
 
+/* phi on the segment and its derivative along it, for the search with derivatives. */
+static double phi_slope_on_segment(double l, double* df, void* c)
+{
+    space_ctx* k = c;
+    scc_vec3 g;
+    double phi = scc_sdf_eval(k->s->sdf, scc_lerp(k->a, k->b, l), &g);
+    k->s->evals++;
+    *df = scc_dot(g, scc_sub(k->b, k->a));
+    if (phi <= k->s->p->margin) {
+        double b[3];
+        for (int j = 0; j < 3; ++j) b[j] = (1.0 - l) * k->ba[j] + l * k->bb[j];
+        scc_fw_witness(k->s, k->t, b, phi);
+    }
+    return phi;
+}
+
 /* Inside the triangle: the end point (weights `bb`) where the in-plane steepest descent
  * direction -grad leaves the triangle. Returns 0 when there is no such direction. */
 static int interior_direction(const scc_tri_state* st, scc_vec3 g, const double b[3], double bb[3])
@@ -141,31 +157,44 @@ static int interior_direction(const scc_tri_state* st, scc_vec3 g, const double 
 }
 
 /* Golden-section search of phi at time t on the segment from the iterate (point xn, weights
- * s->b, phi - margin = gap there) to the weights bb; moves s->b there and returns the length of
- * the step. The search's tolerance is the spatial tolerance or, far from the surface, a fraction
- * of the gap (ours): there the step only has to point the next temporal search the right way,
- * and the searches that place the contact run at contact, where the gap is 0. */
-static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 xn, double gap, const double bb[3], double t)
+ * s->b, phi - margin = gap there, gradient gn) to the weights bb; moves s->b there and returns the
+ * length of the step. The search's tolerance is the spatial tolerance or, far from the surface, a
+ * fraction of the gap (ours): there the step only has to point the next temporal search the right
+ * way, and the searches that place the contact run at contact, where the gap is 0. */
+static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 xn, double gap, scc_vec3 gn, const double bb[3], double t)
 {
     const scc_params* p = s->p;
     scc_vec3 end = scc_add(scc_add(scc_scale(st->x[0], bb[0]), scc_scale(st->x[1], bb[1])), scc_scale(st->x[2], bb[2]));
     double len = scc_dist(end, xn);
     if (!(len > s->dist_tol)) return 0.0;
     space_ctx k = { s, xn, end, { s->b[0], s->b[1], s->b[2] }, { bb[0], bb[1], bb[2] }, t };
-    double tol = fmax(s->dist_tol, p->fwgss_gap_tol * gap) / len;
-    /* Brent's parabolic steps (ours) converge superlinearly where phi is smooth along the segment;
-     * golden section (Algorithm 1) otherwise. */
-    scc_gss_result sp = p->fwgss_brent_spatial ? scc_brent_minimize(0.0, 1.0, tol, p->max_ls_iter, phi_on_segment, &k)
-                                               : scc_gss_minimize(0.0, 1.0, tol, p->max_ls_iter, phi_on_segment, &k);
+    const double fine = s->dist_tol, coarse = p->fwgss_gap_tol * gap;
+    const double tol = fmax(fine, coarse) / len;
+    const double f0 = gap + p->margin; /* phi at the iterate, l = 0: not evaluated again */
+    double f1 = NAN;
+    scc_gss_result sp;
+    /* At full precision (at or next to contact, where the spatial step places the contact) the
+     * gradient is used (ours): secant steps on the slope along the segment need a handful of
+     * evaluations where golden section needs log(tol) / log(0.618), about 25. Far from the surface
+     * the wide golden-section samples stay: there they find the lower of several dips. */
+    if (p->fwgss_deriv_spatial && coarse <= fine &&
+        scc_deriv_minimize(f0, scc_dot(gn, scc_sub(end, xn)), tol, p->max_ls_iter, phi_slope_on_segment, &k, &sp, &f1)) {
+        /* done */
+    } else if (p->fwgss_brent_spatial) {
+        /* Brent's parabolic steps (ours) converge superlinearly where phi is smooth along the segment */
+        sp = scc_brent_minimize(0.0, 1.0, tol, p->max_ls_iter, phi_on_segment, &k);
+    } else {
+        sp = scc_gss_minimize_from(0.0, 1.0, f0, f1, tol, 0.0, p->max_ls_iter, phi_on_segment, &k); /* Algorithm 1 */
+    }
     for (int j = 0; j < 3; ++j) s->b[j] = fmax((1.0 - sp.l) * s->b[j] + sp.l * bb[j], 0.0);
     return sp.l * len;
 }
 
-/* One FWGSS descent from the weights in s->b (Algorithm 2 lines 4-33). Returns 1 if it converged. */
-static int descend(scc_fw_state* s, int64_t* io_iterations)
+/* One FWGSS descent from the weights in s->b and the time t (Algorithm 2 lines 4-33: t = ts).
+ * Returns 1 if it converged. */
+static int descend(scc_fw_state* s, double t, int64_t* io_iterations)
 {
     const scc_params* p = s->p;
-    double t = s->ts;
     int64_t it = 0;
     while (it < p->max_iter && s->evals < p->max_evals) {
         ++it;
@@ -178,10 +207,10 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
         } else if (phi <= p->margin) {
             ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, unsigned_phi_at_time, s);
             if (ls.f > s->dist_tol) ls = crossing_by_bisection(s, s->ts, fmin(t, s->te), p);
-        } else if (scc_dot(g, v) > 0.0) { /* d = -1: moving away, look back in time */
-            ls = scc_gss_minimize_gap(s->ts, t, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
+        } else if (scc_dot(g, v) > 0.0) { /* d = -1: moving away, look back in time (phi at t is known) */
+            ls = scc_gss_minimize_from(s->ts, t, NAN, phi - p->margin, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         } else {
-            ls = scc_gss_minimize_gap(t, s->te, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
+            ls = scc_gss_minimize_from(t, s->te, phi - p->margin, NAN, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         }
         double tn = fmin(ls.l, s->te);
 
@@ -214,7 +243,7 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
                 have_dir = 1;
             }
         }
-        double step = have_dir ? spatial_search(s, &st, xn, gap, bb, tn) : 0.0;
+        double step = have_dir ? spatial_search(s, &st, xn, gap, gn, bb, tn) : 0.0;
         if (interior && step <= s->dist_tol) {
             /* Stalled inside (ours): at a kink of the field (a box's edge or corner under the face)
              * the steepest descent of one side need not descend, and the iterate would stop short
@@ -222,7 +251,7 @@ static int descend(scc_fw_state* s, int64_t* io_iterations)
              * the paper's step towards the support vertex (Eq. 15) is searched too. */
             int sv = scc_fw_support(&st, gn);
             for (int j = 0; j < 3; ++j) bb[j] = j == sv;
-            step = spatial_search(s, &st, scc_fw_point(s, s->b, tn, NULL), gap, bb, tn);
+            step = spatial_search(s, &st, scc_fw_point(s, s->b, tn, NULL), gap, gn, bb, tn);
         }
         int small = fabs(tn - t) <= p->time_tol && step <= s->dist_tol; /* line 32 */
         t = tn;
@@ -423,25 +452,32 @@ void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb
      * bracket is narrower than fwgss_gap_tol x (smallest gap) / (L x speed) cannot hide a contact
      * (scc_gss_minimize_gap), so far from the surface it stops there. */
     s.time_slope = p->fwgss_gap_tol > 0.0 ? fmax(sdf->lipschitz, 1.0) * speed / p->fwgss_gap_tol : 0.0;
+    /* The vertex paths first: in a mesh query their traces are shared with the neighbouring
+     * triangles, and a contact found there rules the proof below out. */
+    if (p->fwgss_vertex_trace > 0)
+        for (int i = 0; i < 3; ++i) trace_vertex(&s, i, p->fwgss_vertex_trace);
     /* Most triangles the broad phase hands over pass close to the field without touching it; a
      * short proof of that skips the descents. */
-    if (p->fwgss_clear_budget > 0 && speed > 0.0 && prove_clear(&s, s.ts, s.te, speed, p->fwgss_clear_budget)) {
+    if (!s.hit && p->fwgss_clear_budget > 0 && speed > 0.0 && prove_clear(&s, s.ts, s.te, speed, p->fwgss_clear_budget)) {
         scc_fw_finish(&s, 1, 0, out);
         return;
     }
-    if (p->fwgss_vertex_trace > 0)
-        for (int i = 0; i < 3; ++i) trace_vertex(&s, i, p->fwgss_vertex_trace);
     int order[3];
     scc_fw_start_order(&s, order);
     int converged = 1;
     int64_t it = 0;
     /* Section 4.4 picks the most promising vertex; the other vertices are tried next (ours),
      * sharing the shrinking interval, so a local minimum or a later entry of the first descent
-     * is corrected and every later descent only searches before the earliest witness. */
+     * is corrected and every later descent only searches before the earliest witness. A restart
+     * begins at that witness's time (fwgss_restart_at_witness): a part of the triangle that
+     * touched earlier is, for a body moving into the field, usually in contact there as well, so the
+     * descent finds it by its spatial steps and searches back in time for its entry, without a
+     * temporal search of the whole interval along the vertex's path first. */
     int starts = 1 + (p->fwgss_restarts < 2 ? p->fwgss_restarts : 2);
     for (int k = 0; k < starts; ++k) {
         s.b[0] = order[k] == 0; s.b[1] = order[k] == 1; s.b[2] = order[k] == 2;
-        if (!descend(&s, &it)) converged = 0;
+        const double t_start = k > 0 && s.hit && p->fwgss_restart_at_witness ? s.te : s.ts;
+        if (!descend(&s, t_start, &it)) converged = 0;
         if (s.hit && s.hit_t <= s.ts) break; /* in contact at the start: nothing is earlier */
     }
     scc_fw_finish(&s, converged, it, out);

@@ -2,7 +2,8 @@
  * sdfccd core: golden-section search, Pelletier-Guenette et al. 2025, Algorithm 1 (Section 3.4).
  * Two fixes to the printed pseudocode: the loop runs while the bracket is WIDER than the
  * tolerance, and the tolerance is absolute (a relative one, tol * (l1 + l2), never stops
- * near l = 0 and is meaningless for intervals that straddle zero). */
+ * near l = 0 and is meaningless for intervals that straddle zero). Also here (ours): Brent's
+ * minimiser, and a line search with derivatives that FWGSS uses near contact. */
 #include "gss.h"
 
 #include <math.h>
@@ -14,21 +15,33 @@ scc_gss_result scc_gss_minimize(double a, double b, double tol, int max_iter, sc
 
 scc_gss_result scc_gss_minimize_gap(double a, double b, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx)
 {
+    return scc_gss_minimize_from(a, b, NAN, NAN, tol, slope, max_iter, f, ctx);
+}
+
+scc_gss_result scc_gss_minimize_from(double a, double b, double fa, double fb, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx)
+{
     const double r = 0.61803398874989484820; /* 1/phi */
     const double rc = 1.0 - r;
     scc_gss_result res;
     double a0 = 0.0, a1 = rc, a2 = r, a3 = 1.0;
     double l0 = a, l3 = b;
-    double f0 = f(l0, ctx), f3;
-    res.evals = 1;
+    double f0 = fa, f3 = fb;
+    res.evals = 0;
+    if (isnan(f0)) {
+        f0 = f(l0, ctx);
+        res.evals++;
+    }
     if (a == b) {
         res.l = a; res.f = f0; res.converged = 1;
         return res;
     }
-    f3 = f(l3, ctx);
+    if (isnan(f3)) {
+        f3 = f(l3, ctx);
+        res.evals++;
+    }
     double l1 = a + (b - a) * a1, l2 = a + (b - a) * a2;
     double f1 = f(l1, ctx), f2 = f(l2, ctx);
-    res.evals += 3;
+    res.evals += 2;
     int it = 0, flat = 0;
     while (fabs(l3 - l0) > tol && it < max_iter) {
         if (slope > 0.0) {
@@ -121,4 +134,62 @@ scc_gss_result scc_brent_minimize(double a, double b, double tol, int max_iter, 
     res.l = x;
     res.f = fx;
     return res;
+}
+
+int scc_deriv_minimize(double f0, double d0, double tol, int max_iter, scc_gss_dfn* f, void* ctx, scc_gss_result* out, double* f1)
+{
+    scc_gss_result res = { 0.0, f0, 0, 1 };
+    if (!(d0 < 0.0)) {
+        *out = res;
+        return 1;
+    }
+    double dhi;
+    const double fhi = f(1.0, &dhi, ctx);
+    *f1 = fhi;
+    res.evals = 1;
+    if (!(dhi > 0.0)) {
+        if (!(fhi < f0)) return 0; /* f fell, rose and fell again: more than one sign change of f' */
+        res.l = 1.0;
+        res.f = fhi;
+        *out = res;
+        return 1;
+    }
+    if (fhi < res.f) { res.l = 1.0; res.f = fhi; }
+    double lo = 0.0, hi = 1.0, dlo = d0;
+    int it = 0, side = 0, slow = 0;
+    while (hi - lo > tol && it < max_iter) {
+        ++it;
+        const double width = hi - lo;
+        double l;
+        if (slow >= 2) {
+            l = 0.5 * (lo + hi);
+            slow = 0;
+        } else {
+            l = lo - dlo * (hi - lo) / (dhi - dlo);
+            const double m = 0.25 * tol; /* strictly inside, as the entry search keeps its samples */
+            if (!(l > lo + m)) l = lo + m;
+            if (!(l < hi - m)) l = hi - m;
+        }
+        double dl;
+        const double fl = f(l, &dl, ctx);
+        res.evals++;
+        if (fl < res.f) { res.l = l; res.f = fl; }
+        if (dl < 0.0) {
+            lo = l;
+            dlo = dl;
+            if (side == -1) dhi *= 0.5;
+            side = -1;
+        } else if (dl > 0.0) {
+            hi = l;
+            dhi = dl;
+            if (side == 1) dlo *= 0.5;
+            side = 1;
+        } else {
+            break; /* a stationary point (or a NaN slope): nothing better to bracket */
+        }
+        slow = hi - lo > 0.5 * width ? slow + 1 : 0;
+    }
+    res.converged = hi - lo <= tol || it < max_iter;
+    *out = res;
+    return 1;
 }

@@ -24,8 +24,25 @@ scc_gss_result scc_gss_minimize(double a, double b, double tol, int max_iter, sc
  * is skipped, while far from zero the search ends early. slope <= 0: scc_gss_minimize. */
 scc_gss_result scc_gss_minimize_gap(double a, double b, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx);
 
+/* scc_gss_minimize_gap with f(a) and f(b) already known (fa, fb; NaN: unknown), which are not
+ * evaluated again: the same samples and result, up to two evaluations fewer. */
+scc_gss_result scc_gss_minimize_from(double a, double b, double fa, double fb, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx);
+
 /* Brent's minimiser over [a, b] (a <= b): parabolic steps safeguarded by golden section; the same
  * result struct. Converges superlinearly near a smooth minimum. */
 scc_gss_result scc_brent_minimize(double a, double b, double tol, int max_iter, scc_gss_fn* f, void* ctx);
+
+/* f(l) and its derivative f'(l) (in *df). */
+typedef double scc_gss_dfn(double l, double* df, void* ctx);
+
+/* Minimises f over [0, 1] from f(0) = f0 and f'(0) = d0 using derivatives (ours): the end l = 1
+ * is evaluated first and is the answer when f still descends there and f(1) < f0; otherwise the
+ * sign change of f' in [0, 1] is closed by secant steps on f' (regula falsi with the Illinois
+ * modification, a bisection after two steps that did not halve the bracket) until the bracket is
+ * narrower than tol or max_iter steps. The result is the evaluated point with the smallest f.
+ * Returns 0 (out untouched but for *f1) when f descends at l = 1 and yet f(1) >= f0, i.e. f' changes
+ * sign more than once: the caller then searches without derivatives, with f(1) in *f1. d0 >= 0
+ * gives l = 0 without an evaluation. */
+int scc_deriv_minimize(double f0, double d0, double tol, int max_iter, scc_gss_dfn* f, void* ctx, scc_gss_result* out, double* f1);
 
 #endif

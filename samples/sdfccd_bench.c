@@ -24,7 +24,7 @@ typedef struct options {
 
 /* FWGSS configurations compared by the experiments: today's defaults, the previous defaults
  * (before issue 9's parameters: golden-section entry search, fixed spatial tolerance, no clear
- * proof, no gap tolerance; the closed-form motion, the interior spatial step, the shared and
+ * proof, no gap tolerance, golden-section spatial searches, restarts from t0; the closed-form motion, the interior spatial step, the shared and
  * refined vertex traces and the start at the broad phase's candidate time are not switchable), and the paper's
  * configuration (no vertex trace, no restarts). */
 typedef enum fw_config { CFG_NEW, CFG_BASELINE, CFG_PAPER, CFG_COUNT } fw_config;
@@ -39,6 +39,8 @@ static sdfccd_QueryParams config_params(fw_config c, int subdivision)
         p.fwgss_speed_tolerance = 0;
         p.fwgss_clear_proof = 0;
         p.fwgss_gap_tolerance = 0.0;
+        p.fwgss_derivative_spatial = 0;
+        p.fwgss_restart_at_witness = 0;
     }
     if (c == CFG_PAPER) {
         p.fwgss_vertex_trace = 0;

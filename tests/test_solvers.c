@@ -108,6 +108,82 @@ START_TEST(test_gss_gap_stop)
 }
 END_TEST
 
+/* The same search with f(a), f(b) handed in (FWGSS passes the values it already has): the same
+ * samples and result, one evaluation fewer per known end. */
+static int g_calls;
+static double quad_counted(double x, void* c) { ++g_calls; return quad(x, c); }
+
+START_TEST(test_gss_known_ends)
+{
+    double m = 0.3;
+    g_calls = 0;
+    scc_gss_result plain = scc_gss_minimize_gap(0.0, 1.0, 1e-9, 0.0, 200, quad_counted, &m);
+    const int plain_calls = g_calls;
+    g_calls = 0;
+    scc_gss_result known = scc_gss_minimize_from(0.0, 1.0, quad(0.0, &m), quad(1.0, &m), 1e-9, 0.0, 200, quad_counted, &m);
+    ck_assert_int_eq(g_calls, plain_calls - 2);
+    ck_assert_int_eq(known.evals, plain.evals - 2);
+    ck_assert_double_eq(known.l, plain.l);
+    ck_assert_double_eq(known.f, plain.f);
+    g_calls = 0;
+    known = scc_gss_minimize_from(0.0, 1.0, NAN, quad(1.0, &m), 1e-9, 0.0, 200, quad_counted, &m);
+    ck_assert_int_eq(g_calls, plain_calls - 1);
+    ck_assert_double_eq(known.l, plain.l);
+}
+END_TEST
+
+/* f and its slope for the search with derivatives. */
+static double quad_d(double x, double* df, void* c) { double m = *(double*)c; *df = 2.0 * (x - m); ++g_calls; return (x - m) * (x - m); }
+static double quartic_d(double x, double* df, void* c) { (void)c; double u = x - 0.62; *df = 4.0 * u * u * u + 2.0 * u; ++g_calls; return u * u * u * u + u * u; }
+static double vee_d(double x, double* df, void* c) { (void)c; *df = x < 0.7 ? -1.0 : 1.0; ++g_calls; return fabs(x - 0.7); }
+/* Two dips: f falls to -1 at 0.25, rises to 1 at 0.75 and falls again, to f(1) = 2.4e-16 > f(0) = 0. */
+static double twodip_d(double x, double* df, void* c) { (void)c; *df = -2.0 * M_PI * cos(2.0 * M_PI * x); ++g_calls; return -sin(2.0 * M_PI * x); }
+
+/* The spatial search with derivatives (FWGSS's fwgss_derivative_spatial): the minimiser to the
+ * tolerance in a handful of evaluations on smooth functions, bisection-bounded on a kink, the whole
+ * step when f still descends at l = 1, no step for a non-descent start, and a refusal (for golden
+ * section) when f' changes sign more than once. Every returned point is an evaluated one. */
+START_TEST(test_deriv_minimize)
+{
+    double m = 0.3, f1 = 0.0;
+    scc_gss_result r;
+    g_calls = 0;
+    ck_assert(scc_deriv_minimize(m * m, -2.0 * m, 1e-9, 64, quad_d, &m, &r, &f1));
+    ck_assert_double_near(r.l, 0.3, 1e-9);
+    ck_assert_int_le(r.evals, 4); /* the secant on a linear slope is exact */
+    ck_assert_int_eq(r.evals, g_calls);
+    ck_assert(r.converged);
+    g_calls = 0;
+    ck_assert(scc_deriv_minimize(pow(0.62, 4) + 0.62 * 0.62, -4.0 * pow(0.62, 3) - 2.0 * 0.62, 1e-9, 64, quartic_d, NULL, &r, &f1));
+    ck_assert_double_near(r.l, 0.62, 1e-8);
+    ck_assert_int_le(r.evals, 16); /* 14 here; golden section needs about 45 */
+    ck_assert_double_near(r.f, quartic_d(r.l, &f1, NULL), 0.0);
+    /* a kink: the slope jumps from -1 to 1; the bisection safeguard still closes the bracket */
+    g_calls = 0;
+    ck_assert(scc_deriv_minimize(0.7, -1.0, 1e-9, 200, vee_d, NULL, &r, &f1));
+    ck_assert_double_near(r.l, 0.7, 1e-8);
+    ck_assert_int_le(r.evals, 2 * 35);
+    /* still descending at the end: the whole step in one evaluation */
+    m = 1.5;
+    ck_assert(scc_deriv_minimize(m * m, -2.0 * m, 1e-9, 64, quad_d, &m, &r, &f1));
+    ck_assert_double_eq(r.l, 1.0);
+    ck_assert_int_eq(r.evals, 1);
+    /* not a descent direction: no step, no evaluation */
+    m = -0.5;
+    ck_assert(scc_deriv_minimize(m * m, -2.0 * m, 1e-9, 64, quad_d, &m, &r, &f1));
+    ck_assert_double_eq(r.l, 0.0);
+    ck_assert_int_eq(r.evals, 0);
+    /* two dips: refused, with f(1) handed back for the golden-section search that follows */
+    double d0;
+    const double f0 = twodip_d(0.0, &d0, NULL);
+    ck_assert(d0 < 0.0);
+    r.l = -1.0;
+    ck_assert(!scc_deriv_minimize(f0, d0, 1e-9, 64, twodip_d, NULL, &r, &f1));
+    ck_assert_double_eq(r.l, -1.0);
+    ck_assert_double_eq(f1, twodip_d(1.0, &d0, NULL));
+}
+END_TEST
+
 static scc_params default_params(void)
 {
     scc_params p = { 0 };
@@ -183,6 +259,8 @@ int main(void)
     tcase_add_test(g, test_gss_known_minima);
     tcase_add_test(g, test_brent_known_minima);
     tcase_add_test(g, test_gss_gap_stop);
+    tcase_add_test(g, test_gss_known_ends);
+    tcase_add_test(g, test_deriv_minimize);
     suite_add_tcase(s, g);
     TCase* d = tcase_create("dcd");
     tcase_add_test(d, test_dcd_deepest_vertex);

@@ -69,6 +69,8 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     out->fwgss_speed_tol = in->fwgss_speed_tolerance != 0;
     out->fwgss_brent_spatial = in->fwgss_brent_spatial != 0;
     out->fwgss_gap_tol = in->fwgss_gap_tolerance;
+    out->fwgss_deriv_spatial = in->fwgss_derivative_spatial != 0;
+    out->fwgss_restart_at_witness = in->fwgss_restart_at_witness != 0;
     if (in->fwgss_clear_proof < 0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_clear_proof must be >= 0 (got %d)", fn, in->fwgss_clear_proof);
     out->fwgss_clear_budget = in->fwgss_clear_proof;

@@ -33,6 +33,8 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.fwgss_brent_spatial = 0;
     p.fwgss_gap_tolerance = 0.5;
     p.certified_max_bytes = SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES;
+    p.fwgss_derivative_spatial = 1;
+    p.fwgss_restart_at_witness = 1;
     return p;
 }
 

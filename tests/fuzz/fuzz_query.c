@@ -229,6 +229,19 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     for (int i = 0; i < 4; ++i) start[i] = fz_vec(&in);
     for (int i = 0; i < 4; ++i) end[i] = fz_vec(&in);
     const int32_t capacity = fz_u8(&in) % 10;
+    /* The FWGSS switches, read last so that older corpus inputs keep their meaning (an exhausted
+     * input reads 0: every switch at its default). Bit k flips switch k; bit 7 also fuzzes the
+     * clear proof's budget and the gap tolerance. */
+    const uint8_t flips = fz_u8(&in);
+    if (flips & 1) p.fwgss_secant_entry = !p.fwgss_secant_entry;
+    if (flips & 2) p.fwgss_speed_tolerance = !p.fwgss_speed_tolerance;
+    if (flips & 4) p.fwgss_brent_spatial = !p.fwgss_brent_spatial;
+    if (flips & 8) p.fwgss_derivative_spatial = !p.fwgss_derivative_spatial;
+    if (flips & 16) p.fwgss_restart_at_witness = !p.fwgss_restart_at_witness;
+    if (flips & 128) {
+        p.fwgss_clear_proof = fz_int(&in, -1, 300);
+        p.fwgss_gap_tolerance = fz_double(&in);
+    }
 
     sdfccd_Contact c[2][16];
     sdfccd_QueryResult r[2];

@@ -112,6 +112,19 @@ typedef struct sdfccd_QueryParams {
                                         (`hit` = 1) or none, and `toi_lower` the time before which no contact is proven.
                                         A mesh query searches one triangle at a time, so this bounds the whole query's
                                         region store. Default SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES. */
+    int32_t fwgss_derivative_spatial; /**< FWGSS: the spatial line searches at full precision (at or next to contact,
+                                        where fwgss_gap_tolerance does not loosen them) use the gradient: the segment's
+                                        end is tried first, then secant steps on the slope of phi along the segment
+                                        (regula falsi with the Illinois modification, safeguarded by bisection), a
+                                        handful of evaluations where golden section needs about 25; when phi falls,
+                                        rises and falls again along the segment, golden section as with 0. Far from the
+                                        surface golden section (or Brent, fwgss_brent_spatial) stays. 0 = golden section
+                                        everywhere. Default 1. */
+    int32_t fwgss_restart_at_witness; /**< FWGSS: a restart (fwgss_restarts) begins at the time of the earliest contact
+                                        witnessed so far instead of at t0: its spatial steps find a part of the triangle
+                                        in contact there and it searches back for that part's entry, without first
+                                        searching the whole interval along the vertex's path. 0 = restarts begin at t0.
+                                        Default 1. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
