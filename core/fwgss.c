@@ -105,11 +105,14 @@ typedef struct space_ctx {
     double t;
 } space_ctx;
 
-static double phi_on_segment(double l, void* c)
+/* phi at parameter l of the segment (and its derivative along it when df is not NULL); a point in
+ * contact is a witness. */
+static double eval_on_segment(space_ctx* k, double l, double* df)
 {
-    space_ctx* k = c;
-    double phi = scc_sdf_eval(k->s->sdf, scc_lerp(k->a, k->b, l), NULL);
+    scc_vec3 g;
+    double phi = scc_sdf_eval(k->s->sdf, scc_lerp(k->a, k->b, l), df ? &g : NULL);
     k->s->evals++;
+    if (df) *df = scc_dot(g, scc_sub(k->b, k->a));
     if (phi <= k->s->p->margin) {
         double b[3];
         for (int j = 0; j < 3; ++j) b[j] = (1.0 - l) * k->ba[j] + l * k->bb[j];
@@ -118,21 +121,10 @@ static double phi_on_segment(double l, void* c)
     return phi;
 }
 
-/* phi on the segment and its derivative along it, for the search with derivatives. */
-static double phi_slope_on_segment(double l, double* df, void* c)
-{
-    space_ctx* k = c;
-    scc_vec3 g;
-    double phi = scc_sdf_eval(k->s->sdf, scc_lerp(k->a, k->b, l), &g);
-    k->s->evals++;
-    *df = scc_dot(g, scc_sub(k->b, k->a));
-    if (phi <= k->s->p->margin) {
-        double b[3];
-        for (int j = 0; j < 3; ++j) b[j] = (1.0 - l) * k->ba[j] + l * k->bb[j];
-        scc_fw_witness(k->s, k->t, b, phi);
-    }
-    return phi;
-}
+static double phi_on_segment(double l, void* c) { return eval_on_segment(c, l, NULL); }
+
+/* phi on the segment and its slope, for the search with derivatives. */
+static double phi_slope_on_segment(double l, double* df, void* c) { return eval_on_segment(c, l, df); }
 
 /* Inside the triangle: the end point (weights `bb`) where the in-plane steepest descent
  * direction -grad leaves the triangle. Returns 0 when there is no such direction. */
