@@ -7,7 +7,8 @@
 //                 [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]
 //                 [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]
 //                 [--projection T] [--spread-depth-fraction F] [--face-search S]
-//                 [--discrete-subdivision-scale S] [--data DIR] [--check KEY=LIMIT,...] [--quiet] [--table4]
+//                 [--discrete-subdivision-scale S] [--batch-threads N] [--data DIR] [--check KEY=LIMIT,...]
+//                 [--quiet] [--table4]
 //
 // --patch-band B / --hard-clamp T / --spread-depth-scale D / --solver-iterations N override the
 // Bullet scenes' set-up (the bridge's Config::patch_band, Bridge::setHardClamp tolerance,
@@ -21,7 +22,8 @@
 // turns it off unless F is given, so D is the scale used. --face-search S sets the bridge's
 // Config::face_search_size (0: off; the spikes scene defaults to 0.02, others to off).
 // --discrete-subdivision-scale S overrides Config::discrete_subdivision_scale (0: the discrete
-// queries subdivide as the library does).
+// queries subdivide as the library does). --batch-threads N sets Config::batch_threads (the
+// step's queries of every pair as batches on N threads; the same results).
 // --table4 adds the paper's Table 4 figures (the CCD of the coming step through the C ABI, timed,
 // up to the first contact; see runner.h) as a "table4" line of the summary.
 // The Bullet build (float or double btScalar) is a separate library, so this program is built
@@ -68,7 +70,7 @@ void usage(std::FILE* f)
                  "                     [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]\n"
                  "                     [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]\n"
                  "                     [--projection T] [--spread-depth-fraction F] [--face-search S]\n"
-                 "                     [--discrete-subdivision-scale S] [--data DIR]\n"
+                 "                     [--discrete-subdivision-scale S] [--batch-threads N] [--data DIR]\n"
                  "                     [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
                  "check keys: max_pen max_pen_ccd min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
 }
@@ -141,6 +143,7 @@ int main(int argc, char** argv)
         else if (a == "--patch-band") opt.patch_band = std::atof(value("metres"));
         else if (a == "--spread-depth-scale") opt.spread_depth_scale = std::atof(value("metres"));
         else if (a == "--face-search") opt.face_search = std::atof(value("metres (0: off)"));
+        else if (a == "--batch-threads") opt.batch_threads = std::atoi(value("a thread count"));
         else if (a == "--solver-iterations") opt.solver_iterations = std::atoi(value("a count"));
         else if (a == "--hard-clamp") opt.hard_clamp = std::atof(value("metres"));
         else if (a == "--extra-manifolds") opt.extra_manifolds = std::atoi(value("a count (0-3)"));

@@ -151,6 +151,7 @@ BridgeImpl::BridgeImpl(const Config& c) : cfg(c)
     if (!(cfg.kick_angular_speed >= 0)) cfg.kick_angular_speed = 0;
     if (!(cfg.cover_depth >= 0)) cfg.cover_depth = 0;
     if (!(cfg.spread_depth_fraction >= 0)) cfg.spread_depth_fraction = 0;
+    cfg.batch_threads = std::max(1, std::min(cfg.batch_threads, 256));
     if (!(cfg.contact_margin >= 0)) cfg.contact_margin = 0;
     if (!(cfg.vertex_distance >= 0)) cfg.vertex_distance = 0;
 }
@@ -316,7 +317,10 @@ Status Bridge::registerWith(btCollisionWorld* world)
             return Status::TooLate;
     }
     const Status s = registerWith(d);
-    if (s == Status::Ok) projectionAttach(m_impl, world);
+    if (s == Status::Ok) {
+        projectionAttach(m_impl, world);
+        m_impl->batch_world = world;
+    }
     return s;
 }
 
@@ -448,6 +452,8 @@ void Bridge::unregister()
         d->registerClosestPointsCreateFunc(s.first, s.second, cc->getClosestPointsAlgorithmCreateFunc(s.first, s.second));
     }
     projectionDetach(m_impl);
+    m_impl->batch_world = nullptr;
+    m_impl->batch_cache.clear();
     std::lock_guard<std::mutex> lock(g_registry_mutex);
     g_registered.erase(d);
     m_impl->dispatcher = nullptr;
@@ -459,7 +465,11 @@ double Bridge::timeOfImpact(const btCollisionObject* mesh_body, const btCollisio
     return m_impl->timeOfImpact(mesh_body, sdf_body, dt);
 }
 
-void Bridge::invalidateShape(const btCollisionShape* shape) { m_impl->shapes.invalidate(shape); }
+void Bridge::invalidateShape(const btCollisionShape* shape)
+{
+    m_impl->shapes.invalidate(shape);
+    m_impl->batch_cache.clear(); // its queries name the shape's old mesh or SDF handle
+}
 
 // ---------------------------------------------------------------------------------------------
 // Misuse reports (bridge.h: setMisuseHandler).

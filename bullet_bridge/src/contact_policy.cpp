@@ -29,6 +29,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 namespace detail {
@@ -394,47 +395,244 @@ struct Gatherer {
 
 using namespace detail;
 
+QueryInput detail::queryInput(sdfccd_SdfId sdf, sdfccd_MeshId mesh, const sdfccd_RigidMotion* sm, const sdfccd_RigidMotion& m, double t1,
+                              const sdfccd_QueryParams& p)
+{
+    QueryInput in;
+    std::memset(&in, 0, sizeof in); // padding too: inputs are compared byte for byte
+    in.sdf = sdf;
+    in.mesh = mesh;
+    in.has_sdf_motion = sm != nullptr;
+    if (sm) std::memcpy(&in.sdf_motion, sm, sizeof *sm);
+    std::memcpy(&in.motion, &m, sizeof m);
+    in.t1 = t1;
+    std::memcpy(&in.params, &p, sizeof p);
+    return in;
+}
+
+bool BridgeImpl::plan(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin, PairPlan& P)
+{
+    P.me = shapes.meshFor(mw->getCollisionShape());
+    P.sdf = shapes.sdfFor(sw->getCollisionShape(), cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
+    if (!P.me || !P.sdf.index1) return false;
+    P.M = motionOf(mw->getCollisionObject(), mw->getWorldTransform(), dt);
+    P.S = motionOf(sw->getCollisionObject(), sw->getWorldTransform(), dt);
+    // A static SDF (the usual case): work in its frame, so the library evaluates the field without
+    // moving it (no pose per evaluation); the candidates go back to the world at the end.
+    P.static_sdf = P.S.v.isZero() && P.S.w.isZero() && P.S.t0 == P.S.t1;
+    P.sdf_world = P.S.t0;
+    if (P.static_sdf) {
+        const btTransform inv = P.sdf_world.inverse();
+        P.M.t0 = inv * P.M.t0;
+        P.M.t1 = inv * P.M.t1;
+        P.M.v = inv.getBasis() * P.M.v;
+        P.M.w = inv.getBasis() * P.M.w;
+        P.S.t0.setIdentity();
+        P.S.t1.setIdentity();
+    }
+    P.margin = margin;
+    P.mm = P.M.rigid();
+    P.sm_value = P.S.rigid();
+    std::memcpy(&P.params, &cfg.query, sizeof P.params);
+    P.params.margin = margin;
+    // With SDFCCD_METHOD_DCD (the discrete baseline the scenes compare against) the main query
+    // runs first and alone decides whether the step has contact (the order before the start-pose
+    // query was moved first).
+    P.continuous = P.params.method != SDFCCD_METHOD_DCD;
+    P.start_margin = margin;
+    P.travel = P.kick = 0;
+    if (dt > 0) {
+        const double reach = P.me->radius + (double)(P.M.t0.getOrigin() - P.S.t0.getOrigin()).length();
+        P.travel = dt * ((double)(P.M.v - P.S.v).length() + (double)P.M.w.length() * P.me->radius + (double)P.S.w.length() * reach);
+        // A kick (a velocity change from another contact solved in the same step, e.g. a body
+        // landing on this one) is not in the predicted motion: the start-pose query also reaches
+        // as far as kick_angular_speed about the body's centre carries its farthest point in the
+        // step, and its features count even when the predicted motion has no contact.
+        P.kick = dt * cfg.kick_angular_speed * P.me->radius;
+        P.start_margin = margin + P.travel + P.kick;
+    }
+    return true;
+}
+
+sdfccd_QueryParams BridgeImpl::discreteParams(const PairPlan& P, double dcd_margin) const
+{
+    sdfccd_QueryParams dcd;
+    std::memcpy(&dcd, &P.params, sizeof dcd);
+    dcd.method = SDFCCD_METHOD_DCD;
+    dcd.margin = dcd_margin;
+    // Subdivision regions below (discrete_subdivision_scale x the mesh radius)^2 are not split:
+    // their points lie that close to the triangle's vertices, which are candidates already.
+    // (Not for the DCD baseline, which keeps the library's subdivision.)
+    const double sub = cfg.discrete_subdivision_scale * P.me->radius;
+    if (P.continuous && sub > 0) dcd.subdivision_min_area = std::max(dcd.subdivision_min_area, sub * sub);
+    return dcd;
+}
+
+namespace {
+
+// The rigid motions of a discrete query at pose (Mx, Sx).
+void posePair(const btTransform& Mx, const btTransform& Sx, sdfccd_RigidMotion& m1, sdfccd_RigidMotion& s1)
+{
+    m1 = sdfccd_default_rigid_motion();
+    s1 = sdfccd_default_rigid_motion();
+    m1.pose = toPose(Mx);
+    s1.pose = toPose(Sx);
+}
+
+// Room given to a batched query's contacts (a query that finds more is run again in the narrow
+// phase with room for all, as an unbatched one is).
+const int32_t kBatchCapacity = 256;
+
+} // namespace
+
+const CachedQuery* BridgeImpl::batched(const btCollisionObject* mo, const btCollisionObject* so, int stage, const QueryInput& in,
+                                       bool* ran) const
+{
+    *ran = false;
+    auto it = batch_cache.find(PairStageKey{ mo, so, stage });
+    if (it == batch_cache.end()) return nullptr;
+    const CachedQuery& q = it->second;
+    if (std::memcmp(&q.in, &in, sizeof in) != 0) return nullptr;
+    *ran = true;
+    if (q.status != SDFCCD_OK || q.result.contacts_found > q.result.contact_count) return nullptr;
+    return &q;
+}
+
+void BridgeImpl::prefetch(double dt, double margin)
+{
+    const auto t_start = std::chrono::steady_clock::now();
+    batch_cache.clear();
+    if (!batch_world || !dispatcher || !(dt > 0)) return;
+    struct Item {
+        const btCollisionObject *mo, *so;
+        PairPlan P;
+        sdfccd_RigidMotion m1, s1; // the pose pair of the current discrete stage
+    };
+    std::vector<Item> items;
+    btBroadphasePairArray& pairs = batch_world->getPairCache()->getOverlappingPairArray();
+    for (int i = 0; i < pairs.size(); ++i) {
+        const btBroadphasePair& bp = pairs[i];
+        if (!bp.m_pProxy0 || !bp.m_pProxy1) continue;
+        const btCollisionObject* a = static_cast<const btCollisionObject*>(bp.m_pProxy0->m_clientObject);
+        const btCollisionObject* b = static_cast<const btCollisionObject*>(bp.m_pProxy1->m_clientObject);
+        if (!a || !b || !dispatcher->needsCollision(a, b)) continue;
+        // Top-level shapes only (a compound's children get their pairs from the compound's own
+        // algorithm, with child transforms).
+        const btCollisionObjectWrapper wa(nullptr, a->getCollisionShape(), a, a->getWorldTransform(), -1, -1);
+        const btCollisionObjectWrapper wb(nullptr, b->getCollisionShape(), b, b->getWorldTransform(), -1, -1);
+        bool mesh_is_b = false;
+        if (!orient(&wa, &wb, mesh_is_b)) continue;
+        const btCollisionObjectWrapper* mw = mesh_is_b ? &wb : &wa;
+        const btCollisionObjectWrapper* sw = mesh_is_b ? &wa : &wb;
+        if (sw->getCollisionShape()->getShapeType() != cfg.sdf_shape_type) continue; // btSdfCollisionShape: Bullet's sampling
+        Item it;
+        it.mo = mw->getCollisionObject();
+        it.so = sw->getCollisionObject();
+        if (!plan(mw, sw, dt, margin, it.P) || !it.P.continuous) continue;
+        items.push_back(it);
+    }
+    // Stage by stage: the queries of `sel` (indices into items) as one batch into the cache.
+    std::vector<sdfccd_BatchQuery> qs;
+    auto runStage = [&](const std::vector<size_t>& sel, int stage) {
+        if (sel.empty()) return;
+        qs.assign(sel.size(), sdfccd_BatchQuery());
+        std::vector<CachedQuery*> out(sel.size());
+        for (size_t k = 0; k < sel.size(); ++k) {
+            Item& it = items[sel[k]];
+            const PairPlan& P = it.P;
+            CachedQuery& c = batch_cache[PairStageKey{ it.mo, it.so, stage }];
+            if (stage == kStageCcd) {
+                c.in = queryInput(P.sdf, P.me->id, P.sm(), P.mm, dt, P.params);
+            } else {
+                sdfccd_RigidMotion s1;
+                posePair(stage == kStageStart ? P.M.t0 : P.M.t1, stage == kStageStart ? P.S.t0 : P.S.t1, it.m1, s1);
+                it.s1 = s1;
+                c.in = queryInput(P.sdf, P.me->id, P.static_sdf ? nullptr : &it.s1, it.m1, 0.0,
+                                  discreteParams(P, stage == kStageStart ? P.start_margin : P.margin));
+            }
+            c.contacts.resize((size_t)kBatchCapacity);
+            out[k] = &c;
+        }
+        for (size_t k = 0; k < sel.size(); ++k) {
+            CachedQuery& c = *out[k];
+            sdfccd_BatchQuery& q = qs[k];
+            q.kind = SDFCCD_BATCH_MESH;
+            q.sdf = c.in.sdf;
+            q.sdf_motion = c.in.has_sdf_motion ? &c.in.sdf_motion : nullptr;
+            q.mesh = c.in.mesh;
+            q.motion = &c.in.motion;
+            q.t0 = 0.0;
+            q.t1 = c.in.t1;
+            q.params = &c.in.params;
+            q.out_contacts = c.contacts.data();
+            q.capacity = kBatchCapacity;
+            q.out_result = &c.result;
+        }
+        sdfccd_query_batch(qs.data(), (int32_t)qs.size(), cfg.batch_threads);
+        for (size_t k = 0; k < sel.size(); ++k) out[k]->status = qs[k].status;
+        stats.batches++;
+    };
+    // (1) every pair's start-pose query; (2) the CCD query of the pairs it leaves open (some
+    // triangle within reach, nothing within the margin yet, no face search to run first); (3) the
+    // end-pose query of those that start in contact or whose CCD query hit: gather()'s order.
+    std::vector<size_t> sel(items.size()), ccd, end;
+    for (size_t k = 0; k < items.size(); ++k) sel[k] = k;
+    runStage(sel, kStageStart);
+    for (size_t k = 0; k < items.size(); ++k) {
+        const CachedQuery& c = batch_cache[PairStageKey{ items[k].mo, items[k].so, kStageStart }];
+        if (c.status != SDFCCD_OK) continue;
+        if (c.result.triangles_tested == 0 && c.result.state == SDFCCD_STATE_NO_HIT) continue;
+        if (cfg.face_search_size > 0 && items[k].P.params.subdivision) continue;
+        bool touching = false;
+        if (c.result.hit)
+            for (int i = 0; i < std::min(c.result.contact_count, kBatchCapacity) && !touching; ++i)
+                touching = c.contacts[(size_t)i].distance <= items[k].P.margin;
+        (touching ? end : ccd).push_back(k);
+    }
+    runStage(ccd, kStageCcd);
+    for (size_t k : ccd) {
+        const CachedQuery& c = batch_cache[PairStageKey{ items[k].mo, items[k].so, kStageCcd }];
+        if (c.status == SDFCCD_OK && c.result.hit) end.push_back(k);
+    }
+    std::sort(end.begin(), end.end());
+    runStage(end, kStageEnd);
+    stats.query_seconds += seconds(t_start);
+}
+
 bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin,
                         std::vector<Candidate>& cands, double* out_radius, btVector3* out_w)
 {
     cands.clear();
-    Gatherer G;
-    G.me = shapes.meshFor(mw->getCollisionShape());
-    G.sdf = shapes.sdfFor(sw->getCollisionShape(), cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
-    if (!G.me || !G.sdf.index1) {
+    PairPlan P;
+    if (!plan(mw, sw, dt, margin, P)) {
         stats.query_errors++;
         return false;
     }
+    Gatherer G;
+    G.me = P.me;
+    G.sdf = P.sdf;
+    G.M = P.M;
+    G.S = P.S;
     if (!workspace && sdfccd_create_workspace(&workspace) != SDFCCD_OK) workspace = nullptr;
     if (out_radius) *out_radius = G.me->radius;
-    G.M = motionOf(mw->getCollisionObject(), mw->getWorldTransform(), dt);
-    G.S = motionOf(sw->getCollisionObject(), sw->getWorldTransform(), dt);
     if (out_w) *out_w = G.M.w - G.S.w;
-    // A static SDF (the usual case): work in its frame, so the library evaluates the field without
-    // moving it (no pose per evaluation); the candidates go back to the world at the end.
-    const bool static_sdf = G.S.v.isZero() && G.S.w.isZero() && G.S.t0 == G.S.t1;
-    const btTransform sdf_world = G.S.t0;
-    if (static_sdf) {
-        const btTransform inv = sdf_world.inverse();
-        G.M.t0 = inv * G.M.t0;
-        G.M.t1 = inv * G.M.t1;
-        G.M.v = inv.getBasis() * G.M.v;
-        G.M.w = inv.getBasis() * G.M.w;
-        G.S.t0.setIdentity();
-        G.S.t1.setIdentity();
-    }
+    const bool static_sdf = P.static_sdf;
+    const btTransform sdf_world = P.sdf_world;
     G.margin = margin;
     G.out = &cands;
     G.evals = 0;
-    const sdfccd_RigidMotion mm = G.M.rigid(), sm_value = G.S.rigid();
-    const sdfccd_RigidMotion* sm = static_sdf ? nullptr : &sm_value;
-    sdfccd_QueryParams params = cfg.query;
-    params.margin = margin;
-
-    // With SDFCCD_METHOD_DCD (the discrete baseline the scenes compare against) the main query
-    // runs first and alone decides whether the step has contact (the order before the start-pose
-    // query was moved first).
-    const bool continuous = params.method != SDFCCD_METHOD_DCD;
+    const sdfccd_RigidMotion mm = P.mm;
+    const sdfccd_RigidMotion* sm = P.sm();
+    const sdfccd_QueryParams& params = P.params;
+    const bool continuous = P.continuous;
+    const btCollisionObject* mo = mw->getCollisionObject();
+    const btCollisionObject* so = sw->getCollisionObject();
+    // Config::batch_threads: a top-level pair of a step whose queries have not been batched yet
+    // (its first pair) runs the batch of every pair.
+    const bool top_level = mw->getWorldTransform() == mo->getWorldTransform() && mw->getCollisionShape() == mo->getCollisionShape() &&
+                           sw->getWorldTransform() == so->getWorldTransform() && sw->getCollisionShape() == so->getCollisionShape();
+    const bool batching = cfg.batch_threads > 1 && batch_world && dt > 0 && continuous && top_level &&
+                          sw->getCollisionShape()->getShapeType() == cfg.sdf_shape_type;
 
     // The candidates back in the world frame, counted.
     auto finish = [&]() {
@@ -448,10 +646,28 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.candidates += (int64_t)cands.size();
         return !cands.empty();
     };
-    // One query into `buf` (grown to the whole contact set, asked again when it was too small).
+    // One query into `buf` (grown to the whole contact set, asked again when it was too small),
+    // taken from the step's batch when it ran there with exactly these inputs.
     auto run = [&](std::vector<sdfccd_Contact>& buf, const sdfccd_RigidMotion* s, const sdfccd_RigidMotion* m, double t1,
-                   const sdfccd_QueryParams& p, sdfccd_QueryResult* r) {
+                   const sdfccd_QueryParams& p, sdfccd_QueryResult* r, int stage) {
         if (buf.size() < 256) buf.resize(256);
+        if (batching) {
+            const QueryInput in = queryInput(G.sdf, G.me->id, s, *m, t1, p);
+            bool ran = false;
+            const CachedQuery* c = batched(mo, so, stage, in, &ran);
+            if (!ran && stage == kStageStart) { // a new step: batch its queries
+                prefetch(dt, margin);
+                c = batched(mo, so, stage, in, &ran);
+            }
+            if (c) {
+                *r = c->result;
+                if (buf.size() < (size_t)r->contact_count) buf.resize((size_t)r->contact_count);
+                std::copy(c->contacts.begin(), c->contacts.begin() + r->contact_count, buf.begin());
+                stats.batched_queries++;
+                stats.sdf_evaluations += r->sdf_evaluations;
+                return SDFCCD_OK;
+            }
+        }
         auto query = [&]() {
             return workspace ? sdfccd_query_mesh_ws(workspace, G.sdf, s, G.me->id, m, 0.0, t1, &p, buf.data(), (int32_t)buf.size(), r)
                              : sdfccd_query_mesh(G.sdf, s, G.me->id, m, 0.0, t1, &p, buf.data(), (int32_t)buf.size(), r);
@@ -470,20 +686,12 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     };
     // A discrete query at pose (Mx, Sx) with margin `dcd_margin`, into `buf`.
     auto discrete = [&](std::vector<sdfccd_Contact>& buf, const btTransform& Mx, const btTransform& Sx, double dcd_margin,
-                        sdfccd_QueryResult* r) {
-        sdfccd_RigidMotion m1 = sdfccd_default_rigid_motion(), s1 = sdfccd_default_rigid_motion();
-        m1.pose = toPose(Mx);
-        s1.pose = toPose(Sx);
-        sdfccd_QueryParams dcd = params;
-        dcd.method = SDFCCD_METHOD_DCD;
-        dcd.margin = dcd_margin;
-        // Subdivision regions below (discrete_subdivision_scale x the mesh radius)^2 are not split:
-        // their points lie that close to the triangle's vertices, which are candidates already.
-        // (Not for the DCD baseline, which keeps the library's subdivision.)
-        const double sub = cfg.discrete_subdivision_scale * G.me->radius;
-        if (continuous && sub > 0) dcd.subdivision_min_area = std::max(dcd.subdivision_min_area, sub * sub);
+                        sdfccd_QueryResult* r, int stage) {
+        sdfccd_RigidMotion m1, s1;
+        posePair(Mx, Sx, m1, s1);
+        const sdfccd_QueryParams dcd = discreteParams(P, dcd_margin);
         stats.end_pose_queries++;
-        return run(buf, static_sdf ? nullptr : &s1, &m1, 0.0, dcd, r) == SDFCCD_OK;
+        return run(buf, static_sdf ? nullptr : &s1, &m1, 0.0, dcd, r, stage) == SDFCCD_OK;
     };
 
     // Moving steps. (1) A discrete query at the start pose with the margin widened by the step's
@@ -495,20 +703,10 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // together on a resting body). Otherwise (2) the CCD query over the step; no hit, no contact.
     sdfccd_QueryResult r0{};
     bool start_ran = false, start_ok = false, starts_touching = false;
-    double start_margin = margin, travel = 0, kick = 0;
-    if (dt > 0) {
-        const double reach = G.me->radius + (double)(G.M.t0.getOrigin() - G.S.t0.getOrigin()).length();
-        travel = dt * ((double)(G.M.v - G.S.v).length() + (double)G.M.w.length() * G.me->radius + (double)G.S.w.length() * reach);
-        // A kick (a velocity change from another contact solved in the same step, e.g. a body
-        // landing on this one) is not in the predicted motion: the start-pose query also reaches
-        // as far as kick_angular_speed about the body's centre carries its farthest point in the
-        // step, and its features count even when the predicted motion has no contact.
-        kick = dt * cfg.kick_angular_speed * G.me->radius;
-        start_margin = margin + travel + kick;
-    }
+    const double start_margin = P.start_margin, travel = P.travel, kick = P.kick;
     if (dt > 0 && continuous) {
         start_ran = true;
-        start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0);
+        start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0, kStageStart);
         if (start_ok && r0.triangles_tested == 0 && r0.state == SDFCCD_STATE_NO_HIT) {
             stats.queries_skipped++;
             stats.last_state = (int)SDFCCD_STATE_NO_HIT;
@@ -538,7 +736,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.last_toi_fraction = 0;
     } else {
         sdfccd_QueryResult res;
-        sdfccd_Status status = run(contacts, sm, &mm, dt, params, &res);
+        sdfccd_Status status = run(contacts, sm, &mm, dt, params, &res, kStageCcd);
         stats.queries++;
         if (status != SDFCCD_OK) {
             stats.query_errors++;
@@ -557,7 +755,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         G.addContacts(contacts.data(), res.contact_count, margin + std::max(cfg.vertex_distance, params.contact_slop));
         if (dt > 0 && !start_ran && (res.toi > 0 || travel + kick > margin)) {
             start_ran = true;
-            start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0);
+            start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0, kStageStart);
         }
     }
 
@@ -574,7 +772,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
                                               : start_margin;
         if (start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, accept);
         sdfccd_QueryResult r1;
-        if (discrete(contacts, G.M.t1, G.S.t1, margin, &r1) && r1.hit) G.addPose(contacts.data(), r1.contact_count, G.M.t1, G.S.t1, margin);
+        if (discrete(contacts, G.M.t1, G.S.t1, margin, &r1, kStageEnd) && r1.hit) G.addPose(contacts.data(), r1.contact_count, G.M.t1, G.S.t1, margin);
     }
     return finish();
 }

@@ -118,6 +118,55 @@ std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double t
 std::vector<int> coverContacts(const std::vector<Candidate>& c, const std::vector<int>& chosen, int limit, double slope,
                                double depth, double tol);
 
+// The inputs of one pair's queries in a step: gather() and the batch prefetch build them alike.
+struct PairPlan {
+    const MeshEntry* me = nullptr;
+    sdfccd_SdfId sdf = kNullSdf;
+    BodyMotion M, S;            // in the SDF's frame when static_sdf
+    bool static_sdf = false;
+    btTransform sdf_world;      // the SDF's world pose (static_sdf)
+    sdfccd_RigidMotion mm, sm_value;
+    sdfccd_QueryParams params;  // Config::query with the pair's margin
+    bool continuous = true;     // not the DCD baseline
+    double margin = 0, start_margin = 0, travel = 0, kick = 0;
+    const sdfccd_RigidMotion* sm() const { return static_sdf ? nullptr : &sm_value; }
+};
+
+// One query's arguments, compared byte for byte with those of a batched query.
+struct QueryInput {
+    sdfccd_SdfId sdf;
+    sdfccd_MeshId mesh;
+    int has_sdf_motion;
+    sdfccd_RigidMotion sdf_motion, motion;
+    double t1;
+    sdfccd_QueryParams params;
+};
+QueryInput queryInput(sdfccd_SdfId sdf, sdfccd_MeshId mesh, const sdfccd_RigidMotion* sm, const sdfccd_RigidMotion& m, double t1,
+                      const sdfccd_QueryParams& p);
+
+// The stages of a pair's queries in a step, in their order.
+enum QueryStage { kStageStart = 0, kStageCcd = 1, kStageEnd = 2 };
+
+// A query run ahead in a step's batch (Config::batch_threads), keyed by its pair and stage.
+struct CachedQuery {
+    QueryInput in;
+    sdfccd_Status status = SDFCCD_OK;
+    sdfccd_QueryResult result;
+    std::vector<sdfccd_Contact> contacts; // capacity given to the query
+};
+struct PairStageKey {
+    const btCollisionObject* mesh;
+    const btCollisionObject* sdf;
+    int stage;
+    bool operator==(const PairStageKey& o) const { return mesh == o.mesh && sdf == o.sdf && stage == o.stage; }
+};
+struct PairStageHash {
+    size_t operator()(const PairStageKey& k) const
+    {
+        return std::hash<const void*>()(k.mesh) * 31u + std::hash<const void*>()(k.sdf) * 7u + (size_t)k.stage;
+    }
+};
+
 class MeshSdfAlgorithm;
 
 Status clampCheck(const BridgeImpl* impl, const btCollisionWorld* world);
@@ -149,6 +198,18 @@ public:
     bool isMeshLike(const btCollisionShape* s) const;
 
     // contact_policy.cpp
+    // The pair's query inputs (false: no mesh or SDF to work with).
+    bool plan(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin, detail::PairPlan& P);
+    // The discrete queries' parameters (start and end pose) with margin `dcd_margin`.
+    sdfccd_QueryParams discreteParams(const detail::PairPlan& P, double dcd_margin) const;
+    // Config::batch_threads: runs the queries of every pair of `world`'s pair cache the bridge
+    // handles and that the batch covers, stage by stage, into batch_cache (replacing it).
+    void prefetch(double dt, double margin);
+    // The batched result of (mesh, sdf, stage) when its inputs are exactly `in`, else NULL; *ran
+    // tells whether the batch ran that query (a result it cannot give: an error, or more contacts
+    // than the batch had room for, which the caller queries again).
+    const detail::CachedQuery* batched(const btCollisionObject* mo, const btCollisionObject* so, int stage, const detail::QueryInput& in,
+                                       bool* ran) const;
     bool gather(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin,
                 std::vector<detail::Candidate>& cands, double* out_radius, btVector3* out_w);
     // Writes the pair's points into manifolds[0..manifold_count) (4 each; the first one is the
@@ -195,6 +256,10 @@ public:
     std::vector<detail::Candidate> scratch;
     std::vector<sdfccd_Contact> contacts, start_contacts;
     sdfccd_Workspace* workspace = nullptr; // the queries' scratch storage (no allocation per query)
+    // Config::batch_threads: the world whose pair cache the batch reads (registerWith(world)) and
+    // the last batch's results.
+    btCollisionWorld* batch_world = nullptr;
+    std::unordered_map<detail::PairStageKey, detail::CachedQuery, detail::PairStageHash> batch_cache;
 
     struct CreateFunc;
     std::unique_ptr<CreateFunc> fn[2]; // contact points, closest points

@@ -75,6 +75,7 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     const double face = std::isnan(opt.face_search) ? setup.face_search : opt.face_search;
     cfg.face_search_size = face > 0 ? face : 0;
     if (opt.discrete_subdivision_scale >= 0) cfg.discrete_subdivision_scale = opt.discrete_subdivision_scale;
+    if (opt.batch_threads >= 1) cfg.batch_threads = opt.batch_threads;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
     if (m_bridge && cfg.patch_band >= 0) {

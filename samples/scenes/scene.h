@@ -52,6 +52,7 @@ struct Options {
                                             0 when a spread depth scale >= 0 is set; 0: off). */
     double discrete_subdivision_scale = -1; /**< Bullet scenes: the bridge's Config::discrete_subdivision_scale (< 0: its
                                                  default; 0: the library's own subdivision). */
+    int batch_threads = -1; /**< Bullet scenes: the bridge's Config::batch_threads (< 1: its default, 1). */
     std::string data_dir; /**< The project's data/ folder. */
 };
 

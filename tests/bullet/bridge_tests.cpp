@@ -935,6 +935,76 @@ static void test_torus_flat()
     sdfccd_destroy_sdf(slab);
 }
 
+// ---- Config::batch_threads: the same simulation, the queries batched across pairs ----
+
+// Eight bodies (tori and boxes as GImpact meshes, one btBoxShape) thrown onto a slab and a ball,
+// both SdfShapes, for `steps` steps; every body's pose and velocity after every step in `trace`.
+static sdfccd_bullet::Stats runPile(int batch_threads, int steps, std::vector<btScalar>& trace)
+{
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05), ball = { 0, 0 };
+    CHECK(sdfccd_create_sphere(0.4, &ball) == SDFCCD_OK, "sphere: %s", sdfccd_last_error());
+    sdfccd_bullet::Config cfg;
+    cfg.batch_threads = batch_threads;
+    sdfccd_bullet::Stats stats;
+    {
+        Bridge bridge(cfg);
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape slab_shape(slab), ball_shape(ball);
+        w.add(&slab_shape, 0, btVector3(0, 0, 0));
+        w.add(&ball_shape, 0, btVector3(0.6, 0, 0.45));
+        std::unique_ptr<TriMesh> torus = makeTorus(0.3, 0.08, 24, 8), box = makeBox(btVector3(0.15f, 0.1f, 0.05f));
+        btBoxShape convex(btVector3(0.1f, 0.1f, 0.1f));
+        std::vector<btRigidBody*> bodies;
+        for (int i = 0; i < 8; ++i) {
+            const btVector3 pos((btScalar)(-0.9 + 0.3 * i), (btScalar)(0.1 * (i % 3)), (btScalar)(0.6 + 0.25 * i));
+            btCollisionShape* shape = i == 7 ? static_cast<btCollisionShape*>(&convex) : (i % 2 ? box->shape.get() : torus->shape.get());
+            btRigidBody* b = w.add(shape, 1, pos, i % 2 ? btVector3(0.15f, 0.1f, 0.05f) : btVector3(0.38f, 0.38f, 0.08f));
+            b->setLinearVelocity(btVector3((btScalar)(i % 2 ? 1 : -1), 0, (btScalar)(-2 - 3 * (i % 4))));
+            b->setAngularVelocity(btVector3((btScalar)(0.5 * i), (btScalar)1, 0));
+            b->setActivationState(DISABLE_DEACTIVATION);
+            bodies.push_back(b);
+        }
+        for (int s = 0; s < steps; ++s) {
+            w.step();
+            for (btRigidBody* b : bodies) {
+                const btTransform& t = b->getWorldTransform();
+                for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c) trace.push_back(t.getBasis()[r][c]);
+                for (int k = 0; k < 3; ++k) {
+                    trace.push_back(t.getOrigin()[k]);
+                    trace.push_back(b->getLinearVelocity()[k]);
+                    trace.push_back(b->getAngularVelocity()[k]);
+                }
+            }
+        }
+        stats = bridge.stats();
+    }
+    sdfccd_destroy_sdf(slab);
+    sdfccd_destroy_sdf(ball);
+    return stats;
+}
+
+static void test_batch_threads()
+{
+    const int steps = 90;
+    std::vector<btScalar> one, three;
+    const sdfccd_bullet::Stats s1 = runPile(1, steps, one), s3 = runPile(3, steps, three);
+    CHECK(one.size() == three.size() && !one.empty(), "trace sizes %zu %zu", one.size(), three.size());
+    size_t first = 0;
+    while (first < one.size() && first < three.size() && std::memcmp(&one[first], &three[first], sizeof(btScalar)) == 0) ++first;
+    CHECK(first == one.size(), "batched run differs from the unbatched one at step %zu", first / (8 * 18));
+    CHECK(s1.batched_queries == 0 && s1.batches == 0, "unbatched run used %lld batched queries", (long long)s1.batched_queries);
+    // Most queries come from the batches (the rest: contact sets larger than a batch's room).
+    CHECK(s3.batches > 0 && 2 * s3.batched_queries > s3.queries + s3.end_pose_queries, "batched %lld of %lld queries in %lld batches",
+          (long long)s3.batched_queries, (long long)(s3.queries + s3.end_pose_queries), (long long)s3.batches);
+    CHECK(s1.queries == s3.queries && s1.end_pose_queries == s3.end_pose_queries && s1.sdf_evaluations == s3.sdf_evaluations,
+          "query counts differ: %lld/%lld CCD, %lld/%lld discrete, %lld/%lld evaluations", (long long)s1.queries, (long long)s3.queries,
+          (long long)s1.end_pose_queries, (long long)s3.end_pose_queries, (long long)s1.sdf_evaluations, (long long)s3.sdf_evaluations);
+    std::printf("batch_threads 3 (%s): %lld of %lld queries from %lld batches, same %zu values over %d steps\n", SDFCCD_BULLET_PRECISION_NAME,
+                (long long)s3.batched_queries, (long long)(s3.queries + s3.end_pose_queries), (long long)s3.batches, one.size(), steps);
+}
+
 // ---- the face search (Config::face_search_size): a coarse box on the spike grid ----
 
 // How far the spike grid's tips (def's cones) reach into the box of half extents h at t (0: none).
@@ -1404,6 +1474,7 @@ static const Test kTests[] = {
     { "hard_clamp", test_hard_clamp },
     { "corner_cube", test_corner_cube },
     { "torus_flat", test_torus_flat },
+    { "batch_threads", test_batch_threads },
     { "kicked_into_sdf", test_kicked_into_sdf },
     { "compound_child", test_compound_child },
     { "face_search", test_face_search },

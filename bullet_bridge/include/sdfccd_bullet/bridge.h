@@ -222,6 +222,19 @@ struct Config {
      * against the other's field. Off: such pairs have no algorithm and pass through each other
      * (check() cannot see that; keep it on unless no two SDF bodies can meet). Default on. */
     bool sdf_pairs = true;
+    /** Threads for the queries of a step (1..256; default 1: every query runs in the narrow phase,
+     * pair by pair, on Bullet's thread). With more, the first pair of each step that the bridge
+     * processes runs the queries of EVERY pair the world's broad phase holds for it (the start-pose
+     * query, then the CCD queries, then the end-pose queries, each stage as one sdfccd_query_batch
+     * on this many threads), and each pair then takes its results from there. The results are
+     * bitwise those the pair would have computed itself, so the simulation is the same whatever the
+     * count. Needs registerWith(btCollisionWorld*) (the pair cache is the world's). Not batched,
+     * and queried in the narrow phase as before: compound children, pairs with the face search, a
+     * btSdfCollisionShape, the DCD baseline (query.method DCD), closest-point queries. An SdfShape
+     * made from a callback SDF is then evaluated from several threads at once: its callback must be
+     * thread-safe (the library's built-in SDFs are). Stats::batched_queries counts the queries used
+     * from a batch. */
+    int batch_threads = 1;
     /** Query parameters passed to sdfccd_query_mesh (margin is replaced by contact_margin): the
      * library's defaults except fwgss_restarts (0): the bridge's discrete query over every
      * feature within the step's travel catches what a restart would correct, for about 20% fewer
@@ -251,6 +264,9 @@ struct Stats {
     int64_t clamps = 0;                /**< Hard-clamp corrections. */
     int64_t projections = 0;           /**< End-of-step projections (Config::projection_tolerance). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (Config::face_search_size). */
+    int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
+                                            they are counted in queries, end_pose_queries and sdf_evaluations too. */
+    int64_t batches = 0;               /**< sdfccd_query_batch calls (Config::batch_threads; up to 3 per step). */
     double last_toi_fraction = 1;      /**< Fraction of the last hit (1 when none). */
     int last_state = 0;                /**< sdfccd_ResultState of the last query. */
 };
