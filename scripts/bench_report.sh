@@ -24,7 +24,7 @@ bench="$build/samples/sdfccd_bench"
 mkdir -p "$out"
 # The commit line first: writing machine.txt below would itself count as an uncommitted change
 # when OUTDIR is the committed samples/report.
-commit="$(git -C "$(dirname "$0")/.." rev-parse --short=12 HEAD 2>/dev/null || echo unknown)$(git -C "$(dirname "$0")/.." status --porcelain --untracked-files=no 2>/dev/null | grep -q . && echo ' (with uncommitted changes)')"
+commit="$(git -C "$(dirname "$0")/.." rev-parse --short=12 HEAD 2>/dev/null || echo unknown)$(git -C "$(dirname "$0")/.." status --porcelain --untracked-files=no 2>/dev/null | grep -q . && echo ' (with uncommitted changes)' || true)"
 {
   echo "Machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'), $(nproc) logical CPUs, $(uname -sr); shared with other users: compare ratios from one run"
   echo "Load average at the start: $(cut -d" " -f1-3 /proc/loadavg) (on $(nproc) CPUs); above the CPU count, timings are contended: trust SDF-evaluation counts and same-run ratios"
