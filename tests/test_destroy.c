@@ -281,8 +281,11 @@ static void* race_everything(void* arg)
     double* vd = malloc(sizeof(double) * 3 * 4096);
     uint32_t* id = malloc(sizeof(uint32_t) * 3 * 8192);
     for (int i = 0; i < N; ++i) pts[i] = (sdfccd_Vec3){ 0.004 * i - 0.4, 0.1, 0.05 };
-    r->started++;
-    for (int it = 0; it < RACE_ITERATIONS; ++it) {
+    /* RACE_ITERATIONS rounds at least, then on until a destroy is seen: the main thread destroys
+     * once every racer has finished a round, so this ends (under valgrind, which runs one thread
+     * at a time, a fixed count could finish before the destroy). */
+    for (int it = 0; it < RACE_ITERATIONS || (r->invalid == 0 && it < 1000000); ++it) {
+        if (it == 1) r->started++; /* a whole round done: some calls were OK before any destroy */
         sdfccd_SdfInfo si;
         tally(r, sdfccd_sdf_get_info(r->sdf, &si), "sdf_get_info");
         tally(r, sdfccd_sdf_eval_batch(r->sdf, pts, N, val, NULL), "sdf_eval_batch");
