@@ -11,8 +11,10 @@ tests="test_api test_sdf test_ccd test_hardening test_destroy test_solvers test_
 cmake --build "$b" -j2 --target $tests >/dev/null
 for t in $tests; do
   echo "== valgrind: $t"
+  # The test's own output is shown only when it fails (valgrind's reports go to stderr as they come).
   CK_FORK=no valgrind --tool=memcheck --error-exitcode=1 --leak-check=full --show-leak-kinds=all \
     --errors-for-leak-kinds=all --track-origins=yes --quiet \
-    --suppressions=scripts/valgrind.supp "$b/tests/$t" >/dev/null
+    --suppressions=scripts/valgrind.supp "$b/tests/$t" >"$b/valgrind_$t.out" \
+    || { tail -40 "$b/valgrind_$t.out"; echo "valgrind: $t failed"; exit 1; }
 done
 echo "valgrind: all clean"
