@@ -8,7 +8,7 @@
 //                 [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]
 //                 [--projection T] [--spread-depth-fraction F] [--face-search S]
 //                 [--discrete-subdivision-scale S] [--batch-threads N] [--data DIR] [--check KEY=LIMIT,...]
-//                 [--quiet] [--table4]
+//                 [--quiet] [--table4] [--inject-nan STEP[,KIND]]
 //
 // --patch-band B / --hard-clamp T / --spread-depth-scale D / --solver-iterations N override the
 // Bullet scenes' set-up (the bridge's Config::patch_band, Bridge::setHardClamp tolerance,
@@ -30,7 +30,9 @@
 // twice: sdfccd_scenes (float Bullet) and sdfccd_scenes_f64 (double). --precision runs the
 // sibling executable with the same arguments when it names the other one.
 //
-// --check evaluates limits on the summary and exits 1 on a violation (the stability tests):
+// --check evaluates limits on the summary and exits 1 on a violation (the stability tests). Every
+// key needs a number. A run that met a non-finite position, velocity, SDF value or energy fails
+// every check (and exits 1 even without --check); a failed measurement query exits 2.
 //   max_pen=M       max penetration over the run <= M (m)
 //   max_pen_ccd=M   the same against the SDF the CCD is given (a grid's own field) <= M (m)
 //   min_max_pen=M   max penetration >= M (asserts that a method fails)
@@ -40,7 +42,15 @@
 //   rest_drift=D    max centre displacement over the last second <= D (m)
 //   moving=N        bodies still moving (> 0.05 m/s) at the end <= N
 //   energy_gain=E   largest energy gain in one step <= E (J)
-//   contact=1 / hit=1   some sample came within 1 mm / the CCD reported contact
+//   contact=1       some sample came within 1 mm (contact=0: none did)
+//   hit=N           at least N CCD queries found contact (bridge: pair-steps with contact)
+//   queries=N       at least N CCD queries were made (the pipeline ran; for methods that never hit)
+//   query_errors=N  at most N CCD queries failed; without this key every check implies query_errors=0
+//
+// --inject-nan STEP[,KIND] is a test hook: after step STEP the runner puts a NaN into what it
+// measures (KIND position: the first active body's centre (default); velocity: the first rigid
+// body's linear velocity; energy; phi: an SDF value; query: a measured point, so the measurement
+// query fails and the runner exits 2). The ctests scenes.inject_nan.* prove the checks see it.
 #include <cerrno>
 #include <climits>
 #include <cstdio>
@@ -72,7 +82,9 @@ void usage(std::FILE* f)
                  "                     [--projection T] [--spread-depth-fraction F] [--face-search S]\n"
                  "                     [--discrete-subdivision-scale S] [--batch-threads N] [--data DIR]\n"
                  "                     [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
-                 "check keys: max_pen max_pen_ccd min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain contact hit\n");
+                 "                     [--inject-nan STEP[,position|velocity|energy|phi|query]]  (test hook)\n"
+                 "check keys: max_pen max_pen_ccd min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain\n"
+                 "            contact hit queries query_errors (see samples/sdfccd_scenes.cpp)\n");
 }
 
 // Runs the sibling build (sdfccd_scenes <-> sdfccd_scenes_f64) with the same arguments.
@@ -156,6 +168,17 @@ int main(int argc, char** argv)
         else if (a == "--check") check = value("limits");
         else if (a == "--quiet") quiet = true;
         else if (a == "--table4") cfg.probe = true;
+        else if (a == "--inject-nan") {
+            std::string v = value("STEP[,KIND]");
+            size_t comma = v.find(',');
+            cfg.inject_step = std::atoi(v.substr(0, comma).c_str());
+            if (comma != std::string::npos) cfg.inject_kind = v.substr(comma + 1);
+            const std::string k = cfg.inject_kind;
+            if (cfg.inject_step < 0 || (k != "position" && k != "velocity" && k != "energy" && k != "phi" && k != "query")) {
+                std::fprintf(stderr, "sdfccd_scenes: --inject-nan STEP[,position|velocity|energy|phi|query]\n");
+                return 2;
+            }
+        }
         else {
             std::fprintf(stderr, "sdfccd_scenes: unknown option '%s'\n", a.c_str());
             usage(stderr);
@@ -202,6 +225,10 @@ int main(int argc, char** argv)
     s.subdivision = opt.subdivision;
     printSummary(s, stdout);
     if (sdfccd_byte_count() != 0) std::fprintf(stderr, "sdfccd_scenes: %lld bytes of sdfccd memory not freed\n", (long long)sdfccd_byte_count());
+    if (!s.measure_error.empty()) {
+        std::fprintf(stderr, "sdfccd_scenes: measurement failed at %s\n", s.measure_error.c_str());
+        return 2;
+    }
     if (!check.empty()) {
         std::string why;
         if (!checkSummary(s, check, &why)) {
@@ -210,5 +237,6 @@ int main(int argc, char** argv)
         }
         std::printf("check passed: %s\n", check.c_str());
     }
+    if (s.non_finite_step >= 0) return 1;
     return sdfccd_byte_count() == 0 ? 0 : 1;
 }

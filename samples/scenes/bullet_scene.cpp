@@ -301,6 +301,7 @@ StepCost BulletScene::cost() const
         c.ccd_seconds = s.query_seconds;
         c.ccd_queries = s.queries + s.end_pose_queries;
         c.hits = s.hits;
+        c.query_errors = s.query_errors;
         c.sdf_evaluations = s.sdf_evaluations + s.own_evaluations;
     }
     c.triangles_tested = -1;

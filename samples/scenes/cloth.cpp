@@ -374,6 +374,7 @@ private:
             sdfccd_Status st = sdfccd_query_mesh_linear(c.ccd, nullptr, mesh.handle, va.data(), vb.data(), 0, dt, &params, nullptr, 0, &res);
             ++m_cost.ccd_queries;
             if (st == SDFCCD_OK) m_cost.triangles_tested += res.triangles_tested;
+            else ++m_cost.query_errors;
             if (st != SDFCCD_OK || !res.hit) {
                 m_cost.ccd_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                 continue;
@@ -401,9 +402,11 @@ private:
                 }
                 if (phi_min > reach + edge + kMargin) continue; // cannot reach the surface this step
                 sdfccd_QueryResult tr;
-                if (sdfccd_query_triangle_linear(c.ccd, nullptr, s0, s1, 0, dt, &params, buf.data(), (int32_t)buf.size(), &tr) != SDFCCD_OK ||
-                    !tr.hit)
+                if (sdfccd_query_triangle_linear(c.ccd, nullptr, s0, s1, 0, dt, &params, buf.data(), (int32_t)buf.size(), &tr) != SDFCCD_OK) {
+                    ++m_cost.query_errors;
                     continue;
+                }
+                if (!tr.hit) continue;
                 if (freeze && tr.state != SDFCCD_STATE_PENETRATING) {
                     // Last resort after the iteration cap: a triangle that still reaches the
                     // surface inside the step does not move this step.

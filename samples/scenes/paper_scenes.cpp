@@ -441,6 +441,7 @@ public:
             m_cost.ccd_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             ++m_cost.ccd_queries;
             if (st != SDFCCD_OK) {
+                ++m_cost.query_errors;
                 std::fprintf(stderr, "sdfccd_scenes: query failed: %s\n", sdfccd_last_error());
                 continue;
             }

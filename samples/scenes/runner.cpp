@@ -96,7 +96,30 @@ struct Measure {
     std::vector<std::vector<double>> sample_phi; // per body, per sample (for snapshots)
     std::vector<char> tunnelled;                 // per body, this step
     std::vector<std::array<double, 3>> centre;   // per body, after the last step (swept kill planes)
+    std::string non_finite;                      // this step: the first non-finite position or SDF value met
+    std::string error;                           // this step: the first measurement query that failed
+    int inject = 0;                              // test hook (RunConfig::inject_kind): 1 NaN phi, 2 NaN query point
 };
+
+bool allFinite(const double* p, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!std::isfinite(p[i])) return false;
+    return true;
+}
+
+std::string bodyName(const Scene& scene, size_t bi) { return scene.bodies[bi].name + "#" + std::to_string(bi); }
+
+void noteNonFinite(Measure& m, const std::string& what)
+{
+    if (m.non_finite.empty()) m.non_finite = what;
+}
+
+// A measurement query failed on finite points: the step's figures are not measurements.
+void noteError(Measure& m, const char* call, const std::string& where)
+{
+    if (m.error.empty()) m.error = std::string(call) + " failed (" + where + "): " + sdfccd_last_error();
+}
 
 // Where each body's centre is now (before the first step: the swept kill planes' start).
 void recordCentres(const Scene& scene, Measure& m)
@@ -116,6 +139,8 @@ void measure(Scene& scene, Measure& m)
     m.min_phi_ccd = 1e300;
     m.min_body = m.min_collider = m.min_sample = -1;
     m.deep = 0;
+    m.non_finite.clear();
+    m.error.clear();
     m.body_min.assign(nb, 1e300);
     m.sample_phi.resize(nb);
     m.tunnelled.assign(nb, 0);
@@ -130,6 +155,10 @@ void measure(Scene& scene, Measure& m)
             const Body& b = scene.bodies[bi];
             if (!b.active) continue;
             worldSamples(b, pts);
+            if (!allFinite(pts.data(), pts.size())) {
+                noteNonFinite(m, "position of " + bodyName(scene, bi));
+                continue;
+            }
             size_t n = pts.size() / 3;
             double lc[3];
             c.frame.applyInverse(&pts[3 * (n - 1)], lc);
@@ -154,9 +183,15 @@ void measure(Scene& scene, Measure& m)
                     double x[3], xl[3], phi = 1e300;
                     for (int k = 0; k < 3; ++k) x[k] = prev[k] + d[k] * j / ns;
                     c.frame.applyInverse(x, xl);
-                    if (sdfccd_sdf_eval(c.exact, sdfccd_Vec3{ xl[0], xl[1], xl[2] }, &phi, nullptr) == SDFCCD_OK &&
-                        phi < -b.mesh->half_thickness)
-                        m.tunnelled[bi] = 1;
+                    if (sdfccd_sdf_eval(c.exact, sdfccd_Vec3{ xl[0], xl[1], xl[2] }, &phi, nullptr) != SDFCCD_OK) {
+                        noteError(m, "sdfccd_sdf_eval", "swept centre of " + bodyName(scene, bi) + " in " + c.name);
+                        break;
+                    }
+                    if (!std::isfinite(phi)) {
+                        noteNonFinite(m, "SDF value of " + c.name + " at the swept centre of " + bodyName(scene, bi));
+                        break;
+                    }
+                    if (phi < -b.mesh->half_thickness) m.tunnelled[bi] = 1;
                 }
             }
             double reach = b.deformable ? 1e300 : b.mesh->radius;
@@ -169,12 +204,34 @@ void measure(Scene& scene, Measure& m)
             }
         }
         if (batch.empty()) continue;
+        if (m.inject == 2) { // test hook: a NaN point, so the query fails
+            batch[0].x = NAN;
+            m.inject = 0;
+        }
         std::vector<double> phi(batch.size(), 1e300);
         if (c.exact_mesh.index1) {
-            sdfccd_mesh_signed_distance(c.exact_mesh, batch.data(), (int32_t)batch.size(), 0, phi.data(), nullptr);
+            if (sdfccd_mesh_signed_distance(c.exact_mesh, batch.data(), (int32_t)batch.size(), 0, phi.data(), nullptr) != SDFCCD_OK) {
+                noteError(m, "sdfccd_mesh_signed_distance", "samples in " + c.name);
+                continue;
+            }
         } else {
-            for (size_t i = 0; i < batch.size(); ++i) sdfccd_sdf_eval(c.exact, batch[i], &phi[i], nullptr);
+            bool failed = false;
+            for (size_t i = 0; i < batch.size() && !failed; ++i)
+                if (sdfccd_sdf_eval(c.exact, batch[i], &phi[i], nullptr) != SDFCCD_OK) failed = true;
+            if (failed) {
+                noteError(m, "sdfccd_sdf_eval", "samples in " + c.name);
+                continue;
+            }
         }
+        if (m.inject == 1) { // test hook: a NaN SDF value
+            phi[0] = NAN;
+            m.inject = 0;
+        }
+        for (size_t i = 0; i < phi.size(); ++i)
+            if (!std::isfinite(phi[i])) {
+                noteNonFinite(m, "SDF value of " + c.name + " at a sample");
+                break;
+            }
         // The CCD's own SDF where it differs from the reference (a grid baked from a mesh): how
         // deep the samples are in the field the CCD was given, apart from the grid's own error.
         if (c.ccd.index1 && (c.exact_mesh.index1 || c.ccd.index1 != c.exact.index1 || c.ccd.generation != c.exact.generation)) {
@@ -182,7 +239,12 @@ void measure(Scene& scene, Measure& m)
                 size_t first = owner[k].second, end = k + 1 < owner.size() ? owner[k + 1].second : batch.size();
                 for (size_t i = first; i + 1 < end; ++i) {
                     double p = 1e300;
-                    if (sdfccd_sdf_eval(c.ccd, batch[i], &p, nullptr) == SDFCCD_OK) m.min_phi_ccd = std::min(m.min_phi_ccd, p);
+                    if (sdfccd_sdf_eval(c.ccd, batch[i], &p, nullptr) != SDFCCD_OK) {
+                        noteError(m, "sdfccd_sdf_eval", "samples in the CCD's SDF of " + c.name);
+                        break;
+                    }
+                    if (!std::isfinite(p)) noteNonFinite(m, "SDF value of the CCD's SDF of " + c.name);
+                    m.min_phi_ccd = std::min(m.min_phi_ccd, p);
                 }
             }
         } else {
@@ -236,7 +298,14 @@ void measure(Scene& scene, Measure& m)
                     closestOnTriangle(fp, &tri[3 * (size_t)mesh.f[3 * (size_t)t]], &tri[3 * (size_t)mesh.f[3 * (size_t)t + 1]],
                                       &tri[3 * (size_t)mesh.f[3 * (size_t)t + 2]], q);
                     double p = 1e300;
-                    if (sdfccd_sdf_eval(c.exact, sdfccd_Vec3{ q[0], q[1], q[2] }, &p, nullptr) != SDFCCD_OK) continue;
+                    if (sdfccd_sdf_eval(c.exact, sdfccd_Vec3{ q[0], q[1], q[2] }, &p, nullptr) != SDFCCD_OK) {
+                        noteError(m, "sdfccd_sdf_eval", "feature points of " + c.name);
+                        continue;
+                    }
+                    if (!std::isfinite(p)) {
+                        noteNonFinite(m, "SDF value of " + c.name + " at a feature point");
+                        continue;
+                    }
                     if (p < kDeepPhi) ++m.deep;
                     m.min_phi_ccd = std::min(m.min_phi_ccd, p);
                     if (p < m.body_min[o.first]) m.body_min[o.first] = p;
@@ -320,7 +389,7 @@ bool probeStep(Scene& scene, const RunConfig& cfg, Summary& s, ProbeStats& ps)
                     double d[3] = { tri[k].x - cen[0], tri[k].y - cen[1], tri[k].z - cen[2] };
                     r = std::max(r, std::sqrt(dot3(d, d)));
                 }
-                double wc[3], l[3], phi;
+                double wc[3], l[3], phi = -1e300; // a failed evaluation keeps the triangle (it is timed, not measured)
                 b.frame.apply(cen, wc);
                 c.frame.applyInverse(wc, l);
                 sdfccd_sdf_eval(c.ccd, sdfccd_Vec3{ l[0], l[1], l[2] }, &phi, nullptr);
@@ -392,7 +461,26 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
         double ccd_s = c.ccd_seconds - prev_cost.ccd_seconds;
         if (probing) s.probe_step_ms += 1e3 * (step_s - ccd_s);
         contacts_sum += c.contacts;
+        if (i == cfg.inject_step) { // test hook (RunConfig::inject_step)
+            m.inject = cfg.inject_kind == "phi" ? 1 : cfg.inject_kind == "query" ? 2 : 0;
+            for (Body& b : scene.bodies) {
+                if (!b.active) continue;
+                if (cfg.inject_kind == "position") {
+                    if (b.deformable) b.world[0] = NAN;
+                    else b.frame.p[0] = NAN;
+                    break;
+                }
+                if (cfg.inject_kind == "velocity" && !b.deformable) {
+                    b.v[0] = NAN;
+                    break;
+                }
+            }
+        }
         measure(scene, m);
+        if (!m.error.empty()) {
+            s.measure_error = "step " + std::to_string(i) + ": " + m.error;
+            break;
+        }
         if (scene.sweptPenetration() > s.max_penetration) {
             s.max_penetration = scene.sweptPenetration();
             s.max_penetration_step = i;
@@ -431,6 +519,19 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
             }
         }
         double e = scene.energy();
+        if (i == cfg.inject_step && cfg.inject_kind == "energy") e = NAN;
+        // Stop at the first non-finite value: later figures would be NaN-blind.
+        std::string non_finite = m.non_finite;
+        for (size_t bi = 0; bi < scene.bodies.size() && non_finite.empty(); ++bi) {
+            const Body& b = scene.bodies[bi];
+            if (b.active && !b.deformable && !(allFinite(b.v, 3) && allFinite(b.w, 3))) non_finite = "velocity of " + bodyName(scene, bi);
+        }
+        if (non_finite.empty() && std::isfinite(s.energy_start) && !std::isfinite(e)) non_finite = "energy";
+        if (!non_finite.empty()) {
+            s.non_finite_step = i;
+            s.non_finite = non_finite;
+            break;
+        }
         if (!scene.injects(i) && std::isfinite(e) && std::isfinite(prev_energy)) s.energy_max_gain = std::max(s.energy_max_gain, e - prev_energy);
         prev_energy = e;
         double max_speed = 0;
@@ -507,6 +608,8 @@ Summary runScene(Scene& scene, const RunConfig& cfg, std::FILE* csv)
     s.step_ms = cfg.steps ? 1e3 * total_step / cfg.steps : 0;
     s.ccd_ms = cfg.steps ? 1e3 * (end.ccd_seconds - start_cost.ccd_seconds) / cfg.steps : 0;
     s.ccd_queries = end.ccd_queries - start_cost.ccd_queries;
+    s.hits = end.hits - start_cost.hits;
+    s.query_errors = end.query_errors - start_cost.query_errors;
     if (cfg.steps && end.sdf_evaluations >= 0 && start_cost.sdf_evaluations >= 0)
         s.sdf_evals_per_step = (double)(end.sdf_evaluations - start_cost.sdf_evaluations) / cfg.steps;
     s.freezes = end.freezes - start_cost.freezes;
@@ -517,6 +620,11 @@ void printSummary(const Summary& s, std::FILE* out)
 {
     std::fprintf(out, "scene %s  (%s, btScalar %s, %d steps of %.4g s)\n", s.scene.c_str(), s.description.c_str(),
                  s.precision.c_str(), s.steps, s.dt);
+    if (s.non_finite_step >= 0)
+        std::fprintf(out, "  NON-FINITE          %s at step %d: the run stopped there and every check fails\n", s.non_finite.c_str(),
+                     s.non_finite_step);
+    if (!s.measure_error.empty())
+        std::fprintf(out, "  MEASUREMENT ERROR   %s: the run stopped there (exit 2)\n", s.measure_error.c_str());
     std::fprintf(out, "  max_penetration_m   %.6f  (step %d%s%s)\n", s.max_penetration, s.max_penetration_step,
                  s.max_penetration_where.empty() ? "" : ", ", s.max_penetration_where.c_str());
     std::fprintf(out, "  max_pen_ccd_sdf_m   %.6f  (the same samples against the SDF the CCD is given: differs where it is a grid)\n",
@@ -537,6 +645,8 @@ void printSummary(const Summary& s, std::FILE* out)
     std::fprintf(out, "  step_ms             %.4f\n", s.step_ms);
     std::fprintf(out, "  ccd_ms              %.4f  (%.1f%% of the step, %lld queries)\n", s.ccd_ms,
                  s.step_ms > 0 ? 100 * s.ccd_ms / s.step_ms : 0.0, (long long)s.ccd_queries);
+    std::fprintf(out, "  ccd_hits            %lld  (queries that found contact; query errors %lld)\n", (long long)s.hits,
+                 (long long)s.query_errors);
     if (s.sdf_evals_per_step >= 0) std::fprintf(out, "  sdf_evals_per_step  %.0f\n", s.sdf_evals_per_step);
     if (s.probe_steps != 0) {
         double share = s.probe_total_ms + s.probe_step_ms > 0 ? 100 * s.probe_total_ms / (s.probe_total_ms + s.probe_step_ms) : 0;
@@ -551,13 +661,24 @@ bool checkSummary(const Summary& s, const std::string& spec, std::string* why)
 {
     std::stringstream in(spec);
     std::string item;
-    bool ok = true;
+    bool ok = true, errors_checked = false;
     std::ostringstream msg;
+    // A run that met a non-finite value or a failed measurement measured nothing: every check fails.
+    std::string broken;
+    if (s.non_finite_step >= 0) broken = "non-finite " + s.non_finite + " at step " + std::to_string(s.non_finite_step);
+    else if (!s.measure_error.empty()) broken = "measurement error at " + s.measure_error;
+    if (!broken.empty()) msg << broken << "; ";
     while (std::getline(in, item, ',')) {
         if (item.empty()) continue;
         size_t eq = item.find('=');
         std::string key = item.substr(0, eq);
-        double lim = eq == std::string::npos ? 0 : std::atof(item.c_str() + eq + 1);
+        char* end = nullptr;
+        double lim = eq == std::string::npos ? NAN : std::strtod(item.c_str() + eq + 1, &end);
+        if (eq == std::string::npos || end == item.c_str() + eq + 1 || *end != 0 || !std::isfinite(lim)) {
+            msg << "check '" << item << "' needs KEY=NUMBER; ";
+            ok = false;
+            continue;
+        }
         bool pass;
         double val;
         if (key == "max_pen") { val = s.max_penetration; pass = val <= lim; }
@@ -570,20 +691,30 @@ bool checkSummary(const Summary& s, const std::string& spec, std::string* why)
         else if (key == "rest_drift") { val = s.rest_drift; pass = val <= lim; }
         else if (key == "moving") { val = s.moving_at_end; pass = val <= lim; }
         else if (key == "energy_gain") { val = s.energy_max_gain; pass = val <= lim; }
-        else if (key == "contact") { val = s.first_contact_step; pass = val >= 0; }
-        else if (key == "hit") { val = s.first_hit_step; pass = val >= 0; }
+        else if (key == "contact" && (lim == 0 || lim == 1)) { val = s.first_contact_step; pass = (val >= 0) == (lim == 1); }
+        else if (key == "hit") { val = (double)s.hits; pass = val >= lim; }
+        else if (key == "queries") { val = (double)s.ccd_queries; pass = val >= lim; }
+        else if (key == "query_errors") { val = (double)s.query_errors; pass = val <= lim; errors_checked = true; }
         else {
-            msg << "unknown check key '" << key << "'; ";
+            msg << "unknown check '" << item << "'; ";
             ok = false;
             continue;
         }
-        if (!pass) {
+        if (!broken.empty()) {
+            ok = false;
+            msg << key << ": not measured; ";
+        } else if (!pass) {
             ok = false;
             msg << key << ": measured " << val << ", limit " << lim << "; ";
         }
     }
+    // Failed CCD queries wrote no contacts: no check passes over them unless the spec allows some.
+    if (!errors_checked && s.query_errors > 0) {
+        ok = false;
+        msg << "query_errors: measured " << s.query_errors << ", limit 0 (implied by every check); ";
+    }
     if (why) *why = msg.str();
-    return ok;
+    return ok && broken.empty();
 }
 
 } // namespace scenes

@@ -11,6 +11,12 @@
  *    its position one second before the end, and the largest vertex-speed bound |v| + |w| radius;
  *  - energy (kinetic + potential): the largest gain in one step (shots excluded);
  *  - cost: wall time per step, CCD time per step and its share, contacts per step.
+ *
+ * A non-finite body position or velocity, SDF value or energy (a scene that defines energy) stops
+ * the run at that step: Summary::non_finite says what and checkSummary fails every check. A
+ * measurement query (sdfccd_sdf_eval, sdfccd_mesh_signed_distance) that fails on finite points
+ * stops it too (Summary::measure_error; the runner exits 2): a failed query is never "no
+ * penetration".
  */
 #ifndef SDFCCD_SCENES_RUNNER_H
 #define SDFCCD_SCENES_RUNNER_H
@@ -35,6 +41,13 @@ struct RunConfig {
      * fastest of 3 identical runs). */
     bool probe = false;
     sdfccd_QueryParams probe_params = sdfccd_default_query_params();
+    /** Test hook (--inject-nan STEP[,KIND]): after step `inject_step` the runner poisons what it
+     * measures with a NaN, to prove the checks fail on it. KIND: "position" (the first active
+     * body's centre), "velocity" (the first active rigid body's linear velocity), "energy" (the
+     * scene's energy), "phi" (the first SDF value measured), "query" (the first measured point, so
+     * the measurement query fails). -1: off. */
+    int inject_step = -1;
+    std::string inject_kind = "position";
 };
 
 struct Summary {
@@ -61,6 +74,11 @@ struct Summary {
     double step_ms = 0;            /**< Mean wall time per step. */
     double ccd_ms = 0;             /**< Mean CCD time per step. */
     int64_t ccd_queries = 0;
+    int64_t hits = 0;              /**< CCD queries (pair-steps for the bridge) that found contact over the run. */
+    int64_t query_errors = 0;      /**< CCD queries of the scene that failed (StepCost::query_errors). */
+    int non_finite_step = -1;      /**< First step with a non-finite position, velocity, SDF value or energy (the run stops there). */
+    std::string non_finite;        /**< What was not finite. */
+    std::string measure_error;     /**< A measurement query that failed on finite points (the run stops there; the runner exits 2). */
     double sdf_evals_per_step = -1; /**< Mean SDF evaluations per step of the collision pipeline (-1: unknown). */
     int body_count = 0;
     int64_t deep_samples = 0;      /**< Sample-steps with phi < -1 mm. */

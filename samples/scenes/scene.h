@@ -156,6 +156,7 @@ struct StepCost {
     double ccd_seconds = 0;  /**< Time inside CCD queries (bridge or direct), cumulative. */
     int64_t ccd_queries = 0; /**< Cumulative. */
     int64_t hits = 0;        /**< Cumulative queries that found contact. */
+    int64_t query_errors = 0; /**< Cumulative CCD queries that failed (no contacts from them; the bridge's Stats::query_errors). */
     int64_t triangles_tested = 0; /**< Cumulative (direct queries only; -1 when unknown). */
     int64_t sdf_evaluations = -1; /**< Cumulative SDF evaluations of the collision pipeline (-1 when unknown). */
     int contacts = 0;        /**< Contact points alive after this step (manifolds or query contacts). */
