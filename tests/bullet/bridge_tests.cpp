@@ -2,6 +2,9 @@
 // Bullet bridge tests (built once per Bullet precision). Usage: bridge_tests [test-name ...];
 // no argument runs every test. Prints one line per failed check and a closing
 // "N passed, N failed"; exits non-zero on any failure.
+// "Measured" beside a limit: the figure at commit 954e223, float / double Bullet (each test prints
+// its figures). A limit of 2 mm on a depth is the bridge's Config::projection_tolerance (no step
+// ends deeper than that unless it started so); positions at rest are held to the same 2 mm.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -126,12 +129,23 @@ static sdfccd_SdfId makeBoxSdf(double hx, double hy, double hz)
     return id;
 }
 
+// phi at p; a failed evaluation (a NaN pose) or a non-finite value fails a check and reads as
+// infinitely deep, so no penetration limit passes over it.
 static double phiAt(sdfccd_SdfId sdf, const btVector3& p)
 {
     sdfccd_Vec3 q = { (double)p.x(), (double)p.y(), (double)p.z() };
     double v = 0;
-    sdfccd_sdf_eval(sdf, q, &v, nullptr);
-    return v;
+    sdfccd_Status st = sdfccd_sdf_eval(sdf, q, &v, nullptr);
+    CHECK(st == SDFCCD_OK && std::isfinite(v), "phi at (%g %g %g): status %d, value %g: %s", q.x, q.y, q.z, (int)st, v,
+          st == SDFCCD_OK ? "not finite" : sdfccd_last_error());
+    return st == SDFCCD_OK && std::isfinite(v) ? v : -INFINITY;
+}
+
+// Every bridge test but the misuse ones: no query failed (a failed query writes no contacts, so
+// the body would pass through with every other check blind to why).
+static void checkNoQueryErrors(const sdfccd_bullet::Stats& s, const char* what)
+{
+    CHECK(s.query_errors == 0, "%s: %lld bridge queries failed", what, (long long)s.query_errors);
 }
 
 // ---- the 200 m/s cube on a 0.1 m slab ----
@@ -177,8 +191,9 @@ static CubeRun runCube(bool bridge_on, bool mesh_first, int steps, sdfccd_bullet
             r.z.push_back(z);
             r.vz.push_back(body->getLinearVelocity().z());
             if (r.impact_step < 0 && std::fabs(z - free_z) > 1e-3) r.impact_step = i;
-            if (kVerbose) std::printf("  cube step %d: z %.6f vz %.4f\n", i, z, body->getLinearVelocity().z());
+            if (kVerbose) std::printf("  cube step %d: z %.6f vz %.5f\n", i, z, body->getLinearVelocity().z());
         }
+        if (bridge_on) checkNoQueryErrors(bridge.stats(), mesh_first ? "cube, mesh first" : "cube, SDF first");
         if (stats_out) *stats_out = bridge.stats();
     }
     sdfccd_destroy_sdf(slab);
@@ -191,7 +206,9 @@ static void testCube(bool mesh_first)
     sdfccd_bullet::Stats stats;
     CubeRun r = runCube(true, mesh_first, 120, &stats);
     // Free fall from z = 5 at 200 m/s: the bottom face (z - 0.5) reaches the slab top (0.05)
-    // during step 2 (index 1), when the centre goes from 1.667 to -1.67.
+    // during step 2 (index 1), when the centre goes from 1.667 to -1.67. Measured (both
+    // precisions): z after impact 0.550374, after it in [0.549898, 0.550374], final 0.550000,
+    // final vz 5.8e-7 / -2.9e-7 m/s.
     CHECK(r.impact_step == 1, "%s: impact step %d, expected 1", order, r.impact_step);
     if (r.impact_step >= 0)
         CHECK(std::fabs(r.z[r.impact_step] - 0.55) <= 1e-3, "%s: z after the impact step %.6f, expected 0.550 +- 0.001", order,
@@ -206,9 +223,9 @@ static void testCube(bool mesh_first)
     CHECK(std::fabs(r.vz.back()) <= 0.05, "%s: final vertical speed %.4f m/s, expected at rest", order, r.vz.back());
     CHECK(stats.speculative_contacts > 0 && stats.ordinary_contacts > 0, "%s: contacts speculative %lld ordinary %lld", order,
           (long long)stats.speculative_contacts, (long long)stats.ordinary_contacts);
-    std::printf("cube (%s, %s): impact step %d, z after impact %.6f, final z %.6f, final vz %.2e, %lld queries, "
+    std::printf("cube (%s, %s): impact step %d, z after impact %.6f, z after it in [%.6f, %.6f], final z %.6f, final vz %.2e, %lld queries, "
                 "%.1f us per query\n",
-                order, SDFCCD_BULLET_PRECISION_NAME, r.impact_step, r.impact_step >= 0 ? r.z[r.impact_step] : NAN, r.z.back(),
+                order, SDFCCD_BULLET_PRECISION_NAME, r.impact_step, r.impact_step >= 0 ? r.z[r.impact_step] : NAN, zmin, zmax, r.z.back(),
                 r.vz.back(), (long long)stats.queries, stats.queries ? 1e6 * stats.query_seconds / stats.queries : 0.0);
 }
 
@@ -294,25 +311,29 @@ static void test_torus_spinning()
                 z_impact = t.getOrigin().z();
             }
             if (kVerbose)
-                std::printf("  torus step %d: pos (%.3f %.3f %.3f) v (%.2f %.2f %.2f) w (%.2f %.2f %.2f) pen %.4f hits %lld\n", i,
+                std::printf("  torus step %d: pos (%.3f %.3f %.3f) v (%.2f %.2f %.2f) w (%.2f %.2f %.2f) pen %.5f hits %lld\n", i,
                             t.getOrigin().x(), t.getOrigin().y(), t.getOrigin().z(), body->getLinearVelocity().x(),
                             body->getLinearVelocity().y(), body->getLinearVelocity().z(), body->getAngularVelocity().x(),
                             body->getAngularVelocity().y(), body->getAngularVelocity().z(), barPenetration(torus, t, half),
                             (long long)bridge.stats().hits);
         }
         stats = bridge.stats();
+        checkNoQueryErrors(stats, "spinning bar on the torus");
         final_pos = body->getCenterOfMassPosition();
         final_v = body->getLinearVelocity();
     }
     CHECK(first_contact == 2, "first hit in step %d, expected 2 (the bar reaches the tubes during the third step)", first_contact);
+    // Measured: z after the impact 0.35519; deepest 0.00000 m (was limited to 0.02); rests at
+    // (-0.0001 -0.0180 0.3500), speed 0.00001 / 0.00000 m/s (was limited to 0.1).
     CHECK(z_impact > 0.35 - 0.02, "after the impact step the bar is at z %.4f, below the tube tops", z_impact);
-    CHECK(worst <= 0.02, "deepest end-of-step penetration %.4f m (tolerance 0.02 m)", worst);
-    CHECK(std::fabs(final_pos.z() - 0.35) <= 0.01 && final_pos.length() < 0.5, "final centre (%.3f %.3f %.3f), expected resting at z 0.35",
+    CHECK(worst <= 0.002, "deepest end-of-step penetration %.5f m (tolerance 0.002 m)", worst);
+    CHECK(std::fabs(final_pos.z() - 0.35) <= 0.002 && final_pos.length() < 0.5, "final centre (%.5f %.5f %.5f), expected resting at z 0.35",
           final_pos.x(), final_pos.y(), final_pos.z());
-    CHECK(final_v.length() < 0.1, "not at rest: %.3f m/s", final_v.length());
-    std::printf("torus: first hit in step %d, z after it %.4f, deepest end-of-step penetration %.5f m, rests at z %.4f, %lld speculative "
-                "+ %lld ordinary contacts\n",
-                first_contact, z_impact, worst, final_pos.z(), (long long)stats.speculative_contacts, (long long)stats.ordinary_contacts);
+    CHECK(final_v.length() < 0.05, "not at rest: %.3f m/s", final_v.length());
+    std::printf("torus (%s): first hit in step %d, z after it %.5f, deepest end-of-step penetration %.5f m, rests at (%.5f %.5f %.5f) "
+                "speed %.5f, %lld speculative + %lld ordinary contacts\n",
+                SDFCCD_BULLET_PRECISION_NAME, first_contact, z_impact, worst, final_pos.x(), final_pos.y(), final_pos.z(), final_v.length(),
+                (long long)stats.speculative_contacts, (long long)stats.ordinary_contacts);
     sdfccd_destroy_sdf(torus);
 }
 
@@ -345,15 +366,17 @@ static void test_kinematic_sdf()
             worst_gap = std::min(worst_gap, gap);
             final_gap = gap;
             if (kVerbose)
-                std::printf("  kinematic step %d: platform %.4f cube %.4f gap %.5f\n", i, platform->getCenterOfMassPosition().z(),
+                std::printf("  kinematic step %d: platform %.5f cube %.5f gap %.5f\n", i, platform->getCenterOfMassPosition().z(),
                             body->getCenterOfMassPosition().z(), gap);
         }
         stats = bridge.stats();
     }
     CHECK(stats.hits > 0, "no contact with the moving slab");
-    CHECK(worst_gap >= -0.01, "the cube sank %.4f m into the rising slab", -worst_gap);
-    CHECK(final_gap <= 0.05, "the cube is not riding on the slab (gap %.4f m)", final_gap);
-    std::printf("kinematic slab at 20 m/s: cube-slab gap min %.5f m, final %.5f m, %lld queries\n", worst_gap, final_gap,
+    checkNoQueryErrors(stats, "kinematic slab");
+    // Measured: gap min -0.00002 / -0.00013 m (was limited to -0.01), final 0.00000 m (was 0.05).
+    CHECK(worst_gap >= -0.002, "the cube sank %.5f m into the rising slab", -worst_gap);
+    CHECK(final_gap <= 0.002, "the cube is not riding on the slab (gap %.5f m)", final_gap);
+    std::printf("kinematic slab at 20 m/s (%s): cube-slab gap min %.5f m, final %.5f m, %lld queries\n", SDFCCD_BULLET_PRECISION_NAME, worst_gap, final_gap,
                 (long long)stats.queries);
     sdfccd_destroy_sdf(slab);
 }
@@ -391,11 +414,14 @@ static void test_dynamic_sdf_on_mesh_floor()
         }
         z_final = body->getCenterOfMassPosition().z();
         v_final = body->getLinearVelocity().length();
+        checkNoQueryErrors(bridge.stats(), "SDF ball on a mesh floor");
     }
+    // Measured: z after the impact and final 0.50000, speed 0.00000 (both precisions).
     CHECK(impact == 2, "impact in step %d, expected 2", impact);
     CHECK(std::fabs(z_after - 0.5) <= 1e-3, "z after the impact step %.5f, expected 0.5", z_after);
     CHECK(std::fabs(z_final - 0.5) <= 1e-3 && v_final < 0.05, "final z %.5f speed %.4f, expected resting at 0.5", z_final, v_final);
-    std::printf("dynamic SDF ball on a GImpact floor: impact step %d, z after it %.5f, final z %.5f\n", impact, z_after, z_final);
+    std::printf("dynamic SDF ball on a GImpact floor (%s): impact step %d, z after it %.5f, final z %.5f speed %.5f\n",
+                SDFCCD_BULLET_PRECISION_NAME, impact, z_after, z_final, v_final);
     sdfccd_destroy_sdf(ball);
 }
 
@@ -456,7 +482,7 @@ static void test_cdf_concave_box()
             worst = std::min(worst, z - half.z() - floor_z);
             if (impact < 0 && bridge.stats().hits > 0) impact = i;
             if (kVerbose)
-                std::printf("  cdf step %d: z %.4f vz %.3f queries %lld hits %lld errors %lld state %d toi %.3f\n", i, z,
+                std::printf("  cdf step %d: z %.5f vz %.3f queries %lld hits %lld errors %lld state %d toi %.3f\n", i, z,
                             body->getLinearVelocity().z(), (long long)bridge.stats().queries, (long long)bridge.stats().hits,
                             (long long)bridge.stats().query_errors, bridge.stats().last_state, bridge.stats().last_toi_fraction);
         }
@@ -465,12 +491,15 @@ static void test_cdf_concave_box()
         stats = bridge.stats();
     }
     CHECK(impact >= 0, "no contact with the .cdf shape");
-    CHECK(std::fabs(final_z - half.z() - floor_z) <= 0.01, "resting bottom at %.4f, floor at %.4f (tolerance 0.01 m, grid SDF)",
+    checkNoQueryErrors(stats, "cube on the .cdf box");
+    // Measured: floor 0.10000; the bottom rests at 0.10000, lowest 0.09992 / 0.09996 (both were
+    // limited to 0.01 m for the grid); speed 0.00005 / 0.00019 m/s.
+    CHECK(std::fabs(final_z - half.z() - floor_z) <= 0.002, "resting bottom at %.5f, floor at %.5f (tolerance 0.002 m)",
           final_z - half.z(), floor_z);
-    CHECK(worst >= -0.01, "the cube went %.4f m below the floor", -worst);
+    CHECK(worst >= -0.002, "the cube went %.5f m below the floor", -worst);
     CHECK(final_v < 0.05, "not at rest: speed %.4f", final_v);
-    std::printf("cdf concave box: floor at z = %.4f, cube bottom rests at %.4f (lowest %.4f), impact step %d, %lld queries\n",
-                floor_z, final_z - half.z(), worst + floor_z, impact, (long long)stats.queries);
+    std::printf("cdf concave box (%s): floor at z = %.5f, cube bottom rests at %.5f (lowest %.5f), speed %.5f, impact step %d, %lld queries\n",
+                SDFCCD_BULLET_PRECISION_NAME, floor_z, final_z - half.z(), worst + floor_z, final_v, impact, (long long)stats.queries);
 }
 
 // ---- a convex box resting on our shape: through the bridge's CCD (default) or, with
@@ -495,8 +524,10 @@ static void test_convex_box_on_triangulation()
         CHECK((shape.getTriangulationTriangleCount() > 0) == !ccd, "%s: triangulation %d", ccd ? "bridge" : "triangulation",
               shape.getTriangulationTriangleCount());
         CHECK((bridge.stats().queries > 0) == (ccd != 0), "bridge queries %lld", (long long)bridge.stats().queries);
+        checkNoQueryErrors(bridge.stats(), "convex box on our shape");
         double z = body->getCenterOfMassPosition().z();
-        CHECK(std::fabs(z - 0.45) <= 0.005, "convex box rests at z %.5f, expected 0.45 +- 0.005", z);
+        // Measured: 0.45000 (bridge), 0.44999 / 0.44998 (Bullet's path); was limited to 0.005.
+        CHECK(std::fabs(z - 0.45) <= 0.002, "convex box rests at z %.5f, expected 0.45 +- 0.002", z);
         CHECK(body->getLinearVelocity().length() < 0.05, "convex box not at rest: %.4f m/s", body->getLinearVelocity().length());
         // A ray straight down hits the top face at z = 0.25 (rays use the triangulation).
         btVector3 from(-1.0, 1.0, 3.0), to(-1.0, 1.0, -3.0);
@@ -504,8 +535,8 @@ static void test_convex_box_on_triangulation()
         w.world.rayTest(from, to, ray);
         CHECK(ray.hasHit() && std::fabs(ray.m_hitPointWorld.z() - 0.25) < 1e-3, "ray test: hit %d at z %.5f", (int)ray.hasHit(),
               ray.hasHit() ? (double)ray.m_hitPointWorld.z() : NAN);
-        std::printf("convex box on our shape (%s): rests at z = %.5f; ray hit z = %.5f (%d triangles)\n",
-                    ccd ? "bridge CCD" : "Bullet, triangulation", z, ray.hasHit() ? (double)ray.m_hitPointWorld.z() : NAN,
+        std::printf("convex box on our shape (%s, %s): rests at z = %.5f speed %.5f; ray hit z = %.5f (%d triangles)\n",
+                    SDFCCD_BULLET_PRECISION_NAME, ccd ? "bridge CCD" : "Bullet, triangulation", z, body->getLinearVelocity().length(), ray.hasHit() ? (double)ray.m_hitPointWorld.z() : NAN,
                     shape.getTriangulationTriangleCount());
     }
     sdfccd_destroy_sdf(ground);
@@ -686,6 +717,7 @@ static void test_closest_points_and_toi()
             alg->~btCollisionAlgorithm();
             w.dispatcher.freeCollisionAlgorithm(alg);
         }
+        checkNoQueryErrors(bridge.stats(), "closest points and time of impact");
     }
     sdfccd_destroy_sdf(slab);
 }
@@ -717,6 +749,7 @@ static double runTumble(bool clamp, int* clamps)
             worst = std::max(worst, barPenetration(torus, body->getWorldTransform(), half));
         }
         *clamps = (int)bridge.stats().clamps;
+        checkNoQueryErrors(bridge.stats(), clamp ? "tumbling bar, clamp on" : "tumbling bar, clamp off");
         CHECK(bridge.hardClampEnabled() == clamp, "hardClampEnabled");
         if (clamp) CHECK(bridge.setHardClamp(&w.world, false) == Status::Ok, "hard clamp off");
     }
@@ -731,9 +764,11 @@ static void test_hard_clamp()
     double on = runTumble(true, &clamps_on);
     CHECK(clamps_off == 0, "clamp corrections while off: %d", clamps_off);
     CHECK(clamps_on > 0, "the clamp never acted");
-    // The clamp works on the mesh's triangles (the library's queries) while this measures sample
-    // points on the bar, hence a little slack over the 1 mm tolerance.
-    CHECK(on <= 2e-3, "with the hard clamp the deepest end-of-step penetration is %.5f m (tolerance 0.001)", on);
+    // Measured (both precisions): 0.00186 m without the clamp, 0.00021 m with it (3 corrections).
+    // The bar's sample points lie on its triangles, which the clamp holds to its 1 mm tolerance
+    // (the limit was 2 mm, above the clamp-off depth, so it could not tell the clamp mattered).
+    CHECK(on <= 1e-3, "with the hard clamp the deepest end-of-step penetration is %.5f m (tolerance 0.001)", on);
+    CHECK(off > 1e-3, "without the clamp the deepest end-of-step penetration is only %.5f m: the case does not need the clamp", off);
     std::printf("hard clamp: deepest end-of-step penetration %.5f m without, %.5f m with (%d corrections)\n", off, on, clamps_on);
 }
 
@@ -822,20 +857,22 @@ static void test_corner_cube()
             dups += duplicatePoints(w.dispatcher);
             if (w.dispatcher.getNumManifolds() > 0 && w.dispatcher.getManifoldByIndexInternal(0)->getNumContacts() > 0) ++steps_in_contact;
             if (kVerbose)
-                std::printf("  corner step %d: z %.4f v %.3f w %.3f pen %.5f\n", i, body->getCenterOfMassPosition().z(),
+                std::printf("  corner step %d: z %.5f v %.3f w %.3f pen %.5f\n", i, body->getCenterOfMassPosition().z(),
                             body->getLinearVelocity().length(), body->getAngularVelocity().length(), pen);
         }
         final_v = body->getLinearVelocity();
         final_w = body->getAngularVelocity();
         final_z = body->getCenterOfMassPosition().z();
+        checkNoQueryErrors(bridge.stats(), "corner-first cube");
     }
+    // Measured: deepest 0.00000 m (was limited to 0.01); rests at 0.55000, v 0.00004 / 0.00002, w 0.00002 / 0.00003.
     CHECK(steps_in_contact > 0, "never in contact");
-    CHECK(worst <= 0.01, "a vertex went %.4f m into the slab (limit 0.01)", worst);
+    CHECK(worst <= 0.002, "a vertex went %.5f m into the slab (limit 0.002)", worst);
     CHECK(dups == 0, "%d duplicate manifold points", dups);
-    CHECK(std::fabs(final_z - 0.55) <= 0.01 && final_v.length() < 0.05 && final_w.length() < 0.05,
+    CHECK(std::fabs(final_z - 0.55) <= 0.002 && final_v.length() < 0.05 && final_w.length() < 0.05,
           "not resting on a face: z %.4f v %.4f w %.4f", final_z, final_v.length(), final_w.length());
-    std::printf("corner-first cube at 20 m/s (%s): deepest vertex %.5f m over 240 steps, rests at z %.4f\n",
-                SDFCCD_BULLET_PRECISION_NAME, worst, final_z);
+    std::printf("corner-first cube at 20 m/s (%s): deepest vertex %.5f m over 240 steps, rests at z %.5f (v %.5f w %.5f)\n",
+                SDFCCD_BULLET_PRECISION_NAME, worst, final_z, final_v.length(), final_w.length());
     sdfccd_destroy_sdf(slab);
 }
 
@@ -881,11 +918,13 @@ static void test_kicked_into_sdf()
             if (i == 0) first = pen;
             worst = std::max(worst, pen);
             if (kVerbose)
-                std::printf("  kicked step %d: z %.4f vz %.3f pen %.5f (shot z %.4f vz %.3f)\n", i, body->getCenterOfMassPosition().z(),
+                std::printf("  kicked step %d: z %.5f vz %.3f pen %.5f (shot z %.5f vz %.3f)\n", i, body->getCenterOfMassPosition().z(),
                             body->getLinearVelocity().z(), pen, hammer->getCenterOfMassPosition().z(), hammer->getLinearVelocity().z());
         }
         projections = bridge.stats().projections;
+        checkNoQueryErrors(bridge.stats(), "kicked cube");
     }
+    // Measured: deepest 0.00100 m, first step 0.00100 m (tolerance 0.002); 8 / 10 projections.
     CHECK(tolerance > 0, "the projection is on by default");
     CHECK(projections > 0, "no projection happened");
     CHECK(first <= tolerance, "the kicked cube ended its first step %.4f m deep (tolerance %.4f)", first, tolerance);
@@ -926,12 +965,14 @@ static void test_torus_flat()
         final_w = body->getAngularVelocity().length();
         stats = bridge.stats();
     }
-    CHECK(worst <= 0.02, "a vertex went %.4f m into the slab (limit 0.02)", worst);
+    checkNoQueryErrors(stats, "flat torus");
+    // Measured: deepest 0.00000 / 0.00001 m (was limited to 0.02); rests at 0.30000 (was +- 0.01), v <= 0.00029, w <= 0.00005.
+    CHECK(worst <= 0.002, "a vertex went %.5f m into the slab (limit 0.002)", worst);
     CHECK(dups == 0, "%d duplicate manifold points", dups);
-    CHECK(std::fabs(final_z - 0.30) <= 0.01 && final_v < 0.05 && final_w < 0.05, "not resting flat: z %.4f v %.4f w %.4f", final_z,
+    CHECK(std::fabs(final_z - 0.30) <= 0.002 && final_v < 0.05 && final_w < 0.05, "not resting flat: z %.4f v %.4f w %.4f", final_z,
           final_v, final_w);
-    std::printf("flat torus at 50 m/s (%s): deepest vertex %.5f m, rests at z %.4f, %.1f candidates per query\n",
-                SDFCCD_BULLET_PRECISION_NAME, worst, final_z, stats.queries ? (double)stats.candidates / stats.queries : 0.0);
+    std::printf("flat torus at 50 m/s (%s): deepest vertex %.5f m, rests at z %.5f (v %.5f w %.5f), %.1f candidates per query\n",
+                SDFCCD_BULLET_PRECISION_NAME, worst, final_z, final_v, final_w, stats.queries ? (double)stats.candidates / stats.queries : 0.0);
     sdfccd_destroy_sdf(slab);
 }
 
@@ -991,6 +1032,8 @@ static void test_batch_threads()
     std::vector<btScalar> one, three;
     const sdfccd_bullet::Stats s1 = runPile(1, steps, one), s3 = runPile(3, steps, three);
     CHECK(one.size() == three.size() && !one.empty(), "trace sizes %zu %zu", one.size(), three.size());
+    checkNoQueryErrors(s1, "pile, 1 thread");
+    checkNoQueryErrors(s3, "pile, 3 threads");
     size_t first = 0;
     while (first < one.size() && first < three.size() && std::memcmp(&one[first], &three[first], sizeof(btScalar)) == 0) ++first;
     CHECK(first == one.size(), "batched run differs from the unbatched one at step %zu", first / (8 * 18));
@@ -1017,6 +1060,7 @@ static double tipIntrusion(const sdfccd_SpikeGridDef& def, const btTransform& t,
                                 (btScalar)def.height);
             const btVector3 l = t.invXform(tip);
             const double in = std::min(h - std::fabs((double)l.x()), std::min(h - std::fabs((double)l.y()), h - std::fabs((double)l.z())));
+            if (!std::isfinite(in)) return INFINITY; // a NaN pose is no "no intrusion"
             worst = std::max(worst, in);
         }
     return worst;
@@ -1066,12 +1110,16 @@ static void test_face_search()
     const double without = runSpikesBox(0, &rest_off, &off);
     // Without the search, the library's points (one per triangle from its vertices, subdivision
     // only around a point in contact) miss the tips between the vertices and the box sinks.
+    // Measured: with the search 0.00034 / 0.00037 m, without 0.05648 / 0.05372 m; rest speed with
+    // it 0.0385 / 0.0444 m/s.
     CHECK(without > 0.005, "without the face search the tips reach only %.4f m into the box (the case is no test)", without);
     CHECK(off.face_regions == 0, "face search ran while off: %lld regions", (long long)off.face_regions);
+    checkNoQueryErrors(on, "box on spikes, face search on");
+    checkNoQueryErrors(off, "box on spikes, face search off");
     CHECK(with <= 0.001, "with the face search the tips reach %.4f m into the box (limit 0.001)", with);
     CHECK(rest_on <= 0.05, "with the face search the box is still moving: %.4f m/s over the last second", rest_on);
     CHECK(on.face_regions > 0, "face search never ran");
-    std::printf("box on spikes (%s): tip intrusion %.5f m with the face search (%lld regions), %.5f m without; rest speed %.4f / %.4f m/s\n",
+    std::printf("box on spikes (%s): tip intrusion %.5f m with the face search (%lld regions), %.5f m without; rest speed %.5f / %.5f m/s\n",
                 SDFCCD_BULLET_PRECISION_NAME, with, (long long)on.face_regions, without, rest_on, rest_off);
 }
 
@@ -1112,11 +1160,14 @@ static void test_compound_child()
         stats = bridge.stats();
     }
     CHECK(stats.hits > 0, "the compound child never reached the bridge's algorithm");
-    CHECK(worst <= 0.01, "the child went %.4f m into the slab", worst);
-    CHECK(std::fabs(lowest_final - 0.05) <= 0.005 && final_v < 0.05, "child's lowest vertex rests at %.4f (slab top 0.05), speed %.4f",
+    checkNoQueryErrors(stats, "compound child");
+    // Measured: deepest 0.00754 m (both precisions; the limit stays 0.01), rests with its lowest
+    // vertex at 0.05000 (was +- 0.005), speed 0.00026 / 0.00016.
+    CHECK(worst <= 0.01, "the child went %.5f m into the slab", worst);
+    CHECK(std::fabs(lowest_final - 0.05) <= 0.002 && final_v < 0.05, "child's lowest vertex rests at %.4f (slab top 0.05), speed %.4f",
           lowest_final, final_v);
-    std::printf("compound child (%s): deepest %.5f m, rests with its lowest vertex at %.4f\n", SDFCCD_BULLET_PRECISION_NAME, worst,
-                lowest_final);
+    std::printf("compound child (%s): deepest %.5f m, rests with its lowest vertex at %.5f, speed %.5f\n", SDFCCD_BULLET_PRECISION_NAME,
+                worst, lowest_final, final_v);
     sdfccd_destroy_sdf(slab);
 }
 
@@ -1184,6 +1235,7 @@ static void test_callbacks()
         for (int i = 0; i < 5; ++i) w.step();
         CHECK(g_ended == 1, "after lifting: %d ended callbacks, expected 1", g_ended);
         for (int i = 0; i < 120; ++i) w.step(); // falls and lands again
+        checkNoQueryErrors(bridge.stats(), "callbacks");
     }
     gContactStartedCallback = nullptr;
     gContactEndedCallback = nullptr;
@@ -1225,12 +1277,16 @@ static void test_convex_box_fast()
         }
         final_z = body->getCenterOfMassPosition().z();
         final_v = body->getLinearVelocity().length();
+        CHECK(bridge.stats().hits > 0, "the box never reached the bridge's algorithm");
+        checkNoQueryErrors(bridge.stats(), "convex box at 50 m/s");
     }
     // btBoxShape's half extents include its margin: it rests with its centre at 0.05 + 0.2.
-    CHECK(worst <= 0.01, "a box corner went %.4f m into the slab", worst);
-    CHECK(std::fabs(final_z - 0.25) <= 0.005 && final_v < 0.05, "box at z %.4f speed %.4f: passed through or not at rest", final_z,
+    // Measured: deepest 0.00031 / 0.00054 m (was limited to 0.01); rests at 0.25000 (was +- 0.005).
+    CHECK(worst <= 0.002, "a box corner went %.5f m into the slab", worst);
+    CHECK(std::fabs(final_z - 0.25) <= 0.002 && final_v < 0.05, "box at z %.4f speed %.4f: passed through or not at rest", final_z,
           final_v);
-    std::printf("convex box at 50 m/s (%s): deepest corner %.5f m, rests at z %.4f\n", SDFCCD_BULLET_PRECISION_NAME, worst, final_z);
+    std::printf("convex box at 50 m/s (%s): deepest corner %.5f m, rests at z %.5f speed %.5f\n", SDFCCD_BULLET_PRECISION_NAME, worst,
+                final_z, final_v);
     sdfccd_destroy_sdf(slab);
 }
 
@@ -1257,13 +1313,15 @@ static void test_sdf_on_sdf()
         final_z = body->getCenterOfMassPosition().z();
         final_v = body->getLinearVelocity().length();
         CHECK(bridge.stats().hits > 0, "no SDF-SDF contact");
+        checkNoQueryErrors(bridge.stats(), "SDF ball on SDF slab");
     }
-    // The ball's centre rests 0.5 above the slab top (0.05); the triangulation lies within a cell
-    // of the sphere (48 cells over 1 m: ~2 cm).
-    CHECK(lowest >= 0.55 - 0.03, "the ball went down to z %.4f (surface contact at 0.55)", lowest);
-    CHECK(std::fabs(final_z - 0.55) <= 0.03 && final_v < 0.05, "ball rests at z %.4f speed %.4f", final_z, final_v);
-    std::printf("SDF ball on SDF slab (%s): lowest centre %.4f, rests at %.4f (contact at 0.55)\n", SDFCCD_BULLET_PRECISION_NAME, lowest,
-                final_z);
+    // The ball's centre rests 0.5 above the slab top (0.05); the triangulation (48 cells over 1 m:
+    // ~2 cm) has its vertices on the sphere. Measured: lowest and resting centre 0.55000 in both
+    // precisions (the limits were 3 cm, a cell and a half).
+    CHECK(lowest >= 0.55 - 0.002, "the ball went down to z %.5f (surface contact at 0.55)", lowest);
+    CHECK(std::fabs(final_z - 0.55) <= 0.002 && final_v < 0.05, "ball rests at z %.4f speed %.4f", final_z, final_v);
+    std::printf("SDF ball on SDF slab (%s): lowest centre %.5f, rests at %.5f speed %.5f (contact at 0.55)\n", SDFCCD_BULLET_PRECISION_NAME,
+                lowest, final_z, final_v);
     sdfccd_destroy_sdf(ball);
     sdfccd_destroy_sdf(slab);
 }
