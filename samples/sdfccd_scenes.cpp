@@ -171,7 +171,10 @@ int main(int argc, char** argv)
         else if (a == "--inject-nan") {
             std::string v = value("STEP[,KIND]");
             size_t comma = v.find(',');
-            cfg.inject_step = std::atoi(v.substr(0, comma).c_str());
+            const std::string step = v.substr(0, comma);
+            char* end = nullptr;
+            const long n = std::strtol(step.c_str(), &end, 10);
+            cfg.inject_step = step.empty() || *end != 0 || n > INT_MAX ? -1 : (int)n;
             if (comma != std::string::npos) cfg.inject_kind = v.substr(comma + 1);
             const std::string k = cfg.inject_kind;
             if (cfg.inject_step < 0 || (k != "position" && k != "velocity" && k != "energy" && k != "phi" && k != "query")) {
