@@ -664,20 +664,24 @@ START_TEST(test_band_never_dense)
 }
 END_TEST
 
-typedef struct eval_job { sdfccd_SdfId grid; const sdfccd_Vec3* p; double* out; int n; } eval_job;
+typedef struct eval_job { sdfccd_SdfId grid; const sdfccd_Vec3* p; double* out; int n, failed; } eval_job;
 static void* eval_thread(void* arg)
 {
     eval_job* j = arg;
     for (int i = 0; i < j->n; ++i) {
         sdfccd_Vec3 g;
-        sdfccd_sdf_eval(j->grid, j->p[i], &j->out[i], &g);
+        if (sdfccd_sdf_eval(j->grid, j->p[i], &j->out[i], &g) != SDFCCD_OK) {
+            j->failed++;
+            j->out[i] = NAN;
+            continue;
+        }
         j->out[i] += 1e-3 * (g.x + g.y + g.z);
     }
     return NULL;
 }
 
 /* Evaluation is thread-safe: four threads evaluating one band grid at once (holes, outside
- * points and kept cells) give exactly the serial results. */
+ * points and kept cells) give exactly the serial results, and every call returns SDFCCD_OK. */
 START_TEST(test_concurrent_eval)
 {
     sdfccd_MeshId mesh = test_load_mesh("bullet3/torus_textured.obj");
@@ -693,16 +697,20 @@ START_TEST(test_concurrent_eval)
     double* par = malloc(T * N * sizeof *par);
     test_rng rng = { 71 };
     for (int i = 0; i < N; ++i) p[i] = (sdfccd_Vec3){ test_rng_uniform(&rng, -1.2, 1.2), test_rng_uniform(&rng, -0.6, 0.6), test_rng_uniform(&rng, -1.2, 1.2) };
-    eval_job js = { g, p, serial, N };
+    eval_job js = { g, p, serial, N, 0 };
     eval_thread(&js);
+    ck_assert_msg(js.failed == 0, "%d of %d serial evaluations failed", js.failed, N);
     pthread_t th[T];
     eval_job jobs[T];
     for (int t = 0; t < T; ++t) {
-        jobs[t] = (eval_job){ g, p, par + (size_t)t * N, N };
+        jobs[t] = (eval_job){ g, p, par + (size_t)t * N, N, 0 };
         ck_assert_int_eq(pthread_create(&th[t], NULL, eval_thread, &jobs[t]), 0);
     }
     for (int t = 0; t < T; ++t) pthread_join(th[t], NULL);
-    for (int t = 0; t < T; ++t) ck_assert_int_eq(memcmp(serial, par + (size_t)t * N, N * sizeof(double)), 0);
+    for (int t = 0; t < T; ++t) {
+        ck_assert_msg(jobs[t].failed == 0, "thread %d: %d of %d concurrent evaluations failed", t, jobs[t].failed, N);
+        ck_assert_int_eq(memcmp(serial, par + (size_t)t * N, N * sizeof(double)), 0);
+    }
     free(p);
     free(serial);
     free(par);

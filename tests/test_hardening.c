@@ -261,32 +261,50 @@ static double nan_field(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 
 /* Finding "NaN behind OK": CSG's fmin/fmax dropped a NaN operand, so a NaN point "touched"
  * (hit = 1 with NaN contacts). A NaN operand now makes the combination NaN, which never touches,
- * and an OK result has only finite contacts. */
+ * and an OK result has only finite contacts. The plane z = 0 united with a field that is NaN for
+ * z <= 0.05 and z above: the union is NaN wherever the plane would be touched and equals that
+ * field elsewhere, so a triangle falling through z = 0 must give, for every method, exactly the
+ * result of the NaN field alone (no hit, no contact), while the plane alone is hit at t = 0.5
+ * (DCD: at the end pose). */
 START_TEST(test_csg_nan_operand)
 {
-    sdfccd_SdfId plane, cb, u;
-    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, -5.0, &plane), SDFCCD_OK);
+    sdfccd_SdfId plane, cb, csg[3];
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, 0.0, &plane), SDFCCD_OK);
     sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
     d.eval = nan_field;
     ck_assert_int_eq(sdfccd_create_callback_sdf(&d, &cb), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_UNION, plane, cb, &u), SDFCCD_OK);
-    double v;
-    ck_assert_int_eq(sdfccd_sdf_eval(u, (sdfccd_Vec3){ 0, 0, 0 }, &v, NULL), SDFCCD_OK);
-    ck_assert(isnan(v));
+    const sdfccd_CsgOp ops[3] = { SDFCCD_CSG_UNION, SDFCCD_CSG_INTERSECTION, SDFCCD_CSG_DIFFERENCE };
+    for (int k = 0; k < 3; ++k) {
+        ck_assert_int_eq(sdfccd_create_csg(ops[k], plane, cb, &csg[k]), SDFCCD_OK);
+        double v;
+        sdfccd_Vec3 g;
+        ck_assert_int_eq(sdfccd_sdf_eval(csg[k], (sdfccd_Vec3){ 0, 0, 0 }, &v, &g), SDFCCD_OK);
+        ck_assert_msg(isnan(v) && isnan(g.z), "op %d: %g with a NaN operand", k, v);
+        ck_assert_int_eq(sdfccd_sdf_eval(csg[k], (sdfccd_Vec3){ 0, 0, 1 }, &v, NULL), SDFCCD_OK);
+        ck_assert_double_eq(v, 1.0); /* min(1, 1), max(1, 1), max(1, -1): finite operands combine as before */
+    }
+    sdfccd_SdfId u = csg[0];
     sdfccd_Vec3 tri[3] = { { 0, 0, 0.5 }, { 0.1, 0, 0.5 }, { 0, 0.1, 0.5 } };
     sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
     m.linear_velocity.z = -1.0;
     sdfccd_QueryParams p = sdfccd_default_query_params();
     sdfccd_Contact c[8];
-    sdfccd_QueryResult r;
+    sdfccd_QueryResult r, ref, pl;
     for (int method = 0; method < SDFCCD_METHOD_COUNT; ++method) {
         p.method = (sdfccd_Method)method;
+        ck_assert_int_eq(sdfccd_query_triangle(plane, NULL, tri, &m, 0, 1, &p, c, 8, &pl), SDFCCD_OK);
+        const double plane_toi = method == SDFCCD_METHOD_DCD ? 1.0 : 0.5; /* DCD looks at the end pose only */
+        ck_assert_msg(pl.hit && fabs(pl.toi - plane_toi) <= 1e-6, "method %d: the plane alone hit %d at %.9g", method, pl.hit, pl.toi);
+        ck_assert_int_eq(sdfccd_query_triangle(cb, NULL, tri, &m, 0, 1, &p, c, 8, &ref), SDFCCD_OK);
         ck_assert_int_eq(sdfccd_query_triangle(u, NULL, tri, &m, 0, 1, &p, c, 8, &r), SDFCCD_OK);
+        ck_assert_msg(!r.hit && r.contact_count == 0 && r.contacts_found == 0, "method %d: the NaN union touched (hit %d at %.9g, %d contacts)",
+                      method, r.hit, r.toi, r.contacts_found);
+        ck_assert_msg(r.hit == ref.hit && r.state == ref.state && r.toi == ref.toi && r.toi_lower == ref.toi_lower,
+                      "method %d: union state %d toi %.9g lower %.9g, NaN field alone state %d toi %.9g lower %.9g", method, r.state, r.toi,
+                      r.toi_lower, ref.state, ref.toi, ref.toi_lower);
         ck_assert(isfinite(r.toi) && isfinite(r.fraction));
-        for (int i = 0; i < r.contact_count; ++i)
-            ck_assert(isfinite(c[i].point.x) && isfinite(c[i].normal.z) && isfinite(c[i].distance));
     }
-    sdfccd_destroy_sdf(u);
+    for (int k = 0; k < 3; ++k) sdfccd_destroy_sdf(csg[k]);
     sdfccd_destroy_sdf(cb);
     sdfccd_destroy_sdf(plane);
 }
