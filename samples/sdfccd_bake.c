@@ -9,6 +9,8 @@
  * Discregrid's fitted box. Prints progress to standard error (a bar on a terminal, else a line
  * per 10 %) and a summary: cells, nodes, bytes, build time, and the max / RMS error of the grid against the
  * exact mesh distance at K random points of the domain (default 20000).
+ * Exit status: 0 on success, 1 when the mesh cannot be loaded or the grid built or written (the
+ * library's message on stderr), 2 on bad usage.
  */
 #include <errno.h>
 #include <math.h>
