@@ -12,7 +12,10 @@ static double eval(sdfccd_SdfId s, double x, double y, double z, sdfccd_Vec3* g)
     return v;
 }
 
-/* Gradient against central differences (h = 1e-6) at random points away from kinks, and unit length. */
+/* Gradient against central differences (h = 1e-6) at random points away from kinks, and unit length.
+ * At these seeds no point of any field lies within h of a kink: all 400 are checked (measured 400 of
+ * 400 for every field; the floor was 300, so a value that is no distance over a quarter of the
+ * samples, skipped as a "kink", passed). */
 static void check_gradient(sdfccd_SdfId s, test_rng* rng, double extent)
 {
     int checked = 0;
@@ -34,7 +37,7 @@ static void check_gradient(sdfccd_SdfId s, test_rng* rng, double extent)
         ck_assert_double_near(sqrt(g.x * g.x + g.y * g.y + g.z * g.z), 1.0, 1e-12);
         ++checked;
     }
-    ck_assert_int_ge(checked, 300);
+    ck_assert_msg(checked == 400, "only %d of 400 points checked (the others' finite-difference gradient is not unit)", checked);
 }
 
 /* sdfccd_sdf_eval_batch gives sdfccd_sdf_eval's values and gradients bit for bit (analytic and
