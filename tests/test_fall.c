@@ -74,7 +74,10 @@ START_TEST(test_armadillo_1k_on_spikes)
     ck_assert_int_eq(sdfccd_load_mesh(SDFCCD_DATA_DIR "/meshes/armadillo_1k.obj", NULL, &id), SDFCCD_OK);
     sdfccd_MeshInfo info;
     ck_assert_int_eq(sdfccd_mesh_get_info(id, &info), SDFCCD_OK);
-    ck_assert_uint_ge(info.triangle_count, 900);
+    /* The file's 1000 faces and 502 vertices, none degenerate (the floor was 900 triangles). */
+    ck_assert_uint_eq(info.triangle_count, 1000);
+    ck_assert_uint_eq(info.vertex_count, 502);
+    ck_assert_uint_eq(info.dropped_triangles, 0);
     double* v = malloc(3 * (size_t)info.vertex_count * sizeof *v);
     uint32_t* f = malloc(3 * (size_t)info.triangle_count * sizeof *f);
     ck_assert_int_eq(sdfccd_mesh_get_data(id, v, f), SDFCCD_OK);
