@@ -3,6 +3,7 @@
  * sphere: every vertex on the surface, the mesh closed and outward-oriented, the volume close to
  * 4/3 pi r^3; plus argument errors and allocator balance. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "test_util.h"
@@ -76,8 +77,12 @@ START_TEST(sphere_through_the_abi)
     }
     ck_assert_msg(worst <= 1e-3 * cell, "vertex off the sphere by %g (cell %g)", worst, cell);
     ck_assert_int_eq(count_bad_edges(f, info.triangle_count), 0);
-    /* Outward orientation gives a positive volume; an inscribed polyhedron is slightly smaller. */
+    /* Outward orientation gives a positive volume; an inscribed polyhedron is slightly smaller.
+     * Measured: 14592 triangles, vertices off by 0.000915 cells at worst, volume 99.809% of the
+     * exact. */
     double vol = signed_volume(v, f, info.triangle_count), exact = 4.0 / 3.0 * M_PI * r * r * r;
+    printf("sphere r=%g at 32 cells: %u triangles, vertices off the sphere by %.3g (%.3g cells), volume %.6f of exact %.6f (%.4f%%)\n", r,
+           info.triangle_count, worst, worst / cell, vol, exact, 100.0 * vol / exact);
     ck_assert_msg(vol > 0.99 * exact && vol <= exact, "volume %.6f, exact %.6f", vol, exact);
     free(v);
     free(f);
@@ -143,7 +148,10 @@ START_TEST(core_torus)
         vol += scc_dot(p0, scc_cross(p1, p2)) / 6.0;
     }
     double exact = 2 * M_PI * M_PI * 1.0 * 0.3 * 0.3;
-    ck_assert_msg(fabs(vol - exact) < 0.02 * exact, "torus volume %g, exact %g", vol, exact);
+    printf("torus at 48 cells: %u triangles, volume %.6f of exact %.6f (%.4f%%)\n", out.triangle_count, vol, exact, 100.0 * vol / exact);
+    /* Measured 99.698% of the exact volume; the limit was 2%, which linear interpolation along the
+     * edges instead of the root search (99.382%) passed. */
+    ck_assert_msg(fabs(vol - exact) < 0.005 * exact, "torus volume %g, exact %g", vol, exact);
     scc_isosurface_free(&out, &a);
     ck_assert_int_eq(live, 0);
     /* Errors leave nothing allocated. */
