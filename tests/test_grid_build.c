@@ -60,6 +60,7 @@ START_TEST(test_sphere_convergence)
         double e = max_sphere_error(g, 0.5, &ge);
         fprintf(stderr, "sphere r=0.5 on %d^3: max |phi error| %.3g, max gradient error %.3g\n", res, e, ge);
         ck_assert(e < prev / 8.0);
+        /* Measured max |phi error| 0.0128, 0.000245, 2.78e-5 and gradient error 0.275, 0.0176, 0.00326 at 8, 16, 32. */
         if (res == 32) { ck_assert(e < 5e-5); ck_assert(ge < 5e-3); }
         prev = e;
         ck_assert_int_eq(sdfccd_destroy_sdf(g), SDFCCD_OK);
