@@ -21,7 +21,10 @@
  * by 2/h_d.
  * ---------------------------------------------------------------------------------------- */
 
-typedef struct bern_tables { double val[64][32]; } bern_tables;
+typedef struct bern_tables {
+    double val[64][32];
+    double by_node[32][64]; /* val transposed: the conversion runs over independent coefficients */
+} bern_tables;
 
 typedef struct finalize_ctx {
     scc_grid* g;
@@ -58,12 +61,10 @@ static void cell_bound_task(void* vctx, uint32_t task)
         /* Bernstein coefficients of phi on the cell (degree 3 per axis), then those of each
          * partial derivative by differences: d/dxi of a cubic Bernstein form on [-1,1] has the
          * degree-2 coefficients 1.5 (b[i+1] - b[i]) along that axis. */
-        double b[64];
-        for (int s = 0; s < 64; ++s) {
-            const double* row = ctx->bt->val[s];
-            double acc = 0.0;
-            for (int k = 0; k < 32; ++k) acc += row[k] * v[k];
-            b[s] = acc;
+        double b[64] = { 0.0 };
+        for (int k = 0; k < 32; ++k) {
+            const double* row = ctx->bt->by_node[k];
+            for (int s = 0; s < 64; ++s) b[s] += row[s] * v[k];
         }
         double sum2 = 0.0;
         for (int d = 0; d < 3; ++d) {
@@ -328,6 +329,8 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     bern_tables* bt = scc_alloc(a, sizeof *bt);
     if (!bt) return SCC_GRID_OUT_OF_MEMORY;
     scc_cell_bernstein(bt->val);
+    for (int k = 0; k < 32; ++k)
+        for (int q = 0; q < 64; ++q) bt->by_node[k][q] = bt->val[q][k];
     st = compute_cell_bounds(g, bt, parallel_for, parallel_user);
     if (st == SCC_GRID_OK) st = count_valued_cells(g);
     if (st == SCC_GRID_OK) st = find_hole_sources(g);
