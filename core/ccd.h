@@ -100,6 +100,7 @@ typedef struct scc_query_summary {
     int hit;
     double toi, toi_lower;
     int contacts_found;     /* may exceed the capacity */
+    int contacts_written;   /* written to the caller's array (mesh query: a reduction when found > capacity) */
     int64_t iterations, evals, triangles_tested;
 } scc_query_summary;
 

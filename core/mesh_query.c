@@ -11,6 +11,7 @@
  * narrow-phase tests only. */
 #include "bsh.h"
 #include "ccd.h"
+#include "reduce.h"
 
 #include <string.h>
 
@@ -186,6 +187,35 @@ static int run_broad_phase(mesh_ctx* c)
     return ok;
 }
 
+/* The reduction reads a contact as its surface point (the point less phi along the normal). */
+static void contact_item(const void* set, size_t i, scc_reduce_item* out)
+{
+    const scc_contact* c = (const scc_contact*)set + i;
+    out->p = scc_sub(c->point, scc_scale(c->normal, c->distance));
+    out->n = c->normal;
+    out->gap = c->distance;
+    out->id = i;
+}
+
+/* More contacts than the caller's room: the earliest one, then a reduction of the rest (reduce.h;
+ * points within the distance tolerance count as one place), written earliest first. */
+static int reduce_output(const contact_buf* buf, const scc_params* p, scc_workspace* ws, scc_contact* out, int capacity, int* out_written)
+{
+    *out_written = 0;
+    if (capacity <= 0) return 1;
+    int32_t* idx = scc_ws_get(ws, SCC_WS_REDUCE, (size_t)capacity * sizeof *idx);
+    if (!idx) return 0;
+    size_t n = scc_reduce(buf->a, buf->n, contact_item, p->dist_tol, 0, (size_t)capacity, idx);
+    for (size_t i = 0; i < n; ++i) {
+        scc_contact key = buf->a[idx[i]];
+        size_t j = i;
+        while (j > 0 && out[j - 1].toi > key.toi) { out[j] = out[j - 1]; --j; }
+        out[j] = key;
+    }
+    *out_written = (int)n;
+    return 1;
+}
+
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum)
 {
@@ -272,6 +302,10 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     sum->state = sum->hit ? (c.budget_exhausted ? SCC_NOT_CONVERGED : best_state)
                           : (any_not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT);
     sum->contacts_found = (int)buf.n;
-    for (size_t i = 0; i < buf.n && (int)i < capacity; ++i) out[i] = buf.a[i];
-    return 1;
+    if (buf.n <= (size_t)(capacity > 0 ? capacity : 0)) {
+        for (size_t i = 0; i < buf.n; ++i) out[i] = buf.a[i];
+        sum->contacts_written = (int)buf.n;
+        return 1;
+    }
+    return reduce_output(&buf, p, ws, out, capacity, &sum->contacts_written);
 }

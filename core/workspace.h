@@ -23,6 +23,7 @@ enum {
     SCC_WS_VERTICES,  /* the ABI: linear-motion vertex copies */
     SCC_WS_TRACES,    /* mesh query: one FWGSS vertex trace record per mesh vertex (motion.h) */
     SCC_WS_GUARD,     /* guard: per-triangle contact levels (guard.c) */
+    SCC_WS_REDUCE,    /* mesh query: indices of the contacts kept when they exceed the caller's room */
     SCC_WS_SLOTS
 };
 

@@ -194,7 +194,7 @@ static void write_result(const query_setup* q, double t0, double t1, const scc_q
     r->toi_lower = s->toi_lower;
     r->fraction = t1 > t0 ? (s->toi - t0) / (t1 - t0) : 0.0;
     r->contacts_found = s->contacts_found;
-    r->contact_count = s->contacts_found < capacity ? s->contacts_found : capacity;
+    r->contact_count = s->contacts_written < capacity ? s->contacts_written : capacity; /* triangle queries stage more */
     r->iterations = s->iterations;
     r->sdf_evaluations = s->evals;
     r->triangles_tested = s->triangles_tested;

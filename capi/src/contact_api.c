@@ -4,6 +4,7 @@
 #include "capi_internal.h"
 #include "../../core/ccd.h"
 #include "../../core/guard.h"
+#include "../../core/reduce.h"
 
 #include <stdio.h>
 
@@ -142,4 +143,34 @@ sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const s
                                  sdfccd_GuardResult* out)
 {
     SDFCCD__HELD_CALL(guard_rigid(ws, sdf, sdf_motion, mesh, executed, t0, t1, params, out));
+}
+
+/* ---- contact points: reduction ---- */
+
+static void public_item(const void* set, size_t i, scc_reduce_item* out)
+{
+    const sdfccd_ContactPoint* c = (const sdfccd_ContactPoint*)set + i;
+    out->p = sdfccd__v(c->surface_point);
+    out->n = sdfccd__v(c->normal);
+    out->gap = c->gap;
+    out->id = c->id;
+}
+
+sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance, int32_t* out_indices,
+                                     int32_t capacity, int32_t* out_count)
+{
+    static const char fn[] = "sdfccd_reduce_contacts";
+    if (!out_count) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_count is NULL", fn);
+    if (count < 0 || capacity < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: count (%d) and capacity (%d) must be >= 0", fn, count, capacity);
+    if ((count > 0 && !points) || (capacity > 0 && !out_indices))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: points or out_indices is NULL", fn);
+    if (!isfinite(same_place_distance) || same_place_distance < 0.0)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: same_place_distance must be finite and >= 0 (got %g)", fn, same_place_distance);
+    for (int32_t i = 0; i < count; ++i) {
+        const sdfccd_ContactPoint* c = &points[i];
+        if (!scc_vfinite(sdfccd__v(c->surface_point)) || !scc_vfinite(sdfccd__v(c->normal)) || !isfinite(c->gap))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: point %d has a non-finite surface point, normal or gap", fn, i);
+    }
+    *out_count = (int32_t)scc_reduce(points, (size_t)count, public_item, same_place_distance, -1, (size_t)capacity, out_indices);
+    return SDFCCD_OK;
 }

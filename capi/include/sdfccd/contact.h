@@ -112,6 +112,50 @@ SDFCCD_API sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId s
                                             sdfccd_MeshId mesh, const sdfccd_RigidMotion* executed, double t0, double t1,
                                             const sdfccd_GuardParams* params, sdfccd_GuardResult* out);
 
+/** Which feature of the mesh a contact point lies on (from its barycentric weights, 1e-6). */
+typedef enum sdfccd_FeatureKind {
+    SDFCCD_FEATURE_VERTEX = 0, /**< A vertex of the mesh (`feature` is its index). */
+    SDFCCD_FEATURE_EDGE = 1,   /**< An edge of `triangle`: `feature` (0, 1, 2) is the corner it is opposite. */
+    SDFCCD_FEATURE_FACE = 2    /**< The inside of `triangle` (`feature` is 0). */
+} sdfccd_FeatureKind;
+
+/** One contact point of a mesh against an SDF over a step, as an engine's solver takes it: the
+ * material point of the mesh and the surface point and normal that hold it, all at the START of the
+ * step (t0), world frame. A speculative contact (gap > 0) lets the solver close at most the gap in
+ * the step; a negative gap is a penetration to push out. */
+typedef struct sdfccd_ContactPoint {
+    sdfccd_Vec3 point;          /**< The mesh's material point at t0 (world, m). */
+    sdfccd_Vec3 surface_point;  /**< The point of the SDF's surface that holds it, at t0: point - gap * normal (world, m). */
+    sdfccd_Vec3 normal;         /**< Unit normal out of the SDF (world), at t0. */
+    double gap;                 /**< Signed gap at t0 along the normal (m); negative: penetrating. */
+    double toi;                 /**< When the constraint was found: t0 for points of the start pose, the time of impact
+                                     for points from the CCD (s). */
+    double barycentric[3];      /**< Weights of the material point on its triangle's vertices 0, 1, 2. */
+    uint32_t triangle;          /**< Triangle index in the mesh. */
+    sdfccd_FeatureKind feature_kind; /**< Vertex, edge or face. */
+    uint32_t feature;           /**< Vertex index (VERTEX), corner opposite the edge (EDGE), 0 (FACE). */
+    uint64_t id;                /**< Feature id, the same from step to step for the same feature (warm starting): the
+                                     vertex index, (1 << 62) + 3 triangle + corner for an edge, (2 << 62) + triangle for
+                                     a face. */
+} sdfccd_ContactPoint;
+
+/** Reduces a contact set to at most `capacity` points (a pure function of its input: no handle, no
+ * allocation). Chosen, in order: the deepest point (smallest gap; among equally deep ones, within
+ * 1e-9 m, the one farthest from their centre, a corner of a face landing flat), the point farthest
+ * from it, then the points adding most area to the polygon of the chosen ones (collinear points:
+ * the ones extending the segment), and, once no point adds area, the points farthest from every
+ * chosen one. Distances and areas are between the `surface_point`s projected on the plane of the
+ * first point's normal. A point within `same_place_distance` (m, >= 0) of a chosen one is never
+ * chosen, and choosing stops when the best adds no more than that; so the count may be smaller than
+ * both `count` and `capacity`. Ties (within 1e-9 relative) go to the smaller gap, then the smaller
+ * `id`, then the lower index: with distinct ids the choice does not depend on the order of the
+ * input. Writes the chosen indices into `points` to out_indices[0 .. *out_count - 1] (in the order
+ * chosen). O(count x capacity^2) in the worst case.
+ * Errors (::SDFCCD_INVALID_ARGUMENT): NULL pointers (points may be NULL when count is 0), count or
+ * capacity < 0, same_place_distance not finite or < 0, a non-finite point, normal or gap. */
+SDFCCD_API sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
+                                                int32_t* out_indices, int32_t capacity, int32_t* out_count);
+
 #ifdef __cplusplus
 }
 #endif
