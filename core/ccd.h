@@ -138,6 +138,8 @@ typedef struct scc_mesh_query_in {
 
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum);
+/* A bound on the speed (SDF frame) of any point of the mesh over [mm->t0, mm->t1]. */
+double scc_mesh_speed_bound(const scc_mesh_motion* mm);
 /* The motion of triangle t of the mesh motion `mm` (what the mesh query tests per triangle). */
 void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_motion* out);
 /* The same with the scratch storage in a caller-kept workspace (workspace.h): after a first query

@@ -16,35 +16,6 @@
 
 enum { GUARD_ROUNDS = 3, GUARD_MAX_QUERIES = 8 };
 
-/* A bound on the speed of any point of the mesh, in the SDF frame, over [t0, t1]. */
-static double speed_bound(const scc_mesh_motion* mm)
-{
-    const double T = mm->t1 - mm->t0;
-    const scc_mesh* mesh = mm->mesh;
-    const scc_rigid* s = mm->sdf;
-    scc_vec3 gs0 = s ? scc_rigid_center_at(s, mm->t0) : scc_v3(0, 0, 0);
-    double speed = 0.0, reach = 0.0;
-    if (mm->body) {
-        const scc_rigid* b = mm->body;
-        double r = 0.0;
-        for (int k = 0; k < 8; ++k) {
-            scc_vec3 corner = scc_v3(k & 1 ? mesh->bounds.hi.x : mesh->bounds.lo.x, k & 2 ? mesh->bounds.hi.y : mesh->bounds.lo.y,
-                                     k & 4 ? mesh->bounds.hi.z : mesh->bounds.lo.z);
-            r = fmax(r, scc_dist(corner, b->c_local));
-        }
-        speed = scc_len(b->v) + scc_len(b->w) * r;
-        if (s) reach = scc_dist(scc_rigid_center_at(b, mm->t0), gs0) + r + (scc_len(b->v) + scc_len(s->v)) * T;
-    } else {
-        for (uint32_t i = 0; i < mesh->vertex_count; ++i) {
-            double d = scc_dist(mm->end[i], mm->start[i]);
-            speed = fmax(speed, T > 0.0 ? d / T : 0.0);
-            if (s) reach = fmax(reach, scc_dist(mm->start[i], gs0) + d + scc_len(s->v) * T);
-        }
-    }
-    if (s) speed += scc_len(s->v) + scc_len(s->w) * reach;
-    return speed;
-}
-
 /* phi at triangle t's material point b at time t, minus `level` (SDF frame point in *out_x). */
 static double above_level(const scc_sdf* sdf, const scc_tri_motion* m, const double b[3], double t, double level, scc_vec3* out_x,
                           int64_t* evals)
@@ -83,7 +54,7 @@ int scc_guard(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p
     qp.margin = level;
     qp.subdivision = 0; /* the first point is enough */
     /* The TOI may lie a time tolerance late: at most a tenth of the tolerance in depth. */
-    double speed = speed_bound(mm);
+    double speed = scc_mesh_speed_bound(mm);
     if (speed > 0.0) qp.time_tol = fmin(qp.time_tol, 0.1 * tolerance / speed);
 
     memset(out, 0, sizeof *out);

@@ -60,6 +60,34 @@ void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_mot
     }
 }
 
+double scc_mesh_speed_bound(const scc_mesh_motion* mm)
+{
+    const double T = mm->t1 - mm->t0;
+    const scc_mesh* mesh = mm->mesh;
+    const scc_rigid* s = mm->sdf;
+    scc_vec3 gs0 = s ? scc_rigid_center_at(s, mm->t0) : scc_v3(0, 0, 0);
+    double speed = 0.0, reach = 0.0;
+    if (mm->body) {
+        const scc_rigid* b = mm->body;
+        double r = 0.0;
+        for (int k = 0; k < 8; ++k) {
+            scc_vec3 corner = scc_v3(k & 1 ? mesh->bounds.hi.x : mesh->bounds.lo.x, k & 2 ? mesh->bounds.hi.y : mesh->bounds.lo.y,
+                                     k & 4 ? mesh->bounds.hi.z : mesh->bounds.lo.z);
+            r = fmax(r, scc_dist(corner, b->c_local));
+        }
+        speed = scc_len(b->v) + scc_len(b->w) * r;
+        if (s) reach = scc_dist(scc_rigid_center_at(b, mm->t0), gs0) + r + (scc_len(b->v) + scc_len(s->v)) * T;
+    } else {
+        for (uint32_t i = 0; i < mesh->vertex_count; ++i) {
+            double d = scc_dist(mm->end[i], mm->start[i]);
+            speed = fmax(speed, T > 0.0 ? d / T : 0.0);
+            if (s) reach = fmax(reach, scc_dist(mm->start[i], gs0) + d + scc_len(s->v) * T);
+        }
+    }
+    if (s) speed += scc_len(s->v) + scc_len(s->w) * reach;
+    return speed;
+}
+
 typedef struct mesh_ctx {
     scc_mesh_query_in in;        /* the query's inputs, handed to the broad phase as they are */
     contact_buf buf;

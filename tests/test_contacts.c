@@ -322,9 +322,300 @@ START_TEST(test_mesh_query_reduces_contacts)
 }
 END_TEST
 
+/* ---------------- contact generation ---------------- */
+
+static const double DT = 1.0 / 60.0;
+static const double H = 0.05; /* half extent of the test cube */
+
+
+static sdfccd_SdfId make_floor(void)
+{
+    sdfccd_SdfId floor;
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, 0.0, &floor), SDFCCD_OK);
+    return floor;
+}
+
+static sdfccd_ContactSet generate(sdfccd_Workspace* ws, sdfccd_SdfId sdf, sdfccd_MeshId mesh, const sdfccd_RigidMotion* m,
+                                  sdfccd_ContactPoint* out, int32_t cap)
+{
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    sdfccd_ContactSet set;
+    ck_assert_msg(sdfccd_generate_contacts(ws, sdf, NULL, mesh, m, 0.0, DT, &p, out, cap, &set) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert(set.count >= 0 && set.count <= cap && set.count <= set.candidates);
+    return set;
+}
+
+/* Every point is a bottom corner of the cube (|x| = |y| = H, z = z0 at t0), a vertex, with normal +z
+ * and gap z0; the corners are all there. */
+static void assert_bottom_corners(const sdfccd_ContactPoint* c, int32_t n, sdfccd_Vec3 centre, double z0)
+{
+    ck_assert_int_eq(n, 4);
+    int seen = 0;
+    for (int32_t i = 0; i < n; ++i) {
+        ck_assert_double_near(fabs(c[i].point.x - centre.x), H, 1e-12);
+        ck_assert_double_near(fabs(c[i].point.y - centre.y), H, 1e-12);
+        ck_assert_double_near(c[i].point.z, z0, 1e-12);
+        ck_assert_double_near(c[i].gap, z0, 1e-9);
+        ck_assert_double_near(c[i].normal.z, 1.0, 1e-12);
+        ck_assert_double_near(c[i].surface_point.z, 0.0, 1e-9);
+        ck_assert_int_eq(c[i].feature_kind, SDFCCD_FEATURE_VERTEX);
+        ck_assert(c[i].id == c[i].feature);
+        seen |= 1 << ((c[i].point.x > centre.x) + 2 * (c[i].point.y > centre.y));
+    }
+    ck_assert_int_eq(seen, 15);
+}
+
+/* First in the suite: sdfccd_set_allocator needs no library memory live. */
+START_TEST(test_generate_no_allocation_after_warm_up)
+{
+    long allocs = 0;
+    ck_assert_int_eq(sdfccd_set_allocator(test_counting_alloc, test_counting_free, &allocs), SDFCCD_OK);
+    {
+        sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+        sdfccd_SdfId floor = make_floor();
+        sdfccd_Workspace* ws;
+        ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+        sdfccd_RigidMotion m[3] = { sdfccd_default_rigid_motion(), sdfccd_default_rigid_motion(), sdfccd_default_rigid_motion() };
+        m[0].pose.position.z = H;          /* resting */
+        m[1].pose.position.z = H + 0.05;   /* falling onto the floor */
+        m[1].linear_velocity.z = -10;
+        m[2].pose.position.z = 1.0;        /* nothing within reach */
+        sdfccd_ContactPoint c[8];
+        for (int k = 0; k < 3; ++k) (void)generate(ws, floor, cube, &m[k], c, 8);
+        long before = allocs;
+        for (int i = 0; i < 10; ++i)
+            for (int k = 0; k < 3; ++k) ck_assert_int_eq(generate(ws, floor, cube, &m[k], c, 8).count, k == 2 ? 0 : 8);
+        ck_assert_int_eq(allocs - before, 0);
+        sdfccd_destroy_workspace(ws);
+        ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+    }
+    ck_assert_int_eq(sdfccd_set_allocator(NULL, NULL, NULL), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_generate_resting_box)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position = (sdfccd_Vec3){ 0.3, -0.2, H };
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set = generate(ws, floor, cube, &m, c, 4);
+    ck_assert_int_eq(set.started_in_contact, 1);
+    ck_assert_int_eq(set.ccd_ran, 0);
+    ck_assert(set.toi == 0.0);
+    ck_assert_int_gt(set.candidates, 4); /* the bottom face's 25 vertices and its triangles: reduced, not cut */
+    assert_bottom_corners(c, set.count, m.pose.position, 0.0);
+    for (int i = 0; i < 4; ++i) ck_assert(c[i].toi == 0.0);
+    /* ids persist: a step later, slid by 1 cm, the same four features */
+    uint64_t ids[4];
+    for (int i = 0; i < 4; ++i) ids[i] = c[i].id;
+    m.pose.position.x += 0.01;
+    set = generate(ws, floor, cube, &m, c, 4);
+    assert_bottom_corners(c, set.count, m.pose.position, 0.0);
+    for (int i = 0; i < 4; ++i) ck_assert(c[i].id == ids[i]);
+    /* a coarse cube (two triangles a face) without subdivision: one deepest point per triangle, so the
+     * corners come from the triangles' vertices within reach */
+    sdfccd_MeshId coarse = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    p.query.subdivision = 0;
+    ck_assert_int_eq(sdfccd_generate_contacts(ws, floor, NULL, coarse, &m, 0.0, DT, &p, c, 4, &set), SDFCCD_OK);
+    assert_bottom_corners(c, set.count, m.pose.position, 0.0);
+    ck_assert_int_eq(sdfccd_destroy_mesh(coarse), SDFCCD_OK);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_generate_falling_box)
+{
+    /* 5 cm above the floor at 10 m/s: the CCD's TOI is 5 ms, each corner's gap at t0 is 5 cm */
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.z = H + 0.05;
+    m.linear_velocity.z = -10;
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set = generate(ws, floor, cube, &m, c, 4);
+    ck_assert_int_eq(set.started_in_contact, 0);
+    ck_assert_int_eq(set.ccd_ran, 1);
+    ck_assert_int_eq(set.ccd_state, SDFCCD_STATE_HIT);
+    ck_assert_double_near(set.toi, 0.005, 1e-7);
+    assert_bottom_corners(c, set.count, m.pose.position, 0.05);
+    /* nothing within the step's reach: no point, no CCD */
+    m.pose.position.z = 1.0;
+    set = generate(ws, floor, cube, &m, c, 4);
+    ck_assert_int_eq(set.count, 0);
+    ck_assert_int_eq(set.candidates, 0);
+    ck_assert_int_eq(set.ccd_ran, 0);
+    ck_assert(set.toi == DT);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_generate_fast_plate_thin_wall)
+{
+    /* a 4 mm plate tilted 45 deg at 500 m/s towards a 1 cm wall (x in [0, 0.01]): its leading edge is
+     * 0.1 - 0.052 / sqrt(2) from the wall at t0 and reaches it at that over 500 */
+    sdfccd_MeshId plate = test_box_mesh((sdfccd_Vec3){ 0.05, 0.002, 0.05 }, 4, 1, 4);
+    sdfccd_SdfId box, wall;
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.005, 1, 1 }, &box), SDFCCD_OK);
+    sdfccd_Pose at = sdfccd_pose_identity();
+    at.position.x = 0.005;
+    ck_assert_int_eq(sdfccd_create_transformed(box, at, 1.0, &wall), SDFCCD_OK);
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.x = -0.1;
+    m.pose.orientation = (sdfccd_Quat){ cos(M_PI / 8), 0, 0, sin(M_PI / 8) };
+    m.linear_velocity.x = 500;
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set = generate(ws, wall, plate, &m, c, 4);
+    const double lead = 0.1 - 0.052 / sqrt(2.0);
+    ck_assert_int_eq(set.ccd_ran, 1);
+    ck_assert_int_eq(set.ccd_state, SDFCCD_STATE_HIT);
+    ck_assert_double_near(set.toi, lead / 500.0, 1e-9);
+    ck_assert_int_ge(set.count, 2); /* the leading edge: both its ends */
+    ck_assert_double_near(c[0].gap, lead, 1e-9);
+    for (int i = 0; i < set.count; ++i) {
+        ck_assert_double_near(c[i].normal.x, -1.0, 1e-9);
+        ck_assert(c[i].gap >= lead - 1e-9);
+    }
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(box), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(plate), SDFCCD_OK);
+}
+END_TEST
+
+/* A 20 cm cloth (5 x 5 vertices) dropping linearly from z = 2 cm to z = -3 cm onto the floor. */
+START_TEST(test_generate_linear_cloth)
+{
+    double v[75];
+    uint32_t f[96];
+    sdfccd_Vec3 start[25], end[25];
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j) {
+            int k = 5 * i + j;
+            v[3 * k] = -0.1 + 0.05 * i;
+            v[3 * k + 1] = -0.1 + 0.05 * j;
+            v[3 * k + 2] = 0.0;
+            start[k] = (sdfccd_Vec3){ v[3 * k], v[3 * k + 1], 0.02 };
+            end[k] = (sdfccd_Vec3){ v[3 * k], v[3 * k + 1], -0.03 };
+        }
+    int t = 0;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+            uint32_t a = (uint32_t)(5 * i + j);
+            uint32_t q[6] = { a, a + 5, a + 6, a, a + 6, a + 1 };
+            memcpy(f + 6 * t++, q, sizeof q);
+        }
+    sdfccd_MeshDef d = sdfccd_default_mesh_def();
+    d.vertices = v;
+    d.vertex_count = 25;
+    d.indices = f;
+    d.triangle_count = 32;
+    sdfccd_MeshId cloth;
+    ck_assert_int_eq(sdfccd_create_mesh(&d, &cloth), SDFCCD_OK);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set;
+    ck_assert_int_eq(sdfccd_generate_contacts_linear(ws, floor, NULL, cloth, start, end, 0.0, DT, &p, c, 4, &set), SDFCCD_OK);
+    ck_assert_int_eq(set.ccd_state, SDFCCD_STATE_HIT);
+    ck_assert_double_near(set.toi, 0.4 * DT, 1e-7);
+    ck_assert_int_eq(set.count, 4);
+    uint32_t corners = 0;
+    for (int i = 0; i < 4; ++i) {
+        ck_assert_double_near(c[i].gap, 0.02, 1e-9);
+        ck_assert_double_near(c[i].normal.z, 1.0, 1e-12);
+        ck_assert_int_eq(c[i].feature_kind, SDFCCD_FEATURE_VERTEX);
+        ck_assert(c[i].id == 0 || c[i].id == 4 || c[i].id == 20 || c[i].id == 24);
+        corners |= 1u << (c[i].id % 5 == 0 ? c[i].id / 20 : 2 + c[i].id / 20);
+    }
+    ck_assert_int_eq(corners, 15);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cloth), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_generate_bad_input)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    sdfccd_ContactParams p = sdfccd_default_contact_params(), bad;
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set, untouched;
+    memset(&untouched, 0x5a, sizeof untouched);
+    set = untouched;
+#define EXPECT(call, status)                                          \
+    do {                                                              \
+        ck_assert_int_eq((call), (status));                           \
+        ck_assert_msg(strlen(sdfccd_last_error()) > 0, "no message"); \
+        ck_assert(memcmp(&set, &untouched, sizeof set) == 0);         \
+    } while (0)
+    EXPECT(sdfccd_generate_contacts(NULL, floor, NULL, cube, &m, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &p, c, 4, NULL), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, NULL, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, NULL, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &p, NULL, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &p, c, -1, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, DT, 0, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    memset(&bad, 0, sizeof bad);
+    bad.query = sdfccd_default_query_params();
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
+    bad.vertex_distance = -1;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
+    bad.same_place_distance = NAN;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
+    bad.query.margin = INFINITY;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_RigidMotion nan_m = m;
+    nan_m.angular_velocity.x = NAN;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &nan_m, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, &nan_m, cube, &m, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_MeshId null_mesh = { 0, 0 };
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, null_mesh, &m, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_HANDLE);
+    sdfccd_Vec3 pts[8];
+    memset(pts, 0, sizeof pts);
+    EXPECT(sdfccd_generate_contacts_linear(ws, floor, NULL, cube, NULL, pts, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts_linear(ws, floor, NULL, cube, pts, NULL, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+#undef EXPECT
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("contacts");
+    TCase* tg = tcase_create("generate");
+    test_add_memory_fixture(tg);
+    tcase_add_test(tg, test_generate_no_allocation_after_warm_up); /* first: it installs an allocator */
+    tcase_add_test(tg, test_generate_resting_box);
+    tcase_add_test(tg, test_generate_falling_box);
+    tcase_add_test(tg, test_generate_fast_plate_thin_wall);
+    tcase_add_test(tg, test_generate_linear_cloth);
+    tcase_add_test(tg, test_generate_bad_input);
+    suite_add_tcase(s, tg);
     TCase* tc = tcase_create("reduce");
     test_add_memory_fixture(tc);
     tcase_add_test(tc, test_reduce_single_point);

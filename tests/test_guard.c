@@ -26,46 +26,15 @@ typedef struct box_mesh {
 
 static box_mesh make_box(double hx, double hy, double hz, int nx, int ny, int nz)
 {
-    const double h[3] = { hx, hy, hz };
-    const int n[3] = { nx, ny, nz };
     box_mesh b;
-    size_t maxv = 0, maxt = 0;
-    for (int k = 0; k < 3; ++k) {
-        int u = (k + 1) % 3, w = (k + 2) % 3;
-        maxv += 2 * (size_t)(n[u] + 1) * (n[w] + 1);
-        maxt += 4 * (size_t)n[u] * n[w];
-    }
-    b.v = malloc(3 * maxv * sizeof *b.v);
-    b.f = malloc(3 * maxt * sizeof *b.f);
-    b.nv = b.nt = 0;
-    for (int k = 0; k < 3; ++k)
-        for (int s = -1; s <= 1; s += 2) {
-            int u = (k + 1) % 3, w = (k + 2) % 3;
-            uint32_t base = b.nv;
-            for (int i = 0; i <= n[u]; ++i)
-                for (int j = 0; j <= n[w]; ++j) {
-                    double* p = b.v + 3 * b.nv++;
-                    p[k] = s * h[k];
-                    p[u] = -h[u] + 2.0 * h[u] * i / n[u];
-                    p[w] = -h[w] + 2.0 * h[w] * j / n[w];
-                }
-            for (int i = 0; i < n[u]; ++i)
-                for (int j = 0; j < n[w]; ++j) {
-                    uint32_t a = base + (uint32_t)(i * (n[w] + 1) + j), c = a + (uint32_t)(n[w] + 1);
-                    uint32_t q[4] = { a, c, c + 1, a + 1 };
-                    if (s < 0) { uint32_t t = q[1]; q[1] = q[3]; q[3] = t; } /* outward winding */
-                    uint32_t* f = b.f + 3 * b.nt;
-                    f[0] = q[0]; f[1] = q[1]; f[2] = q[2];
-                    f[3] = q[0]; f[4] = q[2]; f[5] = q[3];
-                    b.nt += 2;
-                }
-        }
-    sdfccd_MeshDef d = sdfccd_default_mesh_def();
-    d.vertices = b.v;
-    d.vertex_count = b.nv;
-    d.indices = b.f;
-    d.triangle_count = b.nt;
-    ck_assert_msg(sdfccd_create_mesh(&d, &b.id) == SDFCCD_OK, "%s", sdfccd_last_error());
+    b.id = test_box_mesh((sdfccd_Vec3){ hx, hy, hz }, nx, ny, nz);
+    sdfccd_MeshInfo info;
+    ck_assert_int_eq(sdfccd_mesh_get_info(b.id, &info), SDFCCD_OK);
+    b.nv = info.vertex_count;
+    b.nt = info.triangle_count;
+    b.v = malloc(3 * (size_t)b.nv * sizeof *b.v);
+    b.f = malloc(3 * (size_t)b.nt * sizeof *b.f);
+    ck_assert_int_eq(sdfccd_mesh_get_data(b.id, b.v, b.f), SDFCCD_OK);
     return b;
 }
 
@@ -424,6 +393,79 @@ START_TEST(test_moving_sdf)
 }
 END_TEST
 
+/* A cloth (5 x 5 vertices, 10 cm, tilted 45 deg about z) moving linearly at 500 m/s across the 1 cm
+ * wall x in [0, 0.01]: sdfccd_guard_linear stops it where its leading edge x = -0.1 + 0.05 / sqrt(2)
+ * reaches x = TOL, and the safe positions are the vertices there. */
+START_TEST(test_guard_linear_cloth)
+{
+    enum { NV = 25, NT = 32 };
+    double v[3 * NV];
+    uint32_t f[3 * NT];
+    sdfccd_Vec3 start[NV], end[NV], safe[NV];
+    const double c45 = sqrt(0.5);
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j) {
+            int k = 5 * i + j;
+            double u = -0.05 + 0.025 * i, w = -0.05 + 0.025 * j;
+            v[3 * k] = u * c45 - 0.1;
+            v[3 * k + 1] = u * c45;
+            v[3 * k + 2] = w;
+            start[k] = (sdfccd_Vec3){ v[3 * k], v[3 * k + 1], v[3 * k + 2] };
+            end[k] = (sdfccd_Vec3){ v[3 * k] + 500 * DT, v[3 * k + 1], v[3 * k + 2] };
+        }
+    int t = 0;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+            uint32_t a = (uint32_t)(5 * i + j);
+            uint32_t q[6] = { a, a + 5, a + 6, a, a + 6, a + 1 };
+            memcpy(f + 6 * t++, q, sizeof q);
+        }
+    sdfccd_MeshDef d = sdfccd_default_mesh_def();
+    d.vertices = v;
+    d.vertex_count = NV;
+    d.indices = f;
+    d.triangle_count = NT;
+    sdfccd_MeshId cloth;
+    ck_assert_int_eq(sdfccd_create_mesh(&d, &cloth), SDFCCD_OK);
+    sdfccd_SdfId wall = box_at(v3(0.005, 1, 1), v3(0.005, 0, 0));
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    sdfccd_GuardResult r;
+    ck_assert_msg(sdfccd_guard_linear(ws, wall, NULL, cloth, start, end, 0.0, DT, &gp, &r, safe) == SDFCCD_OK, "%s", sdfccd_last_error());
+    double t_exact = (TOL - (-0.1 + 0.05 * c45)) / 500.0;
+    REPORT("%s: toi - exact %.3g s\n", __func__, r.toi - t_exact);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    ck_assert_msg(r.toi <= t_exact && r.toi >= t_exact - 3e-7, "toi %.12g, exact %.12g", r.toi, t_exact);
+    ck_assert_double_near(r.normal.x, -1.0, 1e-9);
+    /* the safe positions, and no point of the cloth there deeper than TOL (vertices and a grid on each triangle) */
+    double depth = INFINITY;
+    for (int k = 0; k < NV; ++k) ck_assert_double_near(safe[k].x, start[k].x + 500 * r.toi, 1e-12);
+    for (int k = 0; k < NT; ++k)
+        for (int i = 0; i <= 12; ++i)
+            for (int j = 0; i + j <= 12; ++j) {
+                sdfccd_Vec3 a = safe[f[3 * k]], b = safe[f[3 * k + 1]], c = safe[f[3 * k + 2]];
+                double u = i / 12.0, w = j / 12.0, s0 = 1 - u - w, phi;
+                sdfccd_Vec3 x = v3(s0 * a.x + u * b.x + w * c.x, s0 * a.y + u * b.y + w * c.y, s0 * a.z + u * b.z + w * c.z);
+                ck_assert_int_eq(sdfccd_sdf_eval(wall, x, &phi, NULL), SDFCCD_OK);
+                depth = fmin(depth, phi);
+            }
+    ck_assert_msg(depth >= -TOL && depth <= -0.8 * TOL, "min phi at the safe positions %.9g", depth);
+    /* moving away: clear, the end positions */
+    for (int k = 0; k < NV; ++k) { end[k] = start[k]; end[k].x -= 0.3; }
+    ck_assert_int_eq(sdfccd_guard_linear(ws, wall, NULL, cloth, start, end, 0.0, DT, &gp, &r, safe), SDFCCD_OK);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_CLEAR);
+    for (int k = 0; k < NV; ++k) ck_assert(safe[k].x == end[k].x && safe[k].y == end[k].y && safe[k].z == end[k].z);
+    /* bad input */
+    ck_assert_int_eq(sdfccd_guard_linear(ws, wall, NULL, cloth, NULL, end, 0.0, DT, &gp, &r, safe), SDFCCD_INVALID_ARGUMENT);
+    end[3].y = NAN;
+    ck_assert_int_eq(sdfccd_guard_linear(ws, wall, NULL, cloth, start, end, 0.0, DT, &gp, &r, safe), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cloth), SDFCCD_OK);
+}
+END_TEST
+
 START_TEST(test_motion_from_poses)
 {
     test_rng rng = { 19 };
@@ -538,25 +580,13 @@ START_TEST(test_bad_input)
 }
 END_TEST
 
-typedef struct counter { long allocs; } counter;
-static void* count_alloc(size_t n, void* u)
-{
-    ((counter*)u)->allocs++;
-    return malloc(n);
-}
-static void count_free(void* p, size_t n, void* u)
-{
-    (void)n;
-    (void)u;
-    free(p);
-}
 
 /* After a first call of each kind (clear, rolled back, inside at start), guard calls through a
  * workspace allocate nothing. */
 START_TEST(test_no_allocation_after_warm_up)
 {
-    counter cnt = { 0 };
-    ck_assert_int_eq(sdfccd_set_allocator(count_alloc, count_free, &cnt), SDFCCD_OK);
+    long allocs = 0;
+    ck_assert_int_eq(sdfccd_set_allocator(test_counting_alloc, test_counting_free, &allocs), SDFCCD_OK);
     {
         inside_scene s;
         inside_setup(&s);
@@ -565,11 +595,11 @@ START_TEST(test_no_allocation_after_warm_up)
         ms[1].linear_velocity = v3(30, 0, 0);    /* rolled back */
         ms[2].pose.position.y = 0.06;            /* clear */
         for (int k = 0; k < 3; ++k) (void)guard(s.ws, s.both, NULL, s.cube.id, &ms[k], &s.gp);
-        long before = cnt.allocs;
+        long before = allocs;
         int states[3] = { 0, 0, 0 };
         for (int i = 0; i < 10; ++i)
             for (int k = 0; k < 3; ++k) states[guard(s.ws, s.both, NULL, s.cube.id, &ms[k], &s.gp).state]++;
-        ck_assert_int_eq(cnt.allocs - before, 0);
+        ck_assert_int_eq(allocs - before, 0);
         ck_assert_int_eq(states[SDFCCD_GUARD_CLEAR], 10);
         ck_assert_int_eq(states[SDFCCD_GUARD_ROLLED_BACK], 10);
         ck_assert_int_eq(states[SDFCCD_GUARD_INSIDE_AT_START], 10);
@@ -596,6 +626,7 @@ int main(void)
     tcase_add_test(tc, test_inside_at_start_sinking_further);
     tcase_add_test(tc, test_inside_at_start_rest_guarded);
     tcase_add_test(tc, test_moving_sdf);
+    tcase_add_test(tc, test_guard_linear_cloth);
     tcase_add_test(tc, test_motion_from_poses);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);

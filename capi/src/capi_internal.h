@@ -163,6 +163,11 @@ sdfccd_ResultState sdfccd__public_state(int core_state);
 /* The mesh's coordinates within SDFCCD_MAX_QUERY_MAGNITUDE. */
 sdfccd_Status sdfccd__check_mesh_bounds(const sdfccd__mesh* m, const char* fn);
 
+/* Per-vertex linear motion: `start` and `end` (vertex_count each, checked finite and within
+ * SDFCCD_MAX_QUERY_MAGNITUDE) copied into the workspace's vertex slot: *out holds start then end. */
+sdfccd_Status sdfccd__linear_vertices(const sdfccd__mesh* m, const sdfccd_Vec3* start, const sdfccd_Vec3* end, scc_workspace* ws,
+                                      const char* fn, scc_vec3** out);
+
 /* A caller-kept workspace: the mesh query's scratch storage, reused from call to call. */
 struct sdfccd_Workspace {
     scc_workspace ws;

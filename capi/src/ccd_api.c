@@ -369,6 +369,26 @@ sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf
     SDFCCD__HELD_CALL(query_mesh(workspace, sdf, sdf_motion, mesh, motion, t0, t1, params, out_contacts, capacity, out_result, "sdfccd_query_mesh_ws"));
 }
 
+sdfccd_Status sdfccd__linear_vertices(const sdfccd__mesh* m, const sdfccd_Vec3* start, const sdfccd_Vec3* end, scc_workspace* ws,
+                                      const char* fn, scc_vec3** out)
+{
+    uint32_t nv = m->mesh.vertex_count;
+    for (uint32_t i = 0; i < nv; ++i) {
+        const double c[6] = { start[i].x, start[i].y, start[i].z, end[i].x, end[i].y, end[i].z };
+        for (int k = 0; k < 6; ++k)
+            if (!(fabs(c[k]) <= SDFCCD_MAX_QUERY_MAGNITUDE))
+                return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i);
+    }
+    scc_vec3* v = scc_ws_get(ws, SCC_WS_VERTICES, 2 * (size_t)nv * sizeof(scc_vec3));
+    if (!v) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    for (uint32_t i = 0; i < nv; ++i) {
+        v[i] = sdfccd__v(start[i]);
+        v[nv + i] = sdfccd__v(end[i]);
+    }
+    *out = v;
+    return SDFCCD_OK;
+}
+
 static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
                                        sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
                                        const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
@@ -385,23 +405,13 @@ static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId
     sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     uint32_t nv = m->mesh.vertex_count;
-    for (uint32_t i = 0; i < nv; ++i) {
-        const double c[6] = { start[i].x, start[i].y, start[i].z, end[i].x, end[i].y, end[i].z };
-        for (int k = 0; k < 6; ++k)
-            if (!(fabs(c[k]) <= SDFCCD_MAX_QUERY_MAGNITUDE))
-                return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: vertex %u has a non-finite coordinate or one above SDFCCD_MAX_QUERY_MAGNITUDE", fn, i);
-    }
     scc_workspace tmp;
     scc_ws_init(&tmp, sdfccd__allocator());
     scc_workspace* ws = workspace ? &workspace->ws : &tmp;
-    scc_vec3* v = scc_ws_get(ws, SCC_WS_VERTICES, 2 * (size_t)nv * sizeof(scc_vec3));
-    if (!v) {
+    scc_vec3* v;
+    if ((st = sdfccd__linear_vertices(m, start, end, ws, fn, &v))) {
         scc_ws_release(&tmp);
-        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
-    }
-    for (uint32_t i = 0; i < nv; ++i) {
-        v[i] = sdfccd__v(start[i]);
-        v[nv + i] = sdfccd__v(end[i]);
+        return st;
     }
     scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1, NULL };
     st = run_mesh(&q, &mm, ws, out_contacts, capacity, out_result, fn);

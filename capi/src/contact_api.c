@@ -5,6 +5,7 @@
 #include "../../core/ccd.h"
 #include "../../core/guard.h"
 #include "../../core/reduce.h"
+#include "../../core/contacts.h"
 
 #include <stdio.h>
 
@@ -85,48 +86,80 @@ static sdfccd_Pose public_pose(scc_quat q, scc_vec3 p)
     return r;
 }
 
-static sdfccd_Status guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
-                                 const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
-                                 sdfccd_GuardResult* out)
+/* What every step call shares: the workspace, the interval, the SDF (and its motion) and the mesh. */
+typedef struct step_setup {
+    scc_rigid sm;
+    const scc_rigid* smp;
+    sdfccd__sdf* sdf;
+    sdfccd__mesh* mesh;
+} step_setup;
+
+static sdfccd_Status setup_step(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh, double t0,
+                                double t1, const char* fn, step_setup* q)
 {
-    static const char fn[] = "sdfccd_guard_rigid";
     sdfccd_Status st;
+    char what[96];
+    snprintf(what, sizeof what, "%s: ws", fn);
+    if ((st = sdfccd__check_ptr(ws, what)) || (st = sdfccd__check_interval(t0, t1, fn))) return st;
+    q->smp = NULL;
+    if (sdf_motion) {
+        snprintf(what, sizeof what, "%s: sdf_motion", fn);
+        if ((st = sdfccd__convert_motion(sdf_motion, t0, t1, what, &q->sm))) return st;
+        q->smp = &q->sm;
+    }
+    if (!(q->sdf = sdfccd__sdf_acquire(sdf)) || !(q->mesh = sdfccd__mesh_acquire(mesh))) return SDFCCD_INVALID_HANDLE;
+    return sdfccd__check_mesh_bounds(q->mesh, fn);
+}
+
+/* The rigid motion of a step call, checked with the SDF's. */
+static sdfccd_Status setup_rigid(const sdfccd_RigidMotion* motion, double t0, double t1, const step_setup* q, const char* fn, scc_rigid* out)
+{
+    sdfccd_Status st;
+    char what[96];
+    snprintf(what, sizeof what, "%s: motion", fn);
+    if ((st = sdfccd__check_ptr(motion, what)) || (st = sdfccd__convert_motion(motion, t0, t1, what, out))) return st;
+    return sdfccd__check_total_rotation(out, q->smp, t1 - t0, fn);
+}
+
+/* The per-vertex linear motion of a step call, copied into the workspace. */
+static sdfccd_Status setup_linear(const sdfccd_Vec3* start, const sdfccd_Vec3* end, sdfccd_Workspace* ws, const step_setup* q, const char* fn,
+                                  scc_vec3** out)
+{
+    sdfccd_Status st;
+    char what[96];
+    snprintf(what, sizeof what, "%s: start", fn);
+    if ((st = sdfccd__check_ptr(start, what))) return st;
+    snprintf(what, sizeof what, "%s: end", fn);
+    if ((st = sdfccd__check_ptr(end, what))) return st;
+    return sdfccd__linear_vertices(q->mesh, start, end, &ws->ws, fn, out);
+}
+
+static sdfccd_Status run_guard(sdfccd_Workspace* ws, const step_setup* q, const scc_mesh_motion* mm, const sdfccd_GuardParams* params,
+                               sdfccd_GuardResult* out, const char* fn)
+{
     scc_params p;
     double tol = 0.0;
-    if ((st = sdfccd__check_ptr(ws, "sdfccd_guard_rigid: ws")) || (st = sdfccd__check_ptr(out, "sdfccd_guard_rigid: out")) ||
-        (st = sdfccd__check_ptr(executed, "sdfccd_guard_rigid: executed")) || (st = convert_guard_params(params, fn, &p, &tol)) ||
-        (st = sdfccd__check_interval(t0, t1, fn)))
-        return st;
-    scc_rigid sm, body;
-    const scc_rigid* smp = NULL;
-    if (sdf_motion) {
-        if ((st = sdfccd__convert_motion(sdf_motion, t0, t1, "sdfccd_guard_rigid: sdf_motion", &sm))) return st;
-        smp = &sm;
-    }
-    if ((st = sdfccd__convert_motion(executed, t0, t1, "sdfccd_guard_rigid: executed", &body)) ||
-        (st = sdfccd__check_total_rotation(&body, smp, t1 - t0, fn)))
-        return st;
-    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
-    if (!s) return SDFCCD_INVALID_HANDLE;
-    sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
-    if (!m) return SDFCCD_INVALID_HANDLE;
-    if ((st = sdfccd__check_mesh_bounds(m, fn))) return st;
-    scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, smp, t0, t1, NULL };
+    sdfccd_Status st;
+    if ((st = convert_guard_params(params, fn, &p, &tol))) return st;
     scc_guard_out g;
-    if (!scc_guard(s->sdf, &mm, &p, tol, &ws->ws, &g)) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    if (!scc_guard(q->sdf->sdf, mm, &p, tol, &ws->ws, &g)) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    const double t0 = mm->t0, t1 = mm->t1;
     sdfccd_GuardResult r;
     memset(&r, 0, sizeof r);
     r.state = g.state == SCC_GUARD_ROLLED_BACK ? SDFCCD_GUARD_ROLLED_BACK
             : g.state == SCC_GUARD_INSIDE_AT_START ? SDFCCD_GUARD_INSIDE_AT_START : SDFCCD_GUARD_CLEAR;
     r.toi = g.toi;
     r.fraction = t1 > t0 ? (g.toi - t0) / (t1 - t0) : 0.0;
-    scc_quat q;
-    scc_vec3 pos;
-    scc_rigid_pose_at(&body, g.toi, &q, &pos);
-    r.safe_pose = public_pose(q, pos);
+    r.safe_pose = sdfccd_pose_identity();
+    if (mm->body) {
+        scc_quat qq;
+        scc_vec3 pos;
+        scc_rigid_pose_at(mm->body, g.toi, &qq, &pos);
+        r.safe_pose = public_pose(qq, pos);
+    }
     if (g.state == SCC_GUARD_ROLLED_BACK) {
-        r.point = sdfccd__pv(scc_world_point(smp, g.toi, g.point));
-        r.normal = sdfccd__pv(scc_normalize_or(scc_world_vector(smp, g.toi, g.normal), scc_v3(0, 0, 1)));
+        r.point = sdfccd__pv(scc_world_point(q->smp, g.toi, g.point));
+        r.normal = sdfccd__pv(scc_normalize_or(scc_world_vector(q->smp, g.toi, g.normal), scc_v3(0, 0, 1)));
         r.triangle = g.triangle;
     }
     r.min_gap_start = g.min_gap_start;
@@ -138,11 +171,158 @@ static sdfccd_Status guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const s
     return SDFCCD_OK;
 }
 
+static sdfccd_Status guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                 const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
+                                 sdfccd_GuardResult* out)
+{
+    static const char fn[] = "sdfccd_guard_rigid";
+    sdfccd_Status st;
+    step_setup q;
+    scc_rigid body;
+    if ((st = sdfccd__check_ptr(out, "sdfccd_guard_rigid: out")) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
+        (st = setup_rigid(executed, t0, t1, &q, fn, &body)))
+        return st;
+    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, t0, t1, NULL };
+    return run_guard(ws, &q, &mm, params, out, fn);
+}
+
+static sdfccd_Status guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                  const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1, const sdfccd_GuardParams* params,
+                                  sdfccd_GuardResult* out, sdfccd_Vec3* out_positions)
+{
+    static const char fn[] = "sdfccd_guard_linear";
+    sdfccd_Status st;
+    step_setup q;
+    scc_vec3* v;
+    if ((st = sdfccd__check_ptr(out, "sdfccd_guard_linear: out")) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
+        (st = setup_linear(start, end, ws, &q, fn, &v)))
+        return st;
+    const uint32_t nv = q.mesh->mesh.vertex_count;
+    scc_mesh_motion mm = { &q.mesh->mesh, NULL, v, v + nv, q.smp, t0, t1, NULL };
+    if ((st = run_guard(ws, &q, &mm, params, out, fn))) return st;
+    if (out_positions) {
+        const double s = out->fraction;
+        for (uint32_t i = 0; i < nv; ++i) out_positions[i] = sdfccd__pv(scc_lerp(v[i], v[nv + i], s));
+    }
+    return SDFCCD_OK;
+}
+
 sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
                                  const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
                                  sdfccd_GuardResult* out)
 {
     SDFCCD__HELD_CALL(guard_rigid(ws, sdf, sdf_motion, mesh, executed, t0, t1, params, out));
+}
+
+sdfccd_Status sdfccd_guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                  const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1, const sdfccd_GuardParams* params,
+                                  sdfccd_GuardResult* out, sdfccd_Vec3* out_positions)
+{
+    SDFCCD__HELD_CALL(guard_linear(ws, sdf, sdf_motion, mesh, start, end, t0, t1, params, out, out_positions));
+}
+
+/* ---- contact generation ---- */
+
+static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, const char* fn, scc_contact_params* out)
+{
+    sdfccd_Status st;
+    if (!in) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
+    if ((st = sdfccd__check_def(in->internal_value, fn, "params were", "sdfccd_default_contact_params"))) return st;
+    if (!isfinite(in->vertex_distance) || in->vertex_distance < 0.0 || !isfinite(in->same_place_distance) || in->same_place_distance < 0.0)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->vertex_distance and same_place_distance must be finite and >= 0 (got %g, %g)",
+                             fn, in->vertex_distance, in->same_place_distance);
+    if ((st = sdfccd__convert_params(&in->query, fn, &out->query))) return st;
+    out->vertex_distance = in->vertex_distance;
+    out->same_place = in->same_place_distance;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status run_contacts(sdfccd_Workspace* ws, const step_setup* q, const scc_mesh_motion* mm, const sdfccd_ContactParams* params,
+                                  sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set, const char* fn)
+{
+    sdfccd_Status st;
+    scc_contact_params cp;
+    if ((st = convert_contact_params(params, fn, &cp))) return st;
+    if (capacity < 0 || (capacity > 0 && !out_points))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_points is NULL or capacity (%d) < 0", fn, capacity);
+    scc_contact_point* c = NULL;
+    if (capacity > 0 && !(c = scc_ws_get(&ws->ws, SCC_WS_STAGING, (size_t)capacity * sizeof *c)))
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    scc_contact_set s;
+    if (!scc_generate_contacts(q->sdf->sdf, mm, &cp, &ws->ws, c, capacity, &s)) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    const double t0 = mm->t0;
+    for (size_t i = 0; i < s.written; ++i) {
+        sdfccd_ContactPoint* o = &out_points[i];
+        o->point = sdfccd__pv(scc_world_point(q->smp, t0, c[i].point));
+        o->surface_point = sdfccd__pv(scc_world_point(q->smp, t0, c[i].surface));
+        o->normal = sdfccd__pv(scc_normalize_or(scc_world_vector(q->smp, t0, c[i].normal), scc_v3(0, 0, 1)));
+        o->gap = c[i].gap;
+        o->toi = c[i].toi;
+        for (int k = 0; k < 3; ++k) o->barycentric[k] = c[i].bary[k];
+        o->triangle = c[i].triangle;
+        o->feature_kind = c[i].kind == SCC_FEATURE_VERTEX ? SDFCCD_FEATURE_VERTEX : c[i].kind == SCC_FEATURE_EDGE ? SDFCCD_FEATURE_EDGE
+                                                                                                              : SDFCCD_FEATURE_FACE;
+        o->feature = c[i].feature;
+        o->id = c[i].id;
+    }
+    sdfccd_ContactSet r;
+    memset(&r, 0, sizeof r);
+    r.count = (int32_t)s.written;
+    r.candidates = s.candidates > INT32_MAX ? INT32_MAX : (int32_t)s.candidates;
+    r.started_in_contact = s.started_in_contact;
+    r.ccd_ran = s.ccd_ran;
+    r.ccd_state = sdfccd__public_state(s.ccd_state);
+    r.toi = s.toi;
+    r.sdf_evaluations = s.evals;
+    *out_set = r;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status generate_contacts(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                       const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_ContactParams* params,
+                                       sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set)
+{
+    static const char fn[] = "sdfccd_generate_contacts";
+    sdfccd_Status st;
+    step_setup q;
+    scc_rigid body;
+    if ((st = sdfccd__check_ptr(out_set, "sdfccd_generate_contacts: out_set")) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
+        (st = setup_rigid(motion, t0, t1, &q, fn, &body)))
+        return st;
+    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, t0, t1, NULL };
+    return run_contacts(ws, &q, &mm, params, out_points, capacity, out_set, fn);
+}
+
+static sdfccd_Status generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                              const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
+                                              const sdfccd_ContactParams* params, sdfccd_ContactPoint* out_points, int32_t capacity,
+                                              sdfccd_ContactSet* out_set)
+{
+    static const char fn[] = "sdfccd_generate_contacts_linear";
+    sdfccd_Status st;
+    step_setup q;
+    scc_vec3* v;
+    if ((st = sdfccd__check_ptr(out_set, "sdfccd_generate_contacts_linear: out_set")) ||
+        (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) || (st = setup_linear(start, end, ws, &q, fn, &v)))
+        return st;
+    const uint32_t nv = q.mesh->mesh.vertex_count;
+    scc_mesh_motion mm = { &q.mesh->mesh, NULL, v, v + nv, q.smp, t0, t1, NULL };
+    return run_contacts(ws, &q, &mm, params, out_points, capacity, out_set, fn);
+}
+
+sdfccd_Status sdfccd_generate_contacts(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                       const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_ContactParams* params,
+                                       sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set)
+{
+    SDFCCD__HELD_CALL(generate_contacts(ws, sdf, sdf_motion, mesh, motion, t0, t1, params, out_points, capacity, out_set));
+}
+
+sdfccd_Status sdfccd_generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                              const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
+                                              const sdfccd_ContactParams* params, sdfccd_ContactPoint* out_points, int32_t capacity,
+                                              sdfccd_ContactSet* out_set)
+{
+    SDFCCD__HELD_CALL(generate_contacts_linear(ws, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_points, capacity, out_set));
 }
 
 /* ---- contact points: reduction ---- */

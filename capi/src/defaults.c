@@ -106,3 +106,13 @@ sdfccd_GuardParams sdfccd_default_guard_params(void)
     g.query = sdfccd_default_query_params();
     return g;
 }
+
+sdfccd_ContactParams sdfccd_default_contact_params(void)
+{
+    sdfccd_ContactParams c;
+    SDFCCD__DEF_BEGIN(c);
+    c.query = sdfccd_default_query_params();
+    c.vertex_distance = 1e-3;
+    c.same_place_distance = 1e-4;
+    return c;
+}

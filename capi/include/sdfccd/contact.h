@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/** @file contact.h  What a physics engine needs from the CCD over one step: the no-tunnelling
+/** @file contact.h  What a physics engine needs from the CCD over one step: the contact set of a
+ * mesh against an SDF (generated, and reduced to the engine's manifold size), and the no-tunnelling
  * guarantee (the executed motion checked for a time of impact, and the safe pose).
  *
  * The rule (Pelletier-Guenette et al., SCA 2025, Section 4): the simulation never advances past a
@@ -155,6 +156,72 @@ typedef struct sdfccd_ContactPoint {
  * capacity < 0, same_place_distance not finite or < 0, a non-finite point, normal or gap. */
 SDFCCD_API sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
                                                 int32_t* out_indices, int32_t capacity, int32_t* out_count);
+
+/** Settings of contact generation. Must be initialised with sdfccd_default_contact_params(). */
+typedef struct sdfccd_ContactParams {
+    sdfccd_QueryParams query;    /**< The CCD of the step (method, caps); `query.margin` is the contact distance: a
+                                      point touches when phi <= margin (default 0). ::SDFCCD_METHOD_DCD gives the
+                                      start-pose points only. */
+    double vertex_distance;      /**< The vertices of a triangle the CCD finds in contact are points too when they are
+                                      within this of the margin at its time of impact (a face landing flat gives its
+                                      corners). m, >= 0. Default 1e-3. */
+    double same_place_distance;  /**< Points whose surface points are closer than this are one place: the reduction
+                                      keeps one (sdfccd_reduce_contacts()). m, >= 0. Default 1e-4. */
+    int32_t internal_value;      /**< Set by sdfccd_default_contact_params(); do not change. */
+} sdfccd_ContactParams;
+
+/** The default contact settings (see each field of ::sdfccd_ContactParams). */
+SDFCCD_API sdfccd_ContactParams sdfccd_default_contact_params(void);
+
+/** Summary of a contact set. */
+typedef struct sdfccd_ContactSet {
+    int32_t count;               /**< Points written: the reduction of the candidates to the caller's capacity. */
+    int32_t candidates;          /**< Candidates found before the reduction. */
+    int32_t started_in_contact;  /**< 1 when a point of the start pose was within the margin (the CCD is then not
+                                      run: it could only report contact at t0). */
+    int32_t ccd_ran;             /**< 1 when the CCD ran over the step. */
+    sdfccd_ResultState ccd_state; /**< Its state (::SDFCCD_STATE_NO_HIT when it did not run). */
+    double toi;                  /**< The CCD's first time of impact; t0 when started in contact; t1 when none. */
+    int64_t sdf_evaluations;     /**< SDF evaluations of the call. */
+} sdfccd_ContactSet;
+
+/** The contact set an engine needs for one mesh against one SDF over a step [t0, t1]: points with
+ * normal, signed gap at t0, time of impact, triangle and a feature id stable across steps (see
+ * ::sdfccd_ContactPoint). The candidates:
+ *  - the start pose within the step's reach: every triangle whose deepest point (DCD, with adaptive
+ *    subdivision when query.subdivision is on) at t0 lies within margin + the farthest any point can
+ *    travel in the step, and those triangles' vertices within that distance, each held by its own
+ *    closest surface point at t0;
+ *  - unless one of those already touches (gap <= margin), the CCD's contact set at the first time of
+ *    impact (sdfccd_query_mesh_ws()) and the vertices of its triangles within vertex_distance of the
+ *    margin then, each held by the surface point and normal it touches there, its gap measured at t0
+ *    along that normal (a speculative contact: the solver may close at most the gap in the step).
+ * When nothing lies within reach at t0, the step has no contact and the call costs one broad-phase
+ * pass. The candidates are reduced to `capacity` points by sdfccd_reduce_contacts() (deepest first,
+ * then area; never a prefix of the set). Uses the workspace: no allocation after a first call of a
+ * given size. Errors: as sdfccd_query_mesh_ws(), params not from sdfccd_default_contact_params(),
+ * vertex_distance or same_place_distance not finite and >= 0, out_points NULL with capacity > 0;
+ * on error nothing is written. */
+SDFCCD_API sdfccd_Status sdfccd_generate_contacts(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                                  sdfccd_MeshId mesh, const sdfccd_RigidMotion* motion, double t0, double t1,
+                                                  const sdfccd_ContactParams* params, sdfccd_ContactPoint* out_points,
+                                                  int32_t capacity, sdfccd_ContactSet* out_set);
+
+/** sdfccd_generate_contacts() for a deforming mesh (cloth, soft bodies): the mesh's topology with
+ * per-vertex world positions at t0 (`start`) and t1 (`end`), vertex_count each, moving linearly. */
+SDFCCD_API sdfccd_Status sdfccd_generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                                         sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end,
+                                                         double t0, double t1, const sdfccd_ContactParams* params,
+                                                         sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set);
+
+/** The guarantee for a deforming mesh: sdfccd_guard_rigid() with each vertex moving linearly from
+ * `start` (t0) to `end` (t1), world positions, vertex_count each. `out->safe_pose` is the identity
+ * (unused); the safe positions, the vertices at `out->toi`, go to `out_positions` (vertex_count
+ * entries; may be NULL), the end positions unless ROLLED_BACK. */
+SDFCCD_API sdfccd_Status sdfccd_guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                             sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0,
+                                             double t1, const sdfccd_GuardParams* params, sdfccd_GuardResult* out,
+                                             sdfccd_Vec3* out_positions);
 
 #ifdef __cplusplus
 }
