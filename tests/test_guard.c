@@ -24,10 +24,11 @@ typedef struct box_mesh {
     uint32_t nv, nt;
 } box_mesh;
 
-static box_mesh make_box(double hx, double hy, double hz, int nx, int ny, int nz)
+/* A mesh handle with a copy of its arrays (for brute force). */
+static box_mesh mesh_data(sdfccd_MeshId id)
 {
     box_mesh b;
-    b.id = test_box_mesh((sdfccd_Vec3){ hx, hy, hz }, nx, ny, nz);
+    b.id = id;
     sdfccd_MeshInfo info;
     ck_assert_int_eq(sdfccd_mesh_get_info(b.id, &info), SDFCCD_OK);
     b.nv = info.vertex_count;
@@ -36,6 +37,11 @@ static box_mesh make_box(double hx, double hy, double hz, int nx, int ny, int nz
     b.f = malloc(3 * (size_t)b.nt * sizeof *b.f);
     ck_assert_int_eq(sdfccd_mesh_get_data(b.id, b.v, b.f), SDFCCD_OK);
     return b;
+}
+
+static box_mesh make_box(double hx, double hy, double hz, int nx, int ny, int nz)
+{
+    return mesh_data(test_box_mesh((sdfccd_Vec3){ hx, hy, hz }, nx, ny, nz));
 }
 
 static void free_box(box_mesh* b)
@@ -79,10 +85,10 @@ static sdfccd_Quat qmul(sdfccd_Quat a, sdfccd_Quat b)
 }
 
 /* Brute force: the smallest phi over the mesh at `pose`, at the vertices and on a barycentric grid
- * of 12 steps per edge of every triangle (SDF static; world point = pose applied to the local one). */
-static double min_phi_at(sdfccd_SdfId sdf, const box_mesh* b, sdfccd_Pose pose)
+ * of K steps per edge of every triangle (12 unless said; SDF static; world point = pose applied to the
+ * local one). */
+static double min_phi_grid(sdfccd_SdfId sdf, const box_mesh* b, sdfccd_Pose pose, int K)
 {
-    enum { K = 12 };
     double best = INFINITY;
     for (uint32_t t = 0; t < b->nt; ++t) {
         const double* a = b->v + 3 * b->f[3 * t];
@@ -99,6 +105,21 @@ static double min_phi_at(sdfccd_SdfId sdf, const box_mesh* b, sdfccd_Pose pose)
                 best = fmin(best, phi);
             }
     }
+    return best;
+}
+
+static double min_phi_at(sdfccd_SdfId sdf, const box_mesh* b, sdfccd_Pose pose) { return min_phi_grid(sdf, b, pose, 12); }
+
+/* The smallest phi over the mesh's vertices at `pose` (one batch evaluation). */
+static double min_phi_vertices(sdfccd_SdfId sdf, const box_mesh* b, sdfccd_Pose pose, sdfccd_Vec3* scratch, double* values)
+{
+    for (uint32_t i = 0; i < b->nv; ++i) {
+        sdfccd_Vec3 r = rotate(pose.orientation, v3(b->v[3 * i], b->v[3 * i + 1], b->v[3 * i + 2]));
+        scratch[i] = v3(r.x + pose.position.x, r.y + pose.position.y, r.z + pose.position.z);
+    }
+    ck_assert_int_eq(sdfccd_sdf_eval_batch(sdf, scratch, (int32_t)b->nv, values, NULL), SDFCCD_OK);
+    double best = INFINITY;
+    for (uint32_t i = 0; i < b->nv; ++i) best = fmin(best, values[i]);
     return best;
 }
 
@@ -466,6 +487,71 @@ START_TEST(test_guard_linear_cloth)
 }
 END_TEST
 
+/* The thin-body battery at the core (issue 19): the data set's 4 mm shuriken shot at 100-500 m/s
+ * with random orientation, incidence up to 80 degrees and spin up to 200 rad/s, into a 1 cm box wall
+ * and a 1.5 cm spherical shell (CSG difference), seeded. Every shot crosses the wall within the step.
+ * Checked against brute force: the guard rolls back; on [t0, toi] (200 times) no vertex is deeper
+ * than TOL; at the safe pose no point (vertices and a grid of 4 steps per edge) is deeper than TOL,
+ * and the deepest is deeper than 0.8 TOL (the pose is not early). */
+START_TEST(test_shuriken_battery)
+{
+    box_mesh sh = mesh_data(test_load_mesh("../samples/report/dataset/shuriken.obj"));
+    ck_assert_int_eq(sh.nt, 888);
+    sdfccd_SdfId box, wall, outer, inner, shell;
+    ck_assert_int_eq(sdfccd_create_box(v3(0.005, 1, 1), &box), SDFCCD_OK);
+    sdfccd_Pose at = sdfccd_pose_identity();
+    at.position.x = 0.005;
+    ck_assert_int_eq(sdfccd_create_transformed(box, at, 1.0, &wall), SDFCCD_OK); /* x in [0, 0.01] */
+    ck_assert_int_eq(sdfccd_create_sphere(0.3, &outer), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_sphere(0.285, &inner), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_DIFFERENCE, outer, inner, &shell), SDFCCD_OK);
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    sdfccd_Vec3* scratch = malloc(sh.nv * sizeof *scratch);
+    double* values = malloc(sh.nv * sizeof *values);
+    test_rng rng = { 1919 };
+    enum { SHOTS = 12, SAMPLES = 200 };
+    double worst_before = INFINITY, worst_safe = INFINITY, shallowest_safe = -INFINITY;
+    for (int k = 0; k < SHOTS; ++k) {
+        const int into_shell = k % 2;
+        sdfccd_SdfId target = into_shell ? shell : wall;
+        double speed = test_rng_uniform(&rng, 100, 500), incidence = test_rng_uniform(&rng, 0, 80) * M_PI / 180;
+        sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+        m.pose.orientation = axis_angle(test_rng_unit_vector(&rng), test_rng_uniform(&rng, 0, 2 * M_PI));
+        sdfccd_Vec3 axis = test_rng_unit_vector(&rng);
+        double spin = test_rng_uniform(&rng, 0, 200);
+        m.angular_velocity = v3(axis.x * spin, axis.y * spin, axis.z * spin);
+        /* centre 6 cm before the surface (the shuriken's radius is 5 cm), moving at `incidence` to its normal */
+        sdfccd_Vec3 dir = v3(cos(incidence), sin(incidence), 0);
+        m.pose.position = into_shell ? v3(-0.36, -0.36 * tan(incidence) * 0.1, 0) : v3(-0.06, 0, 0);
+        m.linear_velocity = v3(dir.x * speed, dir.y * speed, 0);
+        ck_assert(min_phi_vertices(target, &sh, m.pose, scratch, values) > 0.0);
+        sdfccd_GuardResult r = guard(ws, target, NULL, sh.id, &m, &gp);
+        ck_assert_msg(r.state == SDFCCD_GUARD_ROLLED_BACK, "shot %d: state %d", k, (int)r.state);
+        double before = INFINITY;
+        for (int i = 0; i <= SAMPLES; ++i) before = fmin(before, min_phi_vertices(target, &sh, pose_at(&m, r.toi * i / SAMPLES), scratch, values));
+        double safe = min_phi_grid(target, &sh, r.safe_pose, 4);
+        REPORT("shot %2d (%s, %3.0f m/s, %2.0f deg, %3.0f rad/s): toi %.4g s, deepest vertex before %.3g, at the safe pose %.4g, "
+               "%lld evaluations\n", k, into_shell ? "shell" : "wall ", speed, incidence * 180 / M_PI, spin, r.toi, before, safe,
+               (long long)r.sdf_evaluations);
+        ck_assert_msg(before >= -TOL, "shot %d: a vertex %.9g deep before the safe pose", k, before);
+        ck_assert_msg(safe >= -TOL && safe <= -0.8 * TOL, "shot %d: min phi at the safe pose %.9g", k, safe);
+        worst_before = fmin(worst_before, before);
+        worst_safe = fmin(worst_safe, safe);
+        shallowest_safe = fmax(shallowest_safe, safe);
+    }
+    REPORT("battery: deepest vertex before the safe poses %.4g, depth at the safe poses in [%.4g, %.4g]\n", worst_before, worst_safe,
+           shallowest_safe);
+    free(scratch);
+    free(values);
+    sdfccd_destroy_workspace(ws);
+    const sdfccd_SdfId all[5] = { shell, inner, outer, wall, box };
+    for (int i = 0; i < 5; ++i) ck_assert_int_eq(sdfccd_destroy_sdf(all[i]), SDFCCD_OK);
+    free_box(&sh);
+}
+END_TEST
+
 START_TEST(test_motion_from_poses)
 {
     test_rng rng = { 19 };
@@ -627,6 +713,7 @@ int main(void)
     tcase_add_test(tc, test_inside_at_start_rest_guarded);
     tcase_add_test(tc, test_moving_sdf);
     tcase_add_test(tc, test_guard_linear_cloth);
+    tcase_add_test(tc, test_shuriken_battery);
     tcase_add_test(tc, test_motion_from_poses);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);
