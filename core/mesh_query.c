@@ -225,15 +225,19 @@ static void contact_item(const void* set, size_t i, scc_reduce_item* out)
     out->id = i;
 }
 
-/* More contacts than the caller's room: the earliest one, then a reduction of the rest (reduce.h;
- * points within the distance tolerance count as one place), written earliest first. */
+/* More contacts than the caller's room: the deepest at the earliest time, then a reduction of the rest
+ * (reduce.h; points within the distance tolerance count as one place), written earliest first. */
 static int reduce_output(const contact_buf* buf, const scc_params* p, scc_workspace* ws, scc_contact* out, int capacity, int* out_written)
 {
     *out_written = 0;
     if (capacity <= 0) return 1;
     int32_t* idx = scc_ws_get(ws, SCC_WS_REDUCE, (size_t)capacity * sizeof *idx);
     if (!idx) return 0;
-    size_t n = scc_reduce(buf->a, buf->n, contact_item, p->dist_tol, 0, (size_t)capacity, idx);
+    /* the seed: the deepest contact at the earliest time (the buffer is sorted by time) */
+    long seed = 0;
+    for (size_t i = 1; i < buf->n && buf->a[i].toi == buf->a[0].toi; ++i)
+        if (buf->a[i].distance < buf->a[seed].distance) seed = (long)i;
+    size_t n = scc_reduce(buf->a, buf->n, contact_item, p->dist_tol, seed, (size_t)capacity, idx);
     for (size_t i = 0; i < n; ++i) {
         scc_contact key = buf->a[idx[i]];
         size_t j = i;

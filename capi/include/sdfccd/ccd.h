@@ -223,7 +223,7 @@ SDFCCD_API sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sd
  * (triangles whose TOI lies within params->toi_window of the earliest, plus subdivision
  * contacts). The search interval shrinks as earlier hits are found. Contacts are written earliest
  * first; when more are found than `capacity`, the ones written are a reduction of the set, not its
- * first ones: the earliest contact, then the points spreading most over the contact region
+ * first ones: the deepest contact at the earliest time, then the points spreading most over the contact region
  * (sdfccd_reduce_contacts() on their surface points, with distance_tolerance as the same-place
  * distance), so `contact_count` may be below `capacity`. The linear and workspace variants do the same. */
 SDFCCD_API sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
