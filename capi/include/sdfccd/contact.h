@@ -75,13 +75,16 @@ typedef enum sdfccd_GuardState {
  * start depth minus the tolerance: it may not sink further by more than the tolerance in the step,
  * and every other triangle keeps the level -tolerance. So such a body is not frozen at t0 every
  * step, and the rest of it stays guarded. Known limits: a triangle that starts deeper than half the
- * thickness of a thin feature can cross it; the start depth comes from a local search (DCD), and a
- * triangle whose check still reports contact at t0 after three corrections of its level is left out
- * of the check (counted in `deep_triangles`). */
+ * thickness of a thin feature can cross it; the start depth comes from a local search (DCD), so a
+ * triangle whose check still reports contact at t0 has its level lowered to what the check saw, and
+ * after three such corrections it is left out of the check (as is every triangle still reporting
+ * contact at t0 when the guard has run 8 queries). */
 typedef struct sdfccd_GuardResult {
     sdfccd_GuardState state;   /**< Clear, rolled back, or inside at the start. */
-    double toi;                /**< Seconds in [t0, t1]: the time of the safe pose, at most a time tolerance before the
-                                    first time a point reached its level when ROLLED_BACK; t1 otherwise. */
+    double toi;                /**< Seconds in [t0, t1]. ROLLED_BACK: the time of the safe pose, not after the first time
+                                    a point reached its level and before it by about the query's time tolerance
+                                    (tightened so that no point moves more than a tenth of the tolerance in it); t1
+                                    otherwise. */
     double fraction;           /**< (toi - t0) / (t1 - t0) (0 when t1 == t0). */
     sdfccd_Pose safe_pose;     /**< The mesh pose at `toi` along the executed motion (its end pose unless ROLLED_BACK). */
     sdfccd_Vec3 point;         /**< ROLLED_BACK: the world point of the body that reached its level first, at `toi`
