@@ -194,8 +194,9 @@ int scc_generate_contacts(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     sum->candidates = b.n;
     if (capacity > 0 && b.n > 0) {
         int32_t* idx = scc_ws_get(ws, SCC_WS_REDUCE, (size_t)capacity * sizeof *idx);
-        if (!idx) return 0;
-        sum->written = scc_reduce(b.a, b.n, cand_item, cp->same_place, -1, (size_t)capacity, idx);
+        double* scratch = idx ? scc_ws_get(ws, SCC_WS_REDUCE_SCRATCH, b.n * sizeof *scratch) : NULL;
+        if (!scratch) return 0;
+        sum->written = scc_reduce(b.a, b.n, cand_item, cp->same_place, -1, (size_t)capacity, idx, scratch);
         for (size_t i = 0; i < sum->written; ++i) out[i] = b.a[idx[i]];
     }
     return 1;

@@ -237,7 +237,9 @@ static int reduce_output(const contact_buf* buf, const scc_params* p, scc_worksp
     long seed = 0;
     for (size_t i = 1; i < buf->n && buf->a[i].toi == buf->a[0].toi; ++i)
         if (buf->a[i].distance < buf->a[seed].distance) seed = (long)i;
-    size_t n = scc_reduce(buf->a, buf->n, contact_item, p->dist_tol, seed, (size_t)capacity, idx);
+    double* scratch = scc_ws_get(ws, SCC_WS_REDUCE_SCRATCH, buf->n * sizeof *scratch);
+    if (!scratch) return 0;
+    size_t n = scc_reduce(buf->a, buf->n, contact_item, p->dist_tol, seed, (size_t)capacity, idx, scratch);
     for (size_t i = 0; i < n; ++i) {
         scc_contact key = buf->a[idx[i]];
         size_t j = i;

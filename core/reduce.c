@@ -3,8 +3,11 @@
  * needs (contact.h) and the mesh query's output (the contacts at the time of impact, Section 4.5,
  * when the caller's buffer is smaller than the set). Ours, in the spirit of Box2D's and Bullet's
  * manifold reduction: deepest first, then the points that maximise the contact area, never two
- * points at one place, deterministic. O(n k) evaluations of the accessor per choice at most. */
+ * points at one place, deterministic. With the caller's scratch (n doubles) a choice costs O(n) reads
+ * of the set (O(n) times the hull's size while area decides); without it, O(n k). */
 #include "reduce.h"
+
+#include <string.h>
 
 typedef struct reducer {
     const void* set;
@@ -15,7 +18,10 @@ typedef struct reducer {
     const int32_t* chosen;     /* out[0..m-1] */
     size_t m;
     int32_t hull[SCC_REDUCE_HULL_MAX]; /* counter-clockwise about nref (when hull_n >= 3) */
+    scc_vec3 hp[SCC_REDUCE_HULL_MAX];  /* the hull's points on the contact plane */
     size_t hull_n;             /* 2: a segment hull[0]-hull[1] */
+    double* mind;              /* optional, n: distance on the plane to the nearest chosen point, -1 when
+                                  within tol of one (taken); NULL: recomputed from the chosen points */
 } reducer;
 
 static scc_reduce_item item(const reducer* r, size_t i)
@@ -47,6 +53,7 @@ static int beats(double s, const scc_reduce_item* it, size_t i, double bs, const
 /* 1 when point p is within tol of a chosen point (or is chosen). */
 static int taken(const reducer* r, size_t i, scc_vec3 p)
 {
+    if (r->mind) return r->mind[i] < 0.0;
     for (size_t j = 0; j < r->m; ++j) {
         if ((size_t)r->chosen[j] == i) return 1;
         if (scc_dist(item(r, (size_t)r->chosen[j]).p, p) <= r->tol) return 1;
@@ -59,7 +66,7 @@ static int taken(const reducer* r, size_t i, scc_vec3 p)
 static double gain(const reducer* r, scc_vec3 q, int along)
 {
     if (r->hull_n == 2) {
-        scc_vec3 a = flat(r, item(r, (size_t)r->hull[0]).p), b = flat(r, item(r, (size_t)r->hull[1]).p);
+        scc_vec3 a = r->hp[0], b = r->hp[1];
         if (!along) return fabs(area2(r, a, b, q));
         scc_vec3 ab = scc_sub(b, a);
         double len = scc_len(ab);
@@ -69,8 +76,7 @@ static double gain(const reducer* r, scc_vec3 q, int along)
     }
     double added = 0.0;
     for (size_t e = 0; e < r->hull_n; ++e) {
-        scc_vec3 a = flat(r, item(r, (size_t)r->hull[e]).p), b = flat(r, item(r, (size_t)r->hull[(e + 1) % r->hull_n]).p);
-        double s = area2(r, a, b, q);
+        double s = area2(r, r->hp[e], r->hp[(e + 1) % r->hull_n], q);
         if (s < 0.0) added -= s;
     }
     return added;
@@ -106,10 +112,39 @@ static void hull_add(reducer* r, int32_t i, scc_vec3 q, int along)
     r->hull_n = k < SCC_REDUCE_HULL_MAX ? k : SCC_REDUCE_HULL_MAX;
 }
 
-size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out)
+/* The hull's plane points, after it changed. */
+static void hull_points(reducer* r)
+{
+    for (size_t v = 0; v < r->hull_n; ++v) r->hp[v] = flat(r, item(r, (size_t)r->hull[v]).p);
+}
+
+/* Records the choice of item j in the scratch: items within tol of it are taken, the others' nearest
+ * chosen distance shrinks. */
+static void chosen(reducer* r, size_t j)
+{
+    if (!r->mind) return;
+    const scc_reduce_item c = item(r, j);
+    const scc_vec3 qc = flat(r, c.p);
+    for (size_t i = 0; i < r->n; ++i) {
+        if (r->mind[i] < 0.0) continue;
+        scc_reduce_item it = item(r, i);
+        if (i == j || scc_dist(it.p, c.p) <= r->tol) r->mind[i] = -1.0;
+        else r->mind[i] = fmin(r->mind[i], scc_dist(flat(r, it.p), qc));
+    }
+}
+
+size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out, double* scratch)
 {
     if (n == 0 || k == 0) return 0;
-    reducer r = { set, n, get, tol, scc_v3(0, 0, 1), out, 0, { 0 }, 0 };
+    reducer r;
+    memset(&r, 0, sizeof r);
+    r.set = set;
+    r.n = n;
+    r.get = get;
+    r.tol = tol;
+    r.nref = scc_v3(0, 0, 1);
+    r.chosen = out;
+    r.mind = scratch;
     /* the first point: given, or the deepest; among equally deep ones (a face landing flat) the one
      * farthest from their centre, a corner, so the polygon grows to the region's corners */
     long best = first >= 0 && (size_t)first < n ? first : -1;
@@ -135,6 +170,10 @@ size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol,
     }
     out[r.m++] = (int32_t)best;
     r.nref = scc_normalize_or(item(&r, (size_t)best).n, scc_v3(0, 0, 1));
+    if (r.mind) {
+        for (size_t i = 0; i < n; ++i) r.mind[i] = INFINITY;
+        chosen(&r, (size_t)best);
+    }
     int fill = 0; /* 1 once no point adds area: spread alone */
     while (r.m < k) {
         long pick = -1;
@@ -151,15 +190,19 @@ size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol,
                 scc_vec3 q = flat(&r, it.p);
                 double s;
                 if (r.m == 1 || fill) {
-                    s = INFINITY;
-                    for (size_t j = 0; j < r.m; ++j) s = fmin(s, scc_dist(flat(&r, item(&r, (size_t)out[j]).p), q));
+                    if (r.mind) {
+                        s = r.mind[i];
+                    } else {
+                        s = INFINITY;
+                        for (size_t j = 0; j < r.m; ++j) s = fmin(s, scc_dist(flat(&r, item(&r, (size_t)out[j]).p), q));
+                    }
                 } else {
                     s = gain(&r, q, along);
                 }
                 if (beats(s, &it, i, bs, &bit, pick)) { pick = (long)i; bs = s; bit = it; }
             }
             /* what counts as adding: tol of length, or tol times the segment's length of area */
-            double seg = r.hull_n >= 2 ? scc_dist(flat(&r, item(&r, (size_t)r.hull[0]).p), flat(&r, item(&r, (size_t)r.hull[1]).p)) : 0.0;
+            double seg = r.hull_n >= 2 ? scc_dist(r.hp[0], r.hp[1]) : 0.0;
             double enough = (r.m == 1 || fill || along) ? tol : tol * seg;
             if (pick >= 0 && !(bs > enough)) pick = -1;
         }
@@ -170,13 +213,16 @@ size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol,
         }
         scc_vec3 q = flat(&r, item(&r, (size_t)pick).p);
         out[r.m++] = (int32_t)pick;
+        chosen(&r, (size_t)pick);
         if (fill) continue;
         if (r.m == 2) {
             r.hull[0] = out[0];
             r.hull[1] = (int32_t)pick;
             r.hull_n = 2;
+            hull_points(&r);
         } else if (r.hull_n < SCC_REDUCE_HULL_MAX) {
             hull_add(&r, (int32_t)pick, q, along);
+            hull_points(&r);
         } else {
             fill = 1;
         }

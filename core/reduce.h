@@ -28,7 +28,8 @@ typedef void scc_reduce_get_fn(const void* set, size_t i, scc_reduce_item* out);
  * area to the polygon of the chosen ones (projected on the plane of the first one's normal), then,
  * once none adds area, the points farthest from every chosen one. A point within `tol` (>= 0) of a
  * chosen one is never chosen; choices stop when the best adds no more than `tol` of spread. Ties (scores
- * within 1e-9 relative) go to the smaller gap, then the smaller id, then the lower index. */
-size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out);
+ * within 1e-9 relative) go to the smaller gap, then the smaller id, then the lower index. `scratch`
+ * (n doubles, or NULL) makes it O(n) per choice instead of O(n k); the result is the same. */
+size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out, double* scratch);
 
 #endif

@@ -24,6 +24,7 @@ enum {
     SCC_WS_TRACES,    /* mesh query: one FWGSS vertex trace record per mesh vertex (motion.h) */
     SCC_WS_GUARD,     /* guard: per-triangle contact levels (guard.c) */
     SCC_WS_REDUCE,    /* mesh query and contact sets: indices of the contacts kept (reduce.c) */
+    SCC_WS_REDUCE_SCRATCH, /* the reduction's per-contact distances (reduce.c) */
     SCC_WS_CANDIDATES, /* contact sets: the candidates of a step (contacts.c) */
     SCC_WS_MARKS,     /* contact sets: one mark per mesh vertex (tagged by mark_epoch) */
     SCC_WS_SLOTS

@@ -351,6 +351,6 @@ sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t 
         if (!scc_vfinite(sdfccd__v(c->surface_point)) || !scc_vfinite(sdfccd__v(c->normal)) || !isfinite(c->gap))
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: point %d has a non-finite surface point, normal or gap", fn, i);
     }
-    *out_count = (int32_t)scc_reduce(points, (size_t)count, public_item, same_place_distance, -1, (size_t)capacity, out_indices);
+    *out_count = (int32_t)scc_reduce(points, (size_t)count, public_item, same_place_distance, -1, (size_t)capacity, out_indices, NULL);
     return SDFCCD_OK;
 }
