@@ -90,11 +90,12 @@ static sdfccd_RigidMotion falling(void)
 
 enum {
     CALL_EVAL, CALL_EVAL_BATCH, CALL_QUERY_TRIANGLE, CALL_QUERY_TRIANGLE_LINEAR, CALL_QUERY_MESH, CALL_QUERY_MESH_WS,
-    CALL_QUERY_MESH_LINEAR, CALL_GRID_FROM_SDF, CALL_GRID_FROM_SDF_PROGRESS, CALL_EXTRACT, CALL_COUNT
+    CALL_QUERY_MESH_LINEAR, CALL_GUARD, CALL_GENERATE_CONTACTS, CALL_GRID_FROM_SDF, CALL_GRID_FROM_SDF_PROGRESS, CALL_EXTRACT, CALL_COUNT
 };
 static const char* const k_call_names[CALL_COUNT] = {
     "sdf_eval", "sdf_eval_batch", "query_triangle", "query_triangle_linear", "query_mesh", "query_mesh_ws",
-    "query_mesh_linear", "create_grid_from_sdf", "create_grid_from_sdf (progress)", "extract_isosurface",
+    "query_mesh_linear", "guard_rigid", "generate_contacts", "create_grid_from_sdf", "create_grid_from_sdf (progress)",
+    "extract_isosurface",
 };
 
 /* Runs entry point `call` on `u` (and `mesh`); returns its status. Objects it creates are destroyed. */
@@ -156,6 +157,23 @@ static sdfccd_Status run_sdf_call(int call, sdfccd_SdfId u, sdfccd_MeshId mesh, 
         free(e);
         break;
     }
+    case CALL_GUARD:
+    case CALL_GENERATE_CONTACTS: {
+        sdfccd_Workspace* ws = NULL;
+        ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+        if (call == CALL_GUARD) {
+            sdfccd_GuardParams gp = sdfccd_default_guard_params();
+            sdfccd_GuardResult gr;
+            st = sdfccd_guard_rigid(ws, u, NULL, mesh, &m, 0, 1, &gp, &gr);
+        } else {
+            sdfccd_ContactParams cp = sdfccd_default_contact_params();
+            sdfccd_ContactPoint pts[4];
+            sdfccd_ContactSet set;
+            st = sdfccd_generate_contacts(ws, u, NULL, mesh, &m, 0, 1, &cp, pts, 4, &set);
+        }
+        sdfccd_destroy_workspace(ws);
+        break;
+    }
     case CALL_GRID_FROM_SDF:
     case CALL_GRID_FROM_SDF_PROGRESS: {
         sdfccd_GridDef d = sdfccd_default_grid_def();
@@ -212,7 +230,7 @@ END_TEST
 START_TEST(test_destroy_mesh_inside_call)
 {
     const int64_t base = sdfccd_byte_count();
-    const int calls[] = { CALL_QUERY_MESH, CALL_QUERY_MESH_WS, CALL_QUERY_MESH_LINEAR };
+    const int calls[] = { CALL_QUERY_MESH, CALL_QUERY_MESH_WS, CALL_QUERY_MESH_LINEAR, CALL_GUARD, CALL_GENERATE_CONTACTS };
     for (size_t k = 0; k < sizeof calls / sizeof calls[0]; ++k) {
         victim v;
         memset(&v, 0, sizeof v);
