@@ -299,6 +299,8 @@ static void* race_everything(void* arg)
     double* vd = malloc(sizeof(double) * 3 * 4096);
     uint32_t* id = malloc(sizeof(uint32_t) * 3 * 8192);
     for (int i = 0; i < N; ++i) pts[i] = (sdfccd_Vec3){ 0.004 * i - 0.4, 0.1, 0.05 };
+    sdfccd_Workspace* ws = NULL; /* the guard and contact sets need one; it holds no handle */
+    tally(r, sdfccd_create_workspace(&ws), "create_workspace");
     /* RACE_ITERATIONS rounds at least, then on until a destroy is seen: the main thread destroys
      * once every racer has finished a round, so this ends (under valgrind, which runs one thread
      * at a time, a fixed count could finish before the destroy). */
@@ -347,7 +349,15 @@ static void* race_everything(void* arg)
         sdfccd_Contact c[4];
         sdfccd_QueryResult res;
         tally(r, sdfccd_query_mesh(r->grid, NULL, r->mesh, &m, 0, 1, &p, c, 4, &res), "query_mesh");
+        sdfccd_GuardParams gp = sdfccd_default_guard_params();
+        sdfccd_GuardResult gr;
+        tally(r, sdfccd_guard_rigid(ws, r->sdf, NULL, r->mesh, &m, 0, 1, &gp, &gr), "guard_rigid");
+        sdfccd_ContactParams cp = sdfccd_default_contact_params();
+        sdfccd_ContactPoint cpts[4];
+        sdfccd_ContactSet set;
+        tally(r, sdfccd_generate_contacts(ws, r->grid, NULL, r->mesh, &m, 0, 1, &cp, cpts, 4, &set), "generate_contacts");
     }
+    sdfccd_destroy_workspace(ws);
     free(vd);
     free(id);
     remove(path);
