@@ -100,6 +100,7 @@ typedef struct scc_query_summary {
     int hit;
     double toi, toi_lower;
     int contacts_found;     /* may exceed the capacity */
+    int contacts_written;   /* written to the caller's array (mesh query: a reduction when found > capacity) */
     int64_t iterations, evals, triangles_tested;
 } scc_query_summary;
 
@@ -118,6 +119,11 @@ typedef struct scc_mesh_motion {
     const scc_vec3* end;        /* linear: world vertices at t1 */
     const scc_rigid* sdf;       /* NULL: static SDF */
     double t0, t1;
+    /* Optional per-triangle contact levels (NULL: params->margin for every triangle): triangle t is in
+     * contact when phi <= tri_margin[t]. Each must be <= params->margin, which the broad phase culls
+     * with; -INFINITY leaves the triangle out. Used by the guard (guard.c); the FWGSS vertex traces are
+     * then kept per triangle, since a vertex's neighbours may have different levels. */
+    const double* tri_margin;
 } scc_mesh_motion;
 
 /* The inputs of one mesh query: the field, the mesh's motion, the parameters and the scratch
@@ -132,6 +138,8 @@ typedef struct scc_mesh_query_in {
 
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum);
+/* A bound on the speed (SDF frame) of any point of the mesh over [mm->t0, mm->t1]. */
+double scc_mesh_speed_bound(const scc_mesh_motion* mm);
 /* The motion of triangle t of the mesh motion `mm` (what the mesh query tests per triangle). */
 void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_motion* out);
 /* The same with the scratch storage in a caller-kept workspace (workspace.h): after a first query

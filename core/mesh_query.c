@@ -11,6 +11,7 @@
  * narrow-phase tests only. */
 #include "bsh.h"
 #include "ccd.h"
+#include "reduce.h"
 
 #include <string.h>
 
@@ -59,6 +60,34 @@ void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_mot
     }
 }
 
+double scc_mesh_speed_bound(const scc_mesh_motion* mm)
+{
+    const double T = mm->t1 - mm->t0;
+    const scc_mesh* mesh = mm->mesh;
+    const scc_rigid* s = mm->sdf;
+    scc_vec3 gs0 = s ? scc_rigid_center_at(s, mm->t0) : scc_v3(0, 0, 0);
+    double speed = 0.0, reach = 0.0;
+    if (mm->body) {
+        const scc_rigid* b = mm->body;
+        double r = 0.0;
+        for (int k = 0; k < 8; ++k) {
+            scc_vec3 corner = scc_v3(k & 1 ? mesh->bounds.hi.x : mesh->bounds.lo.x, k & 2 ? mesh->bounds.hi.y : mesh->bounds.lo.y,
+                                     k & 4 ? mesh->bounds.hi.z : mesh->bounds.lo.z);
+            r = fmax(r, scc_dist(corner, b->c_local));
+        }
+        speed = scc_len(b->v) + scc_len(b->w) * r;
+        if (s) reach = scc_dist(scc_rigid_center_at(b, mm->t0), gs0) + r + (scc_len(b->v) + scc_len(s->v)) * T;
+    } else {
+        for (uint32_t i = 0; i < mesh->vertex_count; ++i) {
+            double d = scc_dist(mm->end[i], mm->start[i]);
+            speed = fmax(speed, T > 0.0 ? d / T : 0.0);
+            if (s) reach = fmax(reach, scc_dist(mm->start[i], gs0) + d + scc_len(s->v) * T);
+        }
+    }
+    if (s) speed += scc_len(s->v) + scc_len(s->w) * reach;
+    return speed;
+}
+
 typedef struct mesh_ctx {
     scc_mesh_query_in in;        /* the query's inputs, handed to the broad phase as they are */
     contact_buf buf;
@@ -91,6 +120,10 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
     if (tp.max_evals <= 0) {
         c->budget_exhausted = 1;
         return 1;
+    }
+    if (mm->tri_margin) {
+        if (!(mm->tri_margin[t] > -INFINITY)) return 1; /* left out by the caller */
+        tp.margin = mm->tri_margin[t];
     }
     scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     double tb = fmin(mm->t1, c->best + p->toi_window);
@@ -182,6 +215,41 @@ static int run_broad_phase(mesh_ctx* c)
     return ok;
 }
 
+/* The reduction reads a contact as its surface point (the point less phi along the normal). */
+static void contact_item(const void* set, size_t i, scc_reduce_item* out)
+{
+    const scc_contact* c = (const scc_contact*)set + i;
+    out->p = scc_sub(c->point, scc_scale(c->normal, c->distance));
+    out->n = c->normal;
+    out->gap = c->distance;
+    out->id = i;
+}
+
+/* More contacts than the caller's room: the deepest at the earliest time, then a reduction of the rest
+ * (reduce.h; points within the distance tolerance count as one place), written earliest first. */
+static int reduce_output(const contact_buf* buf, const scc_params* p, scc_workspace* ws, scc_contact* out, int capacity, int* out_written)
+{
+    *out_written = 0;
+    if (capacity <= 0) return 1;
+    int32_t* idx = scc_ws_get(ws, SCC_WS_REDUCE, (size_t)capacity * sizeof *idx);
+    if (!idx) return 0;
+    /* the seed: the deepest contact at the earliest time (the buffer is sorted by time) */
+    long seed = 0;
+    for (size_t i = 1; i < buf->n && buf->a[i].toi == buf->a[0].toi; ++i)
+        if (buf->a[i].distance < buf->a[seed].distance) seed = (long)i;
+    double* scratch = scc_ws_get(ws, SCC_WS_REDUCE_SCRATCH, buf->n * sizeof *scratch);
+    if (!scratch) return 0;
+    size_t n = scc_reduce(buf->a, buf->n, contact_item, p->dist_tol, seed, (size_t)capacity, idx, scratch);
+    for (size_t i = 0; i < n; ++i) {
+        scc_contact key = buf->a[idx[i]];
+        size_t j = i;
+        while (j > 0 && out[j - 1].toi > key.toi) { out[j] = out[j - 1]; --j; }
+        out[j] = key;
+    }
+    *out_written = (int)n;
+    return 1;
+}
+
 int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, const scc_allocator* alloc,
                    scc_contact* out, int capacity, scc_query_summary* sum)
 {
@@ -230,7 +298,7 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     c.traces = NULL;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
     int ok = 1;
-    if (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0 && mm->mesh->vertex_count > 0) {
+    if (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0 && mm->mesh->vertex_count > 0 && !mm->tri_margin) {
         /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
         size_t need = (size_t)mm->mesh->vertex_count * sizeof *c.traces;
         int fresh = ws->slot[SCC_WS_TRACES].bytes < need;
@@ -268,6 +336,10 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     sum->state = sum->hit ? (c.budget_exhausted ? SCC_NOT_CONVERGED : best_state)
                           : (any_not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT);
     sum->contacts_found = (int)buf.n;
-    for (size_t i = 0; i < buf.n && (int)i < capacity; ++i) out[i] = buf.a[i];
-    return 1;
+    if (buf.n <= (size_t)(capacity > 0 ? capacity : 0)) {
+        for (size_t i = 0; i < buf.n; ++i) out[i] = buf.a[i];
+        sum->contacts_written = (int)buf.n;
+        return 1;
+    }
+    return reduce_output(&buf, p, ws, out, capacity, &sum->contacts_written);
 }

@@ -111,6 +111,7 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
     sum->toi = h.toi;
     sum->toi_lower = h.toi_lower;
     sum->contacts_found = n;
+    sum->contacts_written = n < capacity ? n : (capacity > 0 ? capacity : 0);
     sum->iterations = iterations;
     sum->evals = evals;
     sum->triangles_tested = 1;

@@ -12,7 +12,8 @@
 #include "alloc.h"
 
 enum {
-    SCC_WS_CONTACTS,  /* mesh query: contacts of the triangles within the TOI window */
+    SCC_WS_CONTACTS,  /* mesh query: contacts of the triangles within the TOI window; after a query it
+                         holds all sum->contacts_found of them, earliest first */
     SCC_WS_HEAP,      /* broad phase: earliest-candidate heap */
     SCC_WS_SEGMENTS,  /* broad phase: time segments */
     SCC_WS_TESTED,    /* broad phase: one bit per triangle */
@@ -21,6 +22,11 @@ enum {
     SCC_WS_STAGING,   /* the ABI: contacts before conversion to the world frame */
     SCC_WS_VERTICES,  /* the ABI: linear-motion vertex copies */
     SCC_WS_TRACES,    /* mesh query: one FWGSS vertex trace record per mesh vertex (motion.h) */
+    SCC_WS_GUARD,     /* guard: per-triangle contact levels (guard.c) */
+    SCC_WS_REDUCE,    /* mesh query and contact sets: indices of the contacts kept (reduce.c) */
+    SCC_WS_REDUCE_SCRATCH, /* the reduction's per-contact distances (reduce.c) */
+    SCC_WS_CANDIDATES, /* contact sets: the candidates of a step (contacts.c) */
+    SCC_WS_MARKS,     /* contact sets: one mark per mesh vertex (tagged by mark_epoch) */
     SCC_WS_SLOTS
 };
 
@@ -30,12 +36,14 @@ typedef struct scc_workspace {
     const scc_allocator* alloc;
     scc_ws_slot slot[SCC_WS_SLOTS];
     uint32_t trace_epoch;  /* mesh queries so far (tags the SCC_WS_TRACES records in use) */
+    uint32_t mark_epoch;   /* vertex marks handed out so far (tags SCC_WS_MARKS) */
 } scc_workspace;
 
 static inline void scc_ws_init(scc_workspace* ws, const scc_allocator* alloc)
 {
     ws->alloc = alloc;
     ws->trace_epoch = 0;
+    ws->mark_epoch = 0;
     for (int i = 0; i < SCC_WS_SLOTS; ++i) {
         ws->slot[i].p = NULL;
         ws->slot[i].bytes = 0;

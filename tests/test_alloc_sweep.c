@@ -96,6 +96,15 @@ static sdfccd_Status queries(sdfccd_SdfId sdf, sdfccd_MeshId mesh, made* m)
     if (!m->ws) TRY(sdfccd_create_workspace(&m->ws));
     sdfccd_QueryParams p = sdfccd_default_query_params();
     TRY(sdfccd_query_mesh_ws(m->ws, sdf, NULL, mesh, &mo, 0, 1, &p, c, 16, &r));
+    sdfccd_GuardParams gp = sdfccd_default_guard_params(); /* the guard (contact.h) */
+    sdfccd_GuardResult gr;
+    TRY(sdfccd_guard_rigid(m->ws, sdf, NULL, mesh, &mo, 0, 1, &gp, &gr));
+    TRY(sdfccd_guard_linear(m->ws, sdf, NULL, mesh, start_v, end_v, 0, 1, &gp, &gr, NULL));
+    sdfccd_ContactParams cpar = sdfccd_default_contact_params(); /* contact sets (contact.h) */
+    sdfccd_ContactPoint pts[4];
+    sdfccd_ContactSet set;
+    TRY(sdfccd_generate_contacts(m->ws, sdf, NULL, mesh, &mo, 0, 1, &cpar, pts, 4, &set));
+    TRY(sdfccd_generate_contacts_linear(m->ws, sdf, NULL, mesh, start_v, end_v, 0, 1, &cpar, pts, 4, &set));
     return SDFCCD_OK;
 }
 

@@ -90,11 +90,12 @@ static sdfccd_RigidMotion falling(void)
 
 enum {
     CALL_EVAL, CALL_EVAL_BATCH, CALL_QUERY_TRIANGLE, CALL_QUERY_TRIANGLE_LINEAR, CALL_QUERY_MESH, CALL_QUERY_MESH_WS,
-    CALL_QUERY_MESH_LINEAR, CALL_GRID_FROM_SDF, CALL_GRID_FROM_SDF_PROGRESS, CALL_EXTRACT, CALL_COUNT
+    CALL_QUERY_MESH_LINEAR, CALL_GUARD, CALL_GENERATE_CONTACTS, CALL_GRID_FROM_SDF, CALL_GRID_FROM_SDF_PROGRESS, CALL_EXTRACT, CALL_COUNT
 };
 static const char* const k_call_names[CALL_COUNT] = {
     "sdf_eval", "sdf_eval_batch", "query_triangle", "query_triangle_linear", "query_mesh", "query_mesh_ws",
-    "query_mesh_linear", "create_grid_from_sdf", "create_grid_from_sdf (progress)", "extract_isosurface",
+    "query_mesh_linear", "guard_rigid", "generate_contacts", "create_grid_from_sdf", "create_grid_from_sdf (progress)",
+    "extract_isosurface",
 };
 
 /* Runs entry point `call` on `u` (and `mesh`); returns its status. Objects it creates are destroyed. */
@@ -156,6 +157,23 @@ static sdfccd_Status run_sdf_call(int call, sdfccd_SdfId u, sdfccd_MeshId mesh, 
         free(e);
         break;
     }
+    case CALL_GUARD:
+    case CALL_GENERATE_CONTACTS: {
+        sdfccd_Workspace* ws = NULL;
+        ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+        if (call == CALL_GUARD) {
+            sdfccd_GuardParams gp = sdfccd_default_guard_params();
+            sdfccd_GuardResult gr;
+            st = sdfccd_guard_rigid(ws, u, NULL, mesh, &m, 0, 1, &gp, &gr);
+        } else {
+            sdfccd_ContactParams cp = sdfccd_default_contact_params();
+            sdfccd_ContactPoint pts[4];
+            sdfccd_ContactSet set;
+            st = sdfccd_generate_contacts(ws, u, NULL, mesh, &m, 0, 1, &cp, pts, 4, &set);
+        }
+        sdfccd_destroy_workspace(ws);
+        break;
+    }
     case CALL_GRID_FROM_SDF:
     case CALL_GRID_FROM_SDF_PROGRESS: {
         sdfccd_GridDef d = sdfccd_default_grid_def();
@@ -212,7 +230,7 @@ END_TEST
 START_TEST(test_destroy_mesh_inside_call)
 {
     const int64_t base = sdfccd_byte_count();
-    const int calls[] = { CALL_QUERY_MESH, CALL_QUERY_MESH_WS, CALL_QUERY_MESH_LINEAR };
+    const int calls[] = { CALL_QUERY_MESH, CALL_QUERY_MESH_WS, CALL_QUERY_MESH_LINEAR, CALL_GUARD, CALL_GENERATE_CONTACTS };
     for (size_t k = 0; k < sizeof calls / sizeof calls[0]; ++k) {
         victim v;
         memset(&v, 0, sizeof v);
@@ -281,6 +299,8 @@ static void* race_everything(void* arg)
     double* vd = malloc(sizeof(double) * 3 * 4096);
     uint32_t* id = malloc(sizeof(uint32_t) * 3 * 8192);
     for (int i = 0; i < N; ++i) pts[i] = (sdfccd_Vec3){ 0.004 * i - 0.4, 0.1, 0.05 };
+    sdfccd_Workspace* ws = NULL; /* the guard and contact sets need one; it holds no handle */
+    tally(r, sdfccd_create_workspace(&ws), "create_workspace");
     /* RACE_ITERATIONS rounds at least, then on until a destroy is seen: the main thread destroys
      * once every racer has finished a round, so this ends (under valgrind, which runs one thread
      * at a time, a fixed count could finish before the destroy). */
@@ -329,7 +349,15 @@ static void* race_everything(void* arg)
         sdfccd_Contact c[4];
         sdfccd_QueryResult res;
         tally(r, sdfccd_query_mesh(r->grid, NULL, r->mesh, &m, 0, 1, &p, c, 4, &res), "query_mesh");
+        sdfccd_GuardParams gp = sdfccd_default_guard_params();
+        sdfccd_GuardResult gr;
+        tally(r, sdfccd_guard_rigid(ws, r->sdf, NULL, r->mesh, &m, 0, 1, &gp, &gr), "guard_rigid");
+        sdfccd_ContactParams cp = sdfccd_default_contact_params();
+        sdfccd_ContactPoint cpts[4];
+        sdfccd_ContactSet set;
+        tally(r, sdfccd_generate_contacts(ws, r->grid, NULL, r->mesh, &m, 0, 1, &cp, cpts, 4, &set), "generate_contacts");
     }
+    sdfccd_destroy_workspace(ws);
     free(vd);
     free(id);
     remove(path);

@@ -65,3 +65,64 @@ double test_box_distance(sdfccd_Vec3 p, double h)
     const double ox = fmax(q[0], 0.0), oy = fmax(q[1], 0.0), oz = fmax(q[2], 0.0);
     return sqrt(ox * ox + oy * oy + oz * oz) + fmin(fmax(q[0], fmax(q[1], q[2])), 0.0);
 }
+
+sdfccd_MeshId test_box_mesh(sdfccd_Vec3 half, int nx, int ny, int nz)
+{
+    const double h[3] = { half.x, half.y, half.z };
+    const int n[3] = { nx, ny, nz };
+    struct { double* v; uint32_t* f; uint32_t nv, nt; } b;
+    size_t maxv = 0, maxt = 0;
+    for (int k = 0; k < 3; ++k) {
+        int u = (k + 1) % 3, w = (k + 2) % 3;
+        maxv += 2 * (size_t)(n[u] + 1) * (n[w] + 1);
+        maxt += 4 * (size_t)n[u] * n[w];
+    }
+    b.v = malloc(3 * maxv * sizeof *b.v);
+    b.f = malloc(3 * maxt * sizeof *b.f);
+    b.nv = b.nt = 0;
+    for (int k = 0; k < 3; ++k)
+        for (int s = -1; s <= 1; s += 2) {
+            int u = (k + 1) % 3, w = (k + 2) % 3;
+            uint32_t base = b.nv;
+            for (int i = 0; i <= n[u]; ++i)
+                for (int j = 0; j <= n[w]; ++j) {
+                    double* p = b.v + 3 * b.nv++;
+                    p[k] = s * h[k];
+                    p[u] = -h[u] + 2.0 * h[u] * i / n[u];
+                    p[w] = -h[w] + 2.0 * h[w] * j / n[w];
+                }
+            for (int i = 0; i < n[u]; ++i)
+                for (int j = 0; j < n[w]; ++j) {
+                    uint32_t a = base + (uint32_t)(i * (n[w] + 1) + j), c = a + (uint32_t)(n[w] + 1);
+                    uint32_t q[4] = { a, c, c + 1, a + 1 };
+                    if (s < 0) { uint32_t t = q[1]; q[1] = q[3]; q[3] = t; } /* outward winding */
+                    uint32_t* f = b.f + 3 * b.nt;
+                    f[0] = q[0]; f[1] = q[1]; f[2] = q[2];
+                    f[3] = q[0]; f[4] = q[2]; f[5] = q[3];
+                    b.nt += 2;
+                }
+        }
+    sdfccd_MeshDef d = sdfccd_default_mesh_def();
+    d.vertices = b.v;
+    d.vertex_count = b.nv;
+    d.indices = b.f;
+    d.triangle_count = b.nt;
+    sdfccd_MeshId id;
+    ck_assert_msg(sdfccd_create_mesh(&d, &id) == SDFCCD_OK, "%s", sdfccd_last_error());
+    free(b.v);
+    free(b.f);
+    return id;
+}
+
+void* test_counting_alloc(size_t size, void* user)
+{
+    ++*(long*)user;
+    return malloc(size);
+}
+
+void test_counting_free(void* mem, size_t size, void* user)
+{
+    (void)size;
+    (void)user;
+    free(mem);
+}

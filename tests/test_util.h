@@ -28,6 +28,14 @@ sdfccd_MeshId test_load_mesh(const char* rel);
 /* Exact signed distance from p to the axis-aligned cube [-h, h]^3 (negative inside). */
 double test_box_distance(sdfccd_Vec3 p, double h);
 
+/* A closed box mesh [-half, half] whose faces are split into grids of nx, ny, nz cells along x, y, z
+ * (two triangles a cell, outward winding); fails the test when it cannot be created. */
+sdfccd_MeshId test_box_mesh(sdfccd_Vec3 half, int nx, int ny, int nz);
+
+/* An allocator for sdfccd_set_allocator that counts its allocations in the long `user` points to. */
+void* test_counting_alloc(size_t size, void* user);
+void test_counting_free(void* mem, size_t size, void* user);
+
 /* Runs a suite (CK_NORMAL output) and returns the process exit code. */
 int test_run_suite(Suite* s);
 

@@ -195,7 +195,7 @@ typedef struct sdfccd_QueryResult {
     double fraction;          /**< (toi - t0) / (t1 - t0). */
     double toi_lower;         /**< Lower end of the TOI bracket: CERTIFIED proves no contact before it;
                                    other methods report toi here. */
-    int32_t contact_count;    /**< Contacts written to the caller's array. */
+    int32_t contact_count;    /**< Contacts written to the caller's array (mesh queries: a reduction when more were found). */
     int32_t contacts_found;   /**< Contacts found (may exceed the array capacity). */
     int64_t iterations;       /**< Outer iterations (or regions for CERTIFIED), summed over triangles. */
     int64_t sdf_evaluations;  /**< SDF evaluations, summed over triangles. */
@@ -221,7 +221,11 @@ SDFCCD_API sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sd
 
 /** A rigid mesh against an SDF: the earliest TOI over all triangles and the contacts at it
  * (triangles whose TOI lies within params->toi_window of the earliest, plus subdivision
- * contacts). The search interval shrinks as earlier hits are found. */
+ * contacts). The search interval shrinks as earlier hits are found. Contacts are written earliest
+ * first; when more are found than `capacity`, the ones written are a reduction of the set, not its
+ * first ones: the deepest contact at the earliest time, then the points spreading most over the contact region
+ * (sdfccd_reduce_contacts() on their surface points, with distance_tolerance as the same-place
+ * distance), so `contact_count` may be below `capacity`. The linear and workspace variants do the same. */
 SDFCCD_API sdfccd_Status sdfccd_query_mesh(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
     sdfccd_MeshId mesh, const sdfccd_RigidMotion* motion, double t0, double t1,
     const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,

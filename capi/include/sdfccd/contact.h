@@ -1,0 +1,232 @@
+/* SPDX-License-Identifier: MIT */
+/** @file contact.h  What a physics engine needs from the CCD over one step: the contact set of a
+ * mesh against an SDF (generated, and reduced to the engine's manifold size), and the no-tunnelling
+ * guarantee (the executed motion checked for a time of impact, and the safe pose).
+ *
+ * The rule (Pelletier-Guenette et al., SCA 2025, Section 4): the simulation never advances past a
+ * time of impact. An engine integrates a step with whatever contacts it has; then, for every body
+ * that can reach an SDF, it hands the motion the body executed over the step to sdfccd_guard_rigid().
+ * When some point of the body went deeper than the tolerance before the end of the step, the guard
+ * returns the first such time and the pose there; the engine puts the body at that pose and removes
+ * its velocity into the surface along the returned normal. Whatever moved the body (a contact's
+ * impulse, a kick from another body, a joint), it does not pass through the surface.
+ *
+ * Time, frames and units as in ccd.h: seconds over [t0, t1], world frame, metres.
+ */
+#ifndef SDFCCD_CONTACT_H
+#define SDFCCD_CONTACT_H
+
+#include "ccd.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** The executed rigid motion from two poses (what the engine's solver produced over [t0, t1]): the
+ * centre (`local_center` in the body frame; for Bullet the centre of mass, i.e. the body origin,
+ * (0, 0, 0)) moves linearly from its start to its end position, and the body turns by the shortest
+ * arc from start to end orientation, q_end * conj(q_start) with the sign that gives an angle of at
+ * most pi, at constant world angular velocity about the centre (Eq. 14). The motion's pose at t1 is
+ * `end` up to rounding.
+ *
+ * Two poses cannot tell a turn of more than half a revolution from the shorter turn the other way:
+ * an engine that knows the angular velocity it integrated (Bullet: the body's angular velocity over
+ * the step) should fill ::sdfccd_RigidMotion itself with it; the CCD splits any rotation into
+ * segments of at most sdfccd_QueryParams::max_rotation_per_segment.
+ *
+ * Errors (::SDFCCD_INVALID_ARGUMENT): a NULL pointer, a non-finite value, an orientation whose norm
+ * differs from 1 by more than 1e-4 (within that it is normalised), t1 <= t0, a coordinate above
+ * SDFCCD_MAX_QUERY_MAGNITUDE. */
+SDFCCD_API sdfccd_Status sdfccd_rigid_motion_from_poses(const sdfccd_Pose* start, const sdfccd_Pose* end, sdfccd_Vec3 local_center,
+                                                        double t0, double t1, sdfccd_RigidMotion* out_motion);
+
+/** Settings of the guard. Must be initialised with sdfccd_default_guard_params(). */
+typedef struct sdfccd_GuardParams {
+    double tolerance;          /**< Depth (m, > 0) a point may reach below the surface before the guard acts, and the
+                                    accuracy of the returned safe pose: no point the CCD finds is deeper than this at
+                                    it. Default 5e-4. */
+    sdfccd_QueryParams query;  /**< CCD settings of the check (default: sdfccd_default_query_params()). Its `margin`
+                                    and `subdivision` are not used (the guard's level is -tolerance and it needs the
+                                    first point only); its time tolerance is tightened so that the TOI is late by at
+                                    most a tenth of the tolerance in depth. ::SDFCCD_METHOD_DCD is refused (it tests
+                                    the end pose only); ::SDFCCD_METHOD_CERTIFIED gives the guarantee with no false
+                                    negatives on exact SDFs, at a much higher cost. */
+    int32_t internal_value;    /**< Set by sdfccd_default_guard_params(); do not change. */
+} sdfccd_GuardParams;
+
+/** The default guard settings (see each field of ::sdfccd_GuardParams). */
+SDFCCD_API sdfccd_GuardParams sdfccd_default_guard_params(void);
+
+/** What the guard found. */
+typedef enum sdfccd_GuardState {
+    SDFCCD_GUARD_CLEAR = 0,          /**< No point of the body went deeper than the tolerance during the motion:
+                                          the body may take its end pose. */
+    SDFCCD_GUARD_ROLLED_BACK = 1,    /**< One did: `safe_pose` is the pose at `toi`, where no point the CCD found is
+                                          deeper than the tolerance. */
+    SDFCCD_GUARD_INSIDE_AT_START = 2 /**< Part of the body already started deeper than the tolerance, and the motion
+                                          took no point past its level (below): the body may take its end pose, and the
+                                          contacts are to push it out. */
+} sdfccd_GuardState;
+
+/** The outcome of sdfccd_guard_rigid().
+ *
+ * Bodies that start inside: a triangle whose deepest point at t0 is deeper than the tolerance
+ * (a resting body slightly inside, or one pushed in by a stack) is held to its own level, its
+ * start depth minus the tolerance: it may not sink further by more than the tolerance in the step,
+ * and every other triangle keeps the level -tolerance. So such a body is not frozen at t0 every
+ * step, and the rest of it stays guarded. Known limits: a triangle that starts deeper than half the
+ * thickness of a thin feature can cross it; the start depth comes from a local search (DCD), so a
+ * triangle whose check still reports contact at t0 has its level lowered to what the check saw, and
+ * after three such corrections it is left out of the check (as is every triangle still reporting
+ * contact at t0 when the guard has run 8 queries). */
+typedef struct sdfccd_GuardResult {
+    sdfccd_GuardState state;   /**< Clear, rolled back, or inside at the start. */
+    double toi;                /**< Seconds in [t0, t1]. ROLLED_BACK: the time of the safe pose, not after the first time
+                                    a point reached its level and before it by about the query's time tolerance
+                                    (tightened so that no point moves more than a tenth of the tolerance in it); t1
+                                    otherwise. */
+    double fraction;           /**< (toi - t0) / (t1 - t0) (0 when t1 == t0). */
+    sdfccd_Pose safe_pose;     /**< The mesh pose at `toi` along the executed motion (its end pose unless ROLLED_BACK). */
+    sdfccd_Vec3 point;         /**< ROLLED_BACK: the world point of the body that reached its level first, at `toi`
+                                    (else zero). */
+    sdfccd_Vec3 normal;        /**< ROLLED_BACK: the unit SDF normal there (grad phi, out of the SDF, world frame): the
+                                    engine removes the body's velocity into the surface along it (else zero). */
+    double min_gap_start;      /**< Smallest phi at t0 of the points the check saw (diagnostic; INFINITY when it saw
+                                    none within the tolerance of the surface). */
+    uint32_t triangle;         /**< ROLLED_BACK: the triangle of `point`. */
+    int32_t deep_triangles;    /**< Triangles that started deeper than the tolerance (held to their own level). */
+    sdfccd_ResultState query_state; /**< State of the CCD's last query. ::SDFCCD_STATE_NOT_CONVERGED: its evaluation
+                                    budget ran out, so CLEAR is not proven (ROLLED_BACK still is a real contact). */
+    int32_t queries;           /**< Mesh queries run: 1, more when part of the body started deep. */
+    int64_t sdf_evaluations;   /**< SDF evaluations, all queries. */
+} sdfccd_GuardResult;
+
+/** The guarantee: checks the executed motion of a rigid mesh against one SDF (itself possibly moving
+ * with `sdf_motion`, NULL = static at the world origin) with the CCD; if any point reached
+ * phi <= -tolerance before t1, the result says ::SDFCCD_GUARD_ROLLED_BACK with the earliest such
+ * time and the pose there. Never advances past a time of impact (up to the CCD's known misses,
+ * ccd.h). Bodies that start inside: see ::sdfccd_GuardResult. Uses the workspace (not NULL): no
+ * allocation after a first call of a given size. `executed` may rotate by any angle (the CCD
+ * splits it).
+ *
+ * Errors: NULL pointers, params not from sdfccd_default_guard_params(), tolerance not finite and
+ * > 0, the DCD method, and whatever sdfccd_query_mesh_ws() refuses (::SDFCCD_INVALID_ARGUMENT,
+ * ::SDFCCD_INVALID_HANDLE); ::SDFCCD_OUT_OF_MEMORY. On error `out` is not written. */
+SDFCCD_API sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                            sdfccd_MeshId mesh, const sdfccd_RigidMotion* executed, double t0, double t1,
+                                            const sdfccd_GuardParams* params, sdfccd_GuardResult* out);
+
+/** Which feature of the mesh a contact point lies on (from its barycentric weights, 1e-6). */
+typedef enum sdfccd_FeatureKind {
+    SDFCCD_FEATURE_VERTEX = 0, /**< A vertex of the mesh (`feature` is its index). */
+    SDFCCD_FEATURE_EDGE = 1,   /**< An edge of `triangle`: `feature` (0, 1, 2) is the corner it is opposite. */
+    SDFCCD_FEATURE_FACE = 2    /**< The inside of `triangle` (`feature` is 0). */
+} sdfccd_FeatureKind;
+
+/** One contact point of a mesh against an SDF over a step, as an engine's solver takes it: the
+ * material point of the mesh and the surface point and normal that hold it, all at the START of the
+ * step (t0), world frame. A speculative contact (gap > 0) lets the solver close at most the gap in
+ * the step; a negative gap is a penetration to push out. */
+typedef struct sdfccd_ContactPoint {
+    sdfccd_Vec3 point;          /**< The mesh's material point at t0 (world, m). */
+    sdfccd_Vec3 surface_point;  /**< The point of the SDF's surface that holds it, at t0: point - gap * normal (world, m). */
+    sdfccd_Vec3 normal;         /**< Unit normal out of the SDF (world), at t0. */
+    double gap;                 /**< Signed gap at t0 along the normal (m); negative: penetrating. */
+    double toi;                 /**< When the constraint was found: t0 for points of the start pose, the time of impact
+                                     for points from the CCD (s). */
+    double barycentric[3];      /**< Weights of the material point on its triangle's vertices 0, 1, 2. */
+    uint32_t triangle;          /**< Triangle index in the mesh. */
+    sdfccd_FeatureKind feature_kind; /**< Vertex, edge or face. */
+    uint32_t feature;           /**< Vertex index (VERTEX), corner opposite the edge (EDGE), 0 (FACE). */
+    uint64_t id;                /**< Feature id, the same from step to step for the same feature (warm starting): the
+                                     vertex index, (1 << 62) + 3 triangle + corner for an edge, (2 << 62) + triangle for
+                                     a face. */
+} sdfccd_ContactPoint;
+
+/** Reduces a contact set to at most `capacity` points (a pure function of its input: no handle, no
+ * allocation). Chosen, in order: the deepest point (smallest gap; among equally deep ones, within
+ * 1e-9 m, the one farthest from their centre, a corner of a face landing flat), the point farthest
+ * from it, then the points adding most area to the polygon of the chosen ones (collinear points:
+ * the ones extending the segment), and, once no point adds area, the points farthest from every
+ * chosen one. Distances and areas are between the `surface_point`s projected on the plane of the
+ * first point's normal. A point within `same_place_distance` (m, >= 0) of a chosen one is never
+ * chosen, and choosing stops when the best adds no more than that; so the count may be smaller than
+ * both `count` and `capacity`. Ties (within 1e-9 relative) go to the smaller gap, then the smaller
+ * `id`, then the lower index: with distinct ids the choice does not depend on the order of the
+ * input. Writes the chosen indices into `points` to out_indices[0 .. *out_count - 1] (in the order
+ * chosen). O(count x capacity^2) in the worst case.
+ * Errors (::SDFCCD_INVALID_ARGUMENT): NULL pointers (points may be NULL when count is 0), count or
+ * capacity < 0, same_place_distance not finite or < 0, a non-finite point, normal or gap. */
+SDFCCD_API sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
+                                                int32_t* out_indices, int32_t capacity, int32_t* out_count);
+
+/** Settings of contact generation. Must be initialised with sdfccd_default_contact_params(). */
+typedef struct sdfccd_ContactParams {
+    sdfccd_QueryParams query;    /**< The CCD of the step (method, caps); `query.margin` is the contact distance: a
+                                      point touches when phi <= margin (default 0). ::SDFCCD_METHOD_DCD gives the
+                                      start-pose points only. */
+    double vertex_distance;      /**< The vertices of a triangle the CCD finds in contact are points too when they are
+                                      within this of the margin at its time of impact (a face landing flat gives its
+                                      corners). m, >= 0. Default 1e-3. */
+    double same_place_distance;  /**< Points whose surface points are closer than this are one place: the reduction
+                                      keeps one (sdfccd_reduce_contacts()). m, >= 0. Default 1e-4. */
+    int32_t internal_value;      /**< Set by sdfccd_default_contact_params(); do not change. */
+} sdfccd_ContactParams;
+
+/** The default contact settings (see each field of ::sdfccd_ContactParams). */
+SDFCCD_API sdfccd_ContactParams sdfccd_default_contact_params(void);
+
+/** Summary of a contact set. */
+typedef struct sdfccd_ContactSet {
+    int32_t count;               /**< Points written: the reduction of the candidates to the caller's capacity. */
+    int32_t candidates;          /**< Candidates found before the reduction. */
+    int32_t started_in_contact;  /**< 1 when a point of the start pose was within the margin (the CCD is then not
+                                      run: it could only report contact at t0). */
+    int32_t ccd_ran;             /**< 1 when the CCD ran over the step. */
+    sdfccd_ResultState ccd_state; /**< Its state (::SDFCCD_STATE_NO_HIT when it did not run). */
+    double toi;                  /**< The CCD's first time of impact; t0 when started in contact; t1 when none. */
+    int64_t sdf_evaluations;     /**< SDF evaluations of the call. */
+} sdfccd_ContactSet;
+
+/** The contact set an engine needs for one mesh against one SDF over a step [t0, t1]: points with
+ * normal, signed gap at t0, time of impact, triangle and a feature id stable across steps (see
+ * ::sdfccd_ContactPoint). The candidates:
+ *  - the start pose within the step's reach: every triangle whose deepest point (DCD, with adaptive
+ *    subdivision when query.subdivision is on) at t0 lies within margin + the farthest any point can
+ *    travel in the step, and those triangles' vertices within that distance, each held by its own
+ *    closest surface point at t0;
+ *  - unless one of those already touches (gap <= margin), the CCD's contact set at the first time of
+ *    impact (sdfccd_query_mesh_ws()) and the vertices of its triangles within vertex_distance of the
+ *    margin then, each held by the surface point and normal it touches there, its gap measured at t0
+ *    along that normal (a speculative contact: the solver may close at most the gap in the step).
+ * When nothing lies within reach at t0, the step has no contact and the call costs one broad-phase
+ * pass. The candidates are reduced to `capacity` points by sdfccd_reduce_contacts() (deepest first,
+ * then area; never a prefix of the set). Uses the workspace: no allocation after a first call of a
+ * given size. Errors: as sdfccd_query_mesh_ws(), params not from sdfccd_default_contact_params(),
+ * vertex_distance or same_place_distance not finite and >= 0, out_points NULL with capacity > 0;
+ * on error nothing is written. */
+SDFCCD_API sdfccd_Status sdfccd_generate_contacts(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                                  sdfccd_MeshId mesh, const sdfccd_RigidMotion* motion, double t0, double t1,
+                                                  const sdfccd_ContactParams* params, sdfccd_ContactPoint* out_points,
+                                                  int32_t capacity, sdfccd_ContactSet* out_set);
+
+/** sdfccd_generate_contacts() for a deforming mesh (cloth, soft bodies): the mesh's topology with
+ * per-vertex world positions at t0 (`start`) and t1 (`end`), vertex_count each, moving linearly. */
+SDFCCD_API sdfccd_Status sdfccd_generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                                         sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end,
+                                                         double t0, double t1, const sdfccd_ContactParams* params,
+                                                         sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set);
+
+/** The guarantee for a deforming mesh: sdfccd_guard_rigid() with each vertex moving linearly from
+ * `start` (t0) to `end` (t1), world positions, vertex_count each. `out->safe_pose` is the identity
+ * (unused); the safe positions, the vertices at `out->toi`, go to `out_positions` (vertex_count
+ * entries; may be NULL), the end positions unless ROLLED_BACK. */
+SDFCCD_API sdfccd_Status sdfccd_guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                             sdfccd_MeshId mesh, const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0,
+                                             double t1, const sdfccd_GuardParams* params, sdfccd_GuardResult* out,
+                                             sdfccd_Vec3* out_positions);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,356 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd C ABI: contact.h. Validates the arguments, converts to the core's SDF-frame problem
+ * (core/guard.c) and maps the results back to the world. */
+#include "capi_internal.h"
+#include "../../core/ccd.h"
+#include "../../core/guard.h"
+#include "../../core/reduce.h"
+#include "../../core/contacts.h"
+
+#include <stdio.h>
+
+/* Finite pose with a unit orientation (within 1e-4, then normalised) and a bounded position. */
+static sdfccd_Status unit_pose(const sdfccd_Pose* pose, const char* what, scc_xform* out)
+{
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(pose, what)) || (st = sdfccd__check_pose(*pose, what, out))) return st;
+    sdfccd_Quat q = pose->orientation;
+    double n = sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+    if (!(fabs(n - 1.0) <= 1e-4))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: orientation is not a unit quaternion (norm %.17g)", what, n);
+    if (!(scc_maxc(scc_vabs(out->p)) <= SDFCCD_MAX_QUERY_MAGNITUDE))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: position has a coordinate above SDFCCD_MAX_QUERY_MAGNITUDE", what);
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_rigid_motion_from_poses(const sdfccd_Pose* start, const sdfccd_Pose* end, sdfccd_Vec3 local_center, double t0,
+                                             double t1, sdfccd_RigidMotion* out_motion)
+{
+    static const char fn[] = "sdfccd_rigid_motion_from_poses";
+    sdfccd_Status st;
+    scc_xform a, b;
+    if ((st = sdfccd__check_ptr(out_motion, "sdfccd_rigid_motion_from_poses: out_motion")) ||
+        (st = unit_pose(start, "sdfccd_rigid_motion_from_poses: start", &a)) ||
+        (st = unit_pose(end, "sdfccd_rigid_motion_from_poses: end", &b)) ||
+        (st = sdfccd__check_vec(local_center, "sdfccd_rigid_motion_from_poses: local_center")))
+        return st;
+    if (!(scc_maxc(scc_vabs(sdfccd__v(local_center))) <= SDFCCD_MAX_QUERY_MAGNITUDE))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: local_center has a coordinate above SDFCCD_MAX_QUERY_MAGNITUDE", fn);
+    if (!isfinite(t0) || !isfinite(t1) || !(t1 > t0) || !isfinite(t1 - t0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: t0 and t1 must be finite with t1 > t0 (got %g, %g)", fn, t0, t1);
+    const double dt = t1 - t0;
+    scc_vec3 c = sdfccd__v(local_center);
+    scc_vec3 v = scc_scale(scc_sub(scc_xform_apply(b, c), scc_xform_apply(a, c)), 1.0 / dt);
+    /* The rotation from start to end, on the hemisphere of the shorter arc (angle <= pi). */
+    scc_quat d = scc_quat_mul(b.q, scc_quat_conj(a.q));
+    if (d.w < 0.0) d = (scc_quat){ -d.w, -d.x, -d.y, -d.z };
+    scc_vec3 axis = scc_v3(d.x, d.y, d.z);
+    double s = scc_len(axis);
+    double angle = 2.0 * atan2(s, d.w);
+    scc_vec3 w = s > 1e-300 ? scc_scale(axis, angle / (s * dt)) : scc_v3(0, 0, 0);
+    if (!scc_vfinite(v) || !(scc_maxc(scc_vabs(v)) <= SDFCCD_MAX_QUERY_MAGNITUDE))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the velocity (displacement / (t1 - t0)) is not finite or above "
+                             "SDFCCD_MAX_QUERY_MAGNITUDE", fn);
+    if (!scc_vfinite(w))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the angular velocity (angle / (t1 - t0)) is not finite", fn);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position = sdfccd__pv(a.p);
+    m.pose.orientation = (sdfccd_Quat){ a.q.w, a.q.x, a.q.y, a.q.z };
+    m.local_center = local_center;
+    m.linear_velocity = sdfccd__pv(v);
+    m.angular_velocity = sdfccd__pv(w);
+    *out_motion = m;
+    return SDFCCD_OK;
+}
+
+/* Guard params (checked) as the core's query params and tolerance. */
+static sdfccd_Status convert_guard_params(const sdfccd_GuardParams* in, const char* fn, scc_params* out, double* out_tol)
+{
+    sdfccd_Status st;
+    if (!in) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
+    if ((st = sdfccd__check_def(in->internal_value, fn, "params were", "sdfccd_default_guard_params"))) return st;
+    if (!isfinite(in->tolerance) || !(in->tolerance > 0.0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->tolerance must be finite and > 0 (got %g)", fn, in->tolerance);
+    if ((st = sdfccd__convert_params(&in->query, fn, out))) return st;
+    if (out->method == SCC_METHOD_DCD)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the DCD method tests the end pose only and cannot guard a motion", fn);
+    *out_tol = in->tolerance;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Pose public_pose(scc_quat q, scc_vec3 p)
+{
+    sdfccd_Pose r;
+    r.position = sdfccd__pv(p);
+    r.orientation = (sdfccd_Quat){ q.w, q.x, q.y, q.z };
+    return r;
+}
+
+/* What every step call shares: the workspace, the interval, the SDF (and its motion) and the mesh. */
+typedef struct step_setup {
+    scc_rigid sm;
+    const scc_rigid* smp;
+    sdfccd__sdf* sdf;
+    sdfccd__mesh* mesh;
+} step_setup;
+
+static sdfccd_Status setup_step(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh, double t0,
+                                double t1, const char* fn, step_setup* q)
+{
+    sdfccd_Status st;
+    char what[96];
+    snprintf(what, sizeof what, "%s: ws", fn);
+    if ((st = sdfccd__check_ptr(ws, what)) || (st = sdfccd__check_interval(t0, t1, fn))) return st;
+    q->smp = NULL;
+    if (sdf_motion) {
+        snprintf(what, sizeof what, "%s: sdf_motion", fn);
+        if ((st = sdfccd__convert_motion(sdf_motion, t0, t1, what, &q->sm))) return st;
+        q->smp = &q->sm;
+    }
+    if (!(q->sdf = sdfccd__sdf_acquire(sdf)) || !(q->mesh = sdfccd__mesh_acquire(mesh))) return SDFCCD_INVALID_HANDLE;
+    return sdfccd__check_mesh_bounds(q->mesh, fn);
+}
+
+/* The rigid motion of a step call, checked with the SDF's. */
+static sdfccd_Status setup_rigid(const sdfccd_RigidMotion* motion, double t0, double t1, const step_setup* q, const char* fn, scc_rigid* out)
+{
+    sdfccd_Status st;
+    char what[96];
+    snprintf(what, sizeof what, "%s: motion", fn);
+    if ((st = sdfccd__check_ptr(motion, what)) || (st = sdfccd__convert_motion(motion, t0, t1, what, out))) return st;
+    return sdfccd__check_total_rotation(out, q->smp, t1 - t0, fn);
+}
+
+/* The per-vertex linear motion of a step call, copied into the workspace. */
+static sdfccd_Status setup_linear(const sdfccd_Vec3* start, const sdfccd_Vec3* end, sdfccd_Workspace* ws, const step_setup* q, const char* fn,
+                                  scc_vec3** out)
+{
+    sdfccd_Status st;
+    char what[96];
+    snprintf(what, sizeof what, "%s: start", fn);
+    if ((st = sdfccd__check_ptr(start, what))) return st;
+    snprintf(what, sizeof what, "%s: end", fn);
+    if ((st = sdfccd__check_ptr(end, what))) return st;
+    return sdfccd__linear_vertices(q->mesh, start, end, &ws->ws, fn, out);
+}
+
+static sdfccd_Status run_guard(sdfccd_Workspace* ws, const step_setup* q, const scc_mesh_motion* mm, const sdfccd_GuardParams* params,
+                               sdfccd_GuardResult* out, const char* fn)
+{
+    scc_params p;
+    double tol = 0.0;
+    sdfccd_Status st;
+    if ((st = convert_guard_params(params, fn, &p, &tol))) return st;
+    scc_guard_out g;
+    if (!scc_guard(q->sdf->sdf, mm, &p, tol, &ws->ws, &g)) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    const double t0 = mm->t0, t1 = mm->t1;
+    sdfccd_GuardResult r;
+    memset(&r, 0, sizeof r);
+    r.state = g.state == SCC_GUARD_ROLLED_BACK ? SDFCCD_GUARD_ROLLED_BACK
+            : g.state == SCC_GUARD_INSIDE_AT_START ? SDFCCD_GUARD_INSIDE_AT_START : SDFCCD_GUARD_CLEAR;
+    r.toi = g.toi;
+    r.fraction = t1 > t0 ? (g.toi - t0) / (t1 - t0) : 0.0;
+    r.safe_pose = sdfccd_pose_identity();
+    if (mm->body) {
+        scc_quat qq;
+        scc_vec3 pos;
+        scc_rigid_pose_at(mm->body, g.toi, &qq, &pos);
+        r.safe_pose = public_pose(qq, pos);
+    }
+    if (g.state == SCC_GUARD_ROLLED_BACK) {
+        r.point = sdfccd__pv(scc_world_point(q->smp, g.toi, g.point));
+        r.normal = sdfccd__pv(scc_normalize_or(scc_world_vector(q->smp, g.toi, g.normal), scc_v3(0, 0, 1)));
+        r.triangle = g.triangle;
+    }
+    r.min_gap_start = g.min_gap_start;
+    r.deep_triangles = (int32_t)g.deep_triangles;
+    r.query_state = sdfccd__public_state(g.query_state);
+    r.queries = g.queries;
+    r.sdf_evaluations = g.evals;
+    *out = r;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                 const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
+                                 sdfccd_GuardResult* out)
+{
+    static const char fn[] = "sdfccd_guard_rigid";
+    sdfccd_Status st;
+    step_setup q;
+    scc_rigid body;
+    if ((st = sdfccd__check_ptr(out, "sdfccd_guard_rigid: out")) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
+        (st = setup_rigid(executed, t0, t1, &q, fn, &body)))
+        return st;
+    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, t0, t1, NULL };
+    return run_guard(ws, &q, &mm, params, out, fn);
+}
+
+static sdfccd_Status guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                  const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1, const sdfccd_GuardParams* params,
+                                  sdfccd_GuardResult* out, sdfccd_Vec3* out_positions)
+{
+    static const char fn[] = "sdfccd_guard_linear";
+    sdfccd_Status st;
+    step_setup q;
+    scc_vec3* v;
+    if ((st = sdfccd__check_ptr(out, "sdfccd_guard_linear: out")) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
+        (st = setup_linear(start, end, ws, &q, fn, &v)))
+        return st;
+    const uint32_t nv = q.mesh->mesh.vertex_count;
+    scc_mesh_motion mm = { &q.mesh->mesh, NULL, v, v + nv, q.smp, t0, t1, NULL };
+    if ((st = run_guard(ws, &q, &mm, params, out, fn))) return st;
+    if (out_positions) {
+        const double s = out->fraction;
+        for (uint32_t i = 0; i < nv; ++i) out_positions[i] = sdfccd__pv(scc_lerp(v[i], v[nv + i], s));
+    }
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                 const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
+                                 sdfccd_GuardResult* out)
+{
+    SDFCCD__HELD_CALL(guard_rigid(ws, sdf, sdf_motion, mesh, executed, t0, t1, params, out));
+}
+
+sdfccd_Status sdfccd_guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                  const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1, const sdfccd_GuardParams* params,
+                                  sdfccd_GuardResult* out, sdfccd_Vec3* out_positions)
+{
+    SDFCCD__HELD_CALL(guard_linear(ws, sdf, sdf_motion, mesh, start, end, t0, t1, params, out, out_positions));
+}
+
+/* ---- contact generation ---- */
+
+static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, const char* fn, scc_contact_params* out)
+{
+    sdfccd_Status st;
+    if (!in) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
+    if ((st = sdfccd__check_def(in->internal_value, fn, "params were", "sdfccd_default_contact_params"))) return st;
+    if (!isfinite(in->vertex_distance) || in->vertex_distance < 0.0 || !isfinite(in->same_place_distance) || in->same_place_distance < 0.0)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->vertex_distance and same_place_distance must be finite and >= 0 (got %g, %g)",
+                             fn, in->vertex_distance, in->same_place_distance);
+    if ((st = sdfccd__convert_params(&in->query, fn, &out->query))) return st;
+    out->vertex_distance = in->vertex_distance;
+    out->same_place = in->same_place_distance;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status run_contacts(sdfccd_Workspace* ws, const step_setup* q, const scc_mesh_motion* mm, const sdfccd_ContactParams* params,
+                                  sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set, const char* fn)
+{
+    sdfccd_Status st;
+    scc_contact_params cp;
+    if ((st = convert_contact_params(params, fn, &cp))) return st;
+    if (capacity < 0 || (capacity > 0 && !out_points))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_points is NULL or capacity (%d) < 0", fn, capacity);
+    scc_contact_point* c = NULL;
+    if (capacity > 0 && !(c = scc_ws_get(&ws->ws, SCC_WS_STAGING, (size_t)capacity * sizeof *c)))
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    scc_contact_set s;
+    if (!scc_generate_contacts(q->sdf->sdf, mm, &cp, &ws->ws, c, capacity, &s)) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    const double t0 = mm->t0;
+    for (size_t i = 0; i < s.written; ++i) {
+        sdfccd_ContactPoint* o = &out_points[i];
+        o->point = sdfccd__pv(scc_world_point(q->smp, t0, c[i].point));
+        o->surface_point = sdfccd__pv(scc_world_point(q->smp, t0, c[i].surface));
+        o->normal = sdfccd__pv(scc_normalize_or(scc_world_vector(q->smp, t0, c[i].normal), scc_v3(0, 0, 1)));
+        o->gap = c[i].gap;
+        o->toi = c[i].toi;
+        for (int k = 0; k < 3; ++k) o->barycentric[k] = c[i].bary[k];
+        o->triangle = c[i].triangle;
+        o->feature_kind = c[i].kind == SCC_FEATURE_VERTEX ? SDFCCD_FEATURE_VERTEX : c[i].kind == SCC_FEATURE_EDGE ? SDFCCD_FEATURE_EDGE
+                                                                                                              : SDFCCD_FEATURE_FACE;
+        o->feature = c[i].feature;
+        o->id = c[i].id;
+    }
+    sdfccd_ContactSet r;
+    memset(&r, 0, sizeof r);
+    r.count = (int32_t)s.written;
+    r.candidates = s.candidates > INT32_MAX ? INT32_MAX : (int32_t)s.candidates;
+    r.started_in_contact = s.started_in_contact;
+    r.ccd_ran = s.ccd_ran;
+    r.ccd_state = sdfccd__public_state(s.ccd_state);
+    r.toi = s.toi;
+    r.sdf_evaluations = s.evals;
+    *out_set = r;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status generate_contacts(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                       const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_ContactParams* params,
+                                       sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set)
+{
+    static const char fn[] = "sdfccd_generate_contacts";
+    sdfccd_Status st;
+    step_setup q;
+    scc_rigid body;
+    if ((st = sdfccd__check_ptr(out_set, "sdfccd_generate_contacts: out_set")) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
+        (st = setup_rigid(motion, t0, t1, &q, fn, &body)))
+        return st;
+    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, t0, t1, NULL };
+    return run_contacts(ws, &q, &mm, params, out_points, capacity, out_set, fn);
+}
+
+static sdfccd_Status generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                              const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
+                                              const sdfccd_ContactParams* params, sdfccd_ContactPoint* out_points, int32_t capacity,
+                                              sdfccd_ContactSet* out_set)
+{
+    static const char fn[] = "sdfccd_generate_contacts_linear";
+    sdfccd_Status st;
+    step_setup q;
+    scc_vec3* v;
+    if ((st = sdfccd__check_ptr(out_set, "sdfccd_generate_contacts_linear: out_set")) ||
+        (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) || (st = setup_linear(start, end, ws, &q, fn, &v)))
+        return st;
+    const uint32_t nv = q.mesh->mesh.vertex_count;
+    scc_mesh_motion mm = { &q.mesh->mesh, NULL, v, v + nv, q.smp, t0, t1, NULL };
+    return run_contacts(ws, &q, &mm, params, out_points, capacity, out_set, fn);
+}
+
+sdfccd_Status sdfccd_generate_contacts(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                       const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_ContactParams* params,
+                                       sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set)
+{
+    SDFCCD__HELD_CALL(generate_contacts(ws, sdf, sdf_motion, mesh, motion, t0, t1, params, out_points, capacity, out_set));
+}
+
+sdfccd_Status sdfccd_generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                              const sdfccd_Vec3* start, const sdfccd_Vec3* end, double t0, double t1,
+                                              const sdfccd_ContactParams* params, sdfccd_ContactPoint* out_points, int32_t capacity,
+                                              sdfccd_ContactSet* out_set)
+{
+    SDFCCD__HELD_CALL(generate_contacts_linear(ws, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_points, capacity, out_set));
+}
+
+/* ---- contact points: reduction ---- */
+
+static void public_item(const void* set, size_t i, scc_reduce_item* out)
+{
+    const sdfccd_ContactPoint* c = (const sdfccd_ContactPoint*)set + i;
+    out->p = sdfccd__v(c->surface_point);
+    out->n = sdfccd__v(c->normal);
+    out->gap = c->gap;
+    out->id = c->id;
+}
+
+sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance, int32_t* out_indices,
+                                     int32_t capacity, int32_t* out_count)
+{
+    static const char fn[] = "sdfccd_reduce_contacts";
+    if (!out_count) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_count is NULL", fn);
+    if (count < 0 || capacity < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: count (%d) and capacity (%d) must be >= 0", fn, count, capacity);
+    if ((count > 0 && !points) || (capacity > 0 && !out_indices))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: points or out_indices is NULL", fn);
+    if (!isfinite(same_place_distance) || same_place_distance < 0.0)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: same_place_distance must be finite and >= 0 (got %g)", fn, same_place_distance);
+    for (int32_t i = 0; i < count; ++i) {
+        const sdfccd_ContactPoint* c = &points[i];
+        if (!scc_vfinite(sdfccd__v(c->surface_point)) || !scc_vfinite(sdfccd__v(c->normal)) || !isfinite(c->gap))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: point %d has a non-finite surface point, normal or gap", fn, i);
+    }
+    *out_count = (int32_t)scc_reduce(points, (size_t)count, public_item, same_place_distance, -1, (size_t)capacity, out_indices, NULL);
+    return SDFCCD_OK;
+}

@@ -1,0 +1,35 @@
+/* SPDX-License-Identifier: MIT
+ * sdfccd core: reduction of a contact set to a few points (reduce.c). Stateless; the set is read
+ * through an accessor, so the mesh query's contacts and the ABI's contact points share one routine
+ * and nothing is copied or allocated. */
+#ifndef SCC_REDUCE_H
+#define SCC_REDUCE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "scc_math.h"
+
+/* What the reduction reads of one contact: its place (a point on the SDF's surface), the normal
+ * there, its gap (smaller: deeper) and an id that breaks ties independently of the set's order. */
+typedef struct scc_reduce_item {
+    scc_vec3 p, n;
+    double gap;
+    uint64_t id;
+} scc_reduce_item;
+
+typedef void scc_reduce_get_fn(const void* set, size_t i, scc_reduce_item* out);
+
+/* Most hull vertices the area phase keeps; points beyond it are chosen by spread alone. */
+#define SCC_REDUCE_HULL_MAX 32
+
+/* Chooses at most k of the n contacts of `set` and writes their indices to out[0..k-1], in the order
+ * chosen; returns the count. The first is `first` when >= 0, else the deepest (among equally deep
+ * ones the farthest from their centre); then the point farthest from it, then the points adding most
+ * area to the polygon of the chosen ones (projected on the plane of the first one's normal), then,
+ * once none adds area, the points farthest from every chosen one. A point within `tol` (>= 0) of a
+ * chosen one is never chosen; choices stop when the best adds no more than `tol` of spread. Ties (scores
+ * within 1e-9 relative) go to the smaller gap, then the smaller id, then the lower index. `scratch`
+ * (n doubles, or NULL) makes it O(n) per choice instead of O(n k); the result is the same. */
+size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out, double* scratch);
+
+#endif

@@ -1,0 +1,638 @@
+/* SPDX-License-Identifier: MIT
+ * Contact sets (contact.h, issue 19 item 1): sdfccd_reduce_contacts on known candidate sets, the way
+ * Box2D tests its manifold functions (single, coincident, collinear, a face, a thousand points,
+ * ids that persist, order that does not matter, a buffer smaller than the set), the mesh query's
+ * contacts reduced instead of truncated, and contact generation for a step. Public ABI only. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "test_util.h"
+
+#define REPORT(...) do { if (getenv("CONTACTS_VERBOSE")) { printf(__VA_ARGS__); fflush(stdout); } } while (0)
+
+static const double SAME = 1e-4; /* same_place_distance of the reductions below */
+
+static sdfccd_ContactPoint cp(double x, double y, double z, double gap, uint64_t id)
+{
+    sdfccd_ContactPoint c;
+    memset(&c, 0, sizeof c);
+    c.surface_point = (sdfccd_Vec3){ x, y, z };
+    c.point = (sdfccd_Vec3){ x, y, z + gap };
+    c.normal = (sdfccd_Vec3){ 0, 0, 1 };
+    c.gap = gap;
+    c.id = id;
+    c.feature_kind = SDFCCD_FEATURE_VERTEX;
+    c.feature = (uint32_t)id;
+    return c;
+}
+
+static int32_t reduce(const sdfccd_ContactPoint* c, int32_t n, int32_t cap, int32_t* idx)
+{
+    int32_t count = -1;
+    ck_assert_msg(sdfccd_reduce_contacts(c, n, SAME, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert(count >= 0 && count <= cap && count <= n);
+    /* never two at one place, never one twice */
+    for (int32_t i = 0; i < count; ++i) {
+        ck_assert(idx[i] >= 0 && idx[i] < n);
+        for (int32_t j = 0; j < i; ++j) {
+            sdfccd_Vec3 a = c[idx[i]].surface_point, b = c[idx[j]].surface_point;
+            ck_assert(hypot(hypot(a.x - b.x, a.y - b.y), a.z - b.z) > SAME);
+        }
+    }
+    return count;
+}
+
+static int contains(const int32_t* idx, int32_t count, int32_t want)
+{
+    for (int32_t i = 0; i < count; ++i)
+        if (idx[i] == want) return 1;
+    return 0;
+}
+
+/* Area of the convex hull of the chosen points (xy plane), by gift wrapping: the reference. */
+static double hull_area(const sdfccd_ContactPoint* c, const int32_t* idx, int32_t count)
+{
+    if (count < 3) return 0.0;
+    int32_t start = 0;
+    for (int32_t i = 1; i < count; ++i) {
+        sdfccd_Vec3 p = c[idx[i]].surface_point, s = c[idx[start]].surface_point;
+        if (p.x < s.x || (p.x == s.x && p.y < s.y)) start = i;
+    }
+    double area = 0.0;
+    int32_t cur = start;
+    for (int guard = 0; guard <= count; ++guard) {
+        int32_t nxt = (cur + 1) % count;
+        for (int32_t i = 0; i < count; ++i) {
+            sdfccd_Vec3 a = c[idx[cur]].surface_point, b = c[idx[nxt]].surface_point, q = c[idx[i]].surface_point;
+            double cr = (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x);
+            if (cr < 0) nxt = i;
+        }
+        sdfccd_Vec3 a = c[idx[cur]].surface_point, b = c[idx[nxt]].surface_point;
+        area += 0.5 * (a.x * b.y - b.x * a.y);
+        cur = nxt;
+        if (cur == start) break;
+    }
+    return fabs(area);
+}
+
+START_TEST(test_reduce_single_point)
+{
+    sdfccd_ContactPoint c = cp(0.1, 0.2, 0.0, -0.001, 7);
+    int32_t idx[4];
+    ck_assert_int_eq(reduce(&c, 1, 4, idx), 1);
+    ck_assert_int_eq(idx[0], 0);
+    ck_assert_int_eq(reduce(&c, 1, 0, idx), 0);
+    ck_assert_int_eq(reduce(NULL, 0, 4, idx), 0);
+}
+END_TEST
+
+START_TEST(test_reduce_coincident)
+{
+    /* ten contacts at one place (a vertex shared by ten triangles): one point, the deepest */
+    sdfccd_ContactPoint c[10];
+    for (int i = 0; i < 10; ++i) c[i] = cp(0.3, -0.2, 0.0, -0.001 * ((i * 7) % 10), (uint64_t)i);
+    int32_t idx[4];
+    ck_assert_int_eq(reduce(c, 10, 4, idx), 1);
+    ck_assert_int_eq(idx[0], 7); /* (7 * 7) % 10 = 9: the deepest */
+}
+END_TEST
+
+START_TEST(test_reduce_collinear)
+{
+    /* a cylinder lying on a floor: eleven points on a line, the middle one deepest */
+    sdfccd_ContactPoint c[11];
+    for (int i = 0; i < 11; ++i) c[i] = cp(0.1 * i, 0.05 * i, 0.0, i == 5 ? -0.002 : 0.0, (uint64_t)(100 + i));
+    int32_t idx[4];
+    int32_t n = reduce(c, 11, 3, idx);
+    ck_assert_int_eq(n, 3);
+    ck_assert_int_eq(idx[0], 5);                        /* deepest first */
+    ck_assert(contains(idx, n, 0) && contains(idx, n, 10)); /* then both ends */
+    n = reduce(c, 11, 4, idx);
+    ck_assert_int_eq(n, 4);
+    ck_assert(idx[0] == 5 && contains(idx, n, 0) && contains(idx, n, 10));
+}
+END_TEST
+
+START_TEST(test_reduce_face_corners)
+{
+    /* a face landing flat: a 5 x 5 grid at one gap, the corners last in the array; four points are
+     * the corners (the reduction, not the first four) */
+    sdfccd_ContactPoint c[25];
+    int k = 0, corners[4], nc = 0;
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j)
+            if ((i == 0 || i == 4) && (j == 0 || j == 4)) continue;
+            else c[k] = cp(0.01 * i, 0.01 * j, 0.0, 0.0005, (uint64_t)k), ++k;
+    for (int i = 0; i <= 4; i += 4)
+        for (int j = 0; j <= 4; j += 4) corners[nc++] = k, c[k] = cp(0.01 * i, 0.01 * j, 0.0, 0.0005, (uint64_t)k), ++k;
+    int32_t idx[8];
+    int32_t n = reduce(c, 25, 4, idx);
+    ck_assert_int_eq(n, 4);
+    for (int i = 0; i < 4; ++i) ck_assert(contains(idx, n, corners[i]));
+    ck_assert_double_near(hull_area(c, idx, n), 0.04 * 0.04, 1e-15);
+    /* with room for more, the corners and then points spread inside */
+    n = reduce(c, 25, 8, idx);
+    ck_assert_int_eq(n, 8);
+    for (int i = 0; i < 4; ++i) ck_assert(contains(idx, n, corners[i]));
+    ck_assert(contains(idx, n, 10)); /* the centre (2, 2) is the point farthest from the corners */
+}
+END_TEST
+
+/* n points in the unit square, gaps in [-1e-3, 1e-3], ids 1000 + i */
+static void random_set(test_rng* r, sdfccd_ContactPoint* c, int n)
+{
+    for (int i = 0; i < n; ++i)
+        c[i] = cp(test_rng_uniform(r, 0, 1), test_rng_uniform(r, 0, 1), 0.0, test_rng_uniform(r, -1e-3, 1e-3), (uint64_t)(1000 + i));
+}
+
+START_TEST(test_reduce_thousand_points)
+{
+    enum { N = 1000 };
+    static sdfccd_ContactPoint c[N], shuffled[N], moved[N];
+    test_rng rng = { 42 };
+    random_set(&rng, c, N);
+    int deepest = 0;
+    for (int i = 1; i < N; ++i)
+        if (c[i].gap < c[deepest].gap) deepest = i;
+    int32_t idx[16], idx2[16];
+    const int caps[3] = { 4, 8, 16 };
+    for (int t = 0; t < 3; ++t) {
+        int32_t n = reduce(c, N, caps[t], idx);
+        ck_assert_int_eq(n, caps[t]);
+        ck_assert_int_eq(idx[0], deepest);
+        double area = hull_area(c, idx, n);
+        REPORT("thousand points, %d kept: hull area %.4f of the unit square\n", caps[t], area);
+        /* the deepest point may lie anywhere, the rest go to the corners: at least half the square
+         * with 4 points, nearly all of it with 8 and 16 */
+        ck_assert(area >= (caps[t] == 4 ? 0.5 : 0.9));
+        /* the input's order does not matter (distinct ids) */
+        for (int i = 0; i < N; ++i) shuffled[i] = c[(i * 617 + 13) % N];
+        int32_t n2 = reduce(shuffled, N, caps[t], idx2);
+        ck_assert_int_eq(n2, n);
+        for (int i = 0; i < n; ++i) ck_assert(shuffled[idx2[i]].id == c[idx[i]].id);
+        /* ids persist: the same set a step later, every point moved by less than 1e-7 m */
+        for (int i = 0; i < N; ++i) {
+            moved[i] = c[i];
+            moved[i].surface_point.x += test_rng_uniform(&rng, -1e-8, 1e-8);
+            moved[i].surface_point.y += test_rng_uniform(&rng, -1e-8, 1e-8);
+            moved[i].gap += test_rng_uniform(&rng, -1e-12, 1e-12);
+        }
+        n2 = reduce(moved, N, caps[t], idx2);
+        ck_assert_int_eq(n2, n);
+        for (int i = 0; i < n; ++i) ck_assert(moved[idx2[i]].id == c[idx[i]].id);
+    }
+}
+END_TEST
+
+START_TEST(test_reduce_same_place)
+{
+    /* pairs of points closer than same_place_distance (one above the other): never both */
+    sdfccd_ContactPoint c[8];
+    for (int i = 0; i < 4; ++i) {
+        c[2 * i] = cp((i & 1) * 0.1, (i >> 1) * 0.1, 0.0, -0.001, (uint64_t)(2 * i));
+        c[2 * i + 1] = cp((i & 1) * 0.1, (i >> 1) * 0.1, 0.5 * SAME, -0.002, (uint64_t)(2 * i + 1));
+    }
+    int32_t idx[8];
+    int32_t n = reduce(c, 8, 8, idx);
+    ck_assert_int_eq(n, 4);
+    /* the deeper of each pair: the same spread, and ties go to the smaller gap */
+    for (int i = 0; i < n; ++i) ck_assert_int_eq(idx[i] % 2, 1);
+}
+END_TEST
+
+START_TEST(test_reduce_bad_input)
+{
+    sdfccd_ContactPoint c[2] = { cp(0, 0, 0, 0, 1), cp(1, 0, 0, 0, 2) };
+    int32_t idx[2], count = -7;
+    ck_assert_int_eq(sdfccd_reduce_contacts(c, 2, SAME, idx, 2, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts(NULL, 2, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts(c, 2, SAME, NULL, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts(c, -1, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts(c, 2, SAME, idx, -1, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts(c, 2, -1.0, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts(c, 2, NAN, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    c[1].gap = NAN;
+    ck_assert_int_eq(sdfccd_reduce_contacts(c, 2, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(strlen(sdfccd_last_error()) > 0);
+    ck_assert_int_eq(count, -7); /* not written on error */
+}
+END_TEST
+
+/* A torus mesh (ring in the xy-plane, major R, minor r, nu x nv quads); a vertex ring at the bottom. */
+static sdfccd_MeshId torus_mesh(double R, double r, int nu, int nv)
+{
+    double* v = malloc(3 * (size_t)nu * nv * sizeof *v);
+    uint32_t* f = malloc(6 * (size_t)nu * nv * sizeof *f);
+    for (int i = 0; i < nu; ++i)
+        for (int j = 0; j < nv; ++j) {
+            double u = 2 * M_PI * i / nu, w = 2 * M_PI * j / nv;
+            double* p = v + 3 * (i * nv + j);
+            p[0] = (R + r * cos(w)) * cos(u);
+            p[1] = (R + r * cos(w)) * sin(u);
+            p[2] = r * sin(w);
+            uint32_t a = (uint32_t)(i * nv + j), b = (uint32_t)(((i + 1) % nu) * nv + j), c = (uint32_t)(i * nv + (j + 1) % nv),
+                     d = (uint32_t)(((i + 1) % nu) * nv + (j + 1) % nv);
+            uint32_t* t = f + 6 * (i * nv + j);
+            t[0] = a; t[1] = b; t[2] = d;
+            t[3] = a; t[4] = d; t[5] = c;
+        }
+    sdfccd_MeshDef d = sdfccd_default_mesh_def();
+    d.vertices = v;
+    d.vertex_count = (uint32_t)(nu * nv);
+    d.indices = f;
+    d.triangle_count = (uint32_t)(2 * nu * nv);
+    sdfccd_MeshId id;
+    ck_assert_msg(sdfccd_create_mesh(&d, &id) == SDFCCD_OK, "%s", sdfccd_last_error());
+    free(v);
+    free(f);
+    return id;
+}
+
+/* Area of the convex hull (xy) of the query's contact points (world). */
+static double contacts_hull_area(const sdfccd_Contact* k, int32_t n)
+{
+    sdfccd_ContactPoint* c = malloc((size_t)(n > 0 ? n : 1) * sizeof *c);
+    int32_t* idx = malloc((size_t)(n > 0 ? n : 1) * sizeof *idx);
+    for (int32_t i = 0; i < n; ++i) {
+        c[i] = cp(k[i].point.x, k[i].point.y, 0.0, 0.0, (uint64_t)i);
+        idx[i] = i;
+    }
+    double a = hull_area(c, idx, n);
+    free(c);
+    free(idx);
+    return a;
+}
+
+static int cmp_double(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The widest angle (degrees, about the z axis) between neighbouring contact points. */
+static double widest_gap_deg(const sdfccd_Contact* k, int32_t n)
+{
+    double a[64];
+    for (int32_t i = 0; i < n && i < 64; ++i) a[i] = atan2(k[i].point.y, k[i].point.x) * 180.0 / M_PI;
+    qsort(a, (size_t)n, sizeof a[0], cmp_double);
+    double widest = a[0] + 360.0 - a[n - 1];
+    for (int32_t i = 1; i < n; ++i) widest = fmax(widest, a[i] - a[i - 1]);
+    return widest;
+}
+
+/* A torus landing flat on a floor: far more contacts at the TOI than the caller's room. The
+ * contacts written are the reduction (the earliest first, spread over the ring), not the first ones
+ * found (which lay on one side of the ring); hit, TOI and the count found do not change. */
+START_TEST(test_mesh_query_reduces_contacts)
+{
+    sdfccd_MeshId torus = torus_mesh(0.1, 0.03, 48, 16);
+    sdfccd_SdfId floor;
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, 0.0, &floor), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.z = 0.03 + 0.01;
+    m.linear_velocity.z = -1.0;
+    sdfccd_QueryParams p = sdfccd_default_query_params();
+    enum { ALL = 2048 };
+    sdfccd_Contact* all = malloc(ALL * sizeof *all);
+    sdfccd_Contact few[16];
+    sdfccd_QueryResult ra, rf;
+    ck_assert_int_eq(sdfccd_query_mesh(floor, NULL, torus, &m, 0.0, 1.0 / 60.0, &p, all, ALL, &ra), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_query_mesh(floor, NULL, torus, &m, 0.0, 1.0 / 60.0, &p, few, 16, &rf), SDFCCD_OK);
+    ck_assert_int_eq(ra.state, SDFCCD_STATE_HIT);
+    ck_assert_int_lt(ra.contacts_found, ALL);
+    ck_assert_int_eq(ra.contact_count, ra.contacts_found);
+    ck_assert_int_gt(ra.contacts_found, 64); /* the case this tests */
+    ck_assert(rf.toi == ra.toi && rf.hit == ra.hit && rf.contacts_found == ra.contacts_found);
+    ck_assert_int_eq(rf.contact_count, 16);
+    /* first the deepest contact at the earliest time */
+    int deepest = 0;
+    for (int i = 1; i < ra.contact_count && all[i].toi == all[0].toi; ++i)
+        if (all[i].distance < all[deepest].distance) deepest = i;
+    ck_assert(memcmp(&few[0], &all[deepest], sizeof few[0]) == 0);
+    for (int i = 1; i < 16; ++i) ck_assert(few[i].toi >= few[i - 1].toi);
+    double full = contacts_hull_area(all, ra.contact_count), kept = contacts_hull_area(few, 16),
+           prefix = contacts_hull_area(all, 16);
+    REPORT("torus on a floor: %d contacts found; hull area of 16 kept %.5f, of all %.5f, of the first 16 %.5f; widest angle "
+           "between kept points %.1f deg, between the first 16 %.1f deg\n",
+           ra.contacts_found, kept, full, prefix, widest_gap_deg(few, 16), widest_gap_deg(all, 16));
+    /* around the ring: no gap wider than two sixteenths of a turn */
+    ck_assert(widest_gap_deg(few, 16) <= 45.0);
+    /* 16 points spread over a ring of radius 0.1: a 16-gon covers 97 % of the circle */
+    ck_assert(kept >= 0.9 * full);
+    free(all);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(torus), SDFCCD_OK);
+}
+END_TEST
+
+/* ---------------- contact generation ---------------- */
+
+static const double DT = 1.0 / 60.0;
+static const double H = 0.05; /* half extent of the test cube */
+
+
+static sdfccd_SdfId make_floor(void)
+{
+    sdfccd_SdfId floor;
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, 0.0, &floor), SDFCCD_OK);
+    return floor;
+}
+
+static sdfccd_ContactSet generate(sdfccd_Workspace* ws, sdfccd_SdfId sdf, sdfccd_MeshId mesh, const sdfccd_RigidMotion* m,
+                                  sdfccd_ContactPoint* out, int32_t cap)
+{
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    sdfccd_ContactSet set;
+    ck_assert_msg(sdfccd_generate_contacts(ws, sdf, NULL, mesh, m, 0.0, DT, &p, out, cap, &set) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert(set.count >= 0 && set.count <= cap && set.count <= set.candidates);
+    return set;
+}
+
+/* Every point is a bottom corner of the cube (|x| = |y| = H, z = z0 at t0), a vertex, with normal +z
+ * and gap z0; the corners are all there. */
+static void assert_bottom_corners(const sdfccd_ContactPoint* c, int32_t n, sdfccd_Vec3 centre, double z0)
+{
+    ck_assert_int_eq(n, 4);
+    int seen = 0;
+    for (int32_t i = 0; i < n; ++i) {
+        ck_assert_double_near(fabs(c[i].point.x - centre.x), H, 1e-12);
+        ck_assert_double_near(fabs(c[i].point.y - centre.y), H, 1e-12);
+        ck_assert_double_near(c[i].point.z, z0, 1e-12);
+        ck_assert_double_near(c[i].gap, z0, 1e-9);
+        ck_assert_double_near(c[i].normal.z, 1.0, 1e-12);
+        ck_assert_double_near(c[i].surface_point.z, 0.0, 1e-9);
+        ck_assert_int_eq(c[i].feature_kind, SDFCCD_FEATURE_VERTEX);
+        ck_assert(c[i].id == c[i].feature);
+        seen |= 1 << ((c[i].point.x > centre.x) + 2 * (c[i].point.y > centre.y));
+    }
+    ck_assert_int_eq(seen, 15);
+}
+
+/* First in the suite: sdfccd_set_allocator needs no library memory live. */
+START_TEST(test_generate_no_allocation_after_warm_up)
+{
+    long allocs = 0;
+    ck_assert_int_eq(sdfccd_set_allocator(test_counting_alloc, test_counting_free, &allocs), SDFCCD_OK);
+    {
+        sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+        sdfccd_SdfId floor = make_floor();
+        sdfccd_Workspace* ws;
+        ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+        sdfccd_RigidMotion m[3] = { sdfccd_default_rigid_motion(), sdfccd_default_rigid_motion(), sdfccd_default_rigid_motion() };
+        m[0].pose.position.z = H;          /* resting */
+        m[1].pose.position.z = H + 0.05;   /* falling onto the floor */
+        m[1].linear_velocity.z = -10;
+        m[2].pose.position.z = 1.0;        /* nothing within reach */
+        sdfccd_ContactPoint c[8];
+        for (int k = 0; k < 3; ++k) (void)generate(ws, floor, cube, &m[k], c, 8);
+        long before = allocs;
+        for (int i = 0; i < 10; ++i)
+            for (int k = 0; k < 3; ++k) ck_assert_int_eq(generate(ws, floor, cube, &m[k], c, 8).count, k == 2 ? 0 : 8);
+        ck_assert_int_eq(allocs - before, 0);
+        sdfccd_destroy_workspace(ws);
+        ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+    }
+    ck_assert_int_eq(sdfccd_set_allocator(NULL, NULL, NULL), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_generate_resting_box)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position = (sdfccd_Vec3){ 0.3, -0.2, H };
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set = generate(ws, floor, cube, &m, c, 4);
+    ck_assert_int_eq(set.started_in_contact, 1);
+    ck_assert_int_eq(set.ccd_ran, 0);
+    ck_assert(set.toi == 0.0);
+    ck_assert_int_gt(set.candidates, 4); /* the bottom face's 25 vertices and its triangles: reduced, not cut */
+    assert_bottom_corners(c, set.count, m.pose.position, 0.0);
+    for (int i = 0; i < 4; ++i) ck_assert(c[i].toi == 0.0);
+    /* ids persist: a step later, slid by 1 cm, the same four features */
+    uint64_t ids[4];
+    for (int i = 0; i < 4; ++i) ids[i] = c[i].id;
+    m.pose.position.x += 0.01;
+    set = generate(ws, floor, cube, &m, c, 4);
+    assert_bottom_corners(c, set.count, m.pose.position, 0.0);
+    for (int i = 0; i < 4; ++i) ck_assert(c[i].id == ids[i]);
+    /* a coarse cube (two triangles a face) without subdivision: one deepest point per triangle, so the
+     * corners come from the triangles' vertices within reach */
+    sdfccd_MeshId coarse = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    p.query.subdivision = 0;
+    ck_assert_int_eq(sdfccd_generate_contacts(ws, floor, NULL, coarse, &m, 0.0, DT, &p, c, 4, &set), SDFCCD_OK);
+    assert_bottom_corners(c, set.count, m.pose.position, 0.0);
+    ck_assert_int_eq(sdfccd_destroy_mesh(coarse), SDFCCD_OK);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_generate_falling_box)
+{
+    /* 5 cm above the floor at 10 m/s: the CCD's TOI is 5 ms, each corner's gap at t0 is 5 cm */
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.z = H + 0.05;
+    m.linear_velocity.z = -10;
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set = generate(ws, floor, cube, &m, c, 4);
+    ck_assert_int_eq(set.started_in_contact, 0);
+    ck_assert_int_eq(set.ccd_ran, 1);
+    ck_assert_int_eq(set.ccd_state, SDFCCD_STATE_HIT);
+    ck_assert_double_near(set.toi, 0.005, 1e-7);
+    assert_bottom_corners(c, set.count, m.pose.position, 0.05);
+    /* nothing within the step's reach: no point, no CCD */
+    m.pose.position.z = 1.0;
+    set = generate(ws, floor, cube, &m, c, 4);
+    ck_assert_int_eq(set.count, 0);
+    ck_assert_int_eq(set.candidates, 0);
+    ck_assert_int_eq(set.ccd_ran, 0);
+    ck_assert(set.toi == DT);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_generate_fast_plate_thin_wall)
+{
+    /* a 4 mm plate tilted 45 deg at 500 m/s towards a 1 cm wall (x in [0, 0.01]): its leading edge is
+     * 0.1 - 0.052 / sqrt(2) from the wall at t0 and reaches it at that over 500 */
+    sdfccd_MeshId plate = test_box_mesh((sdfccd_Vec3){ 0.05, 0.002, 0.05 }, 4, 1, 4);
+    sdfccd_SdfId box, wall;
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.005, 1, 1 }, &box), SDFCCD_OK);
+    sdfccd_Pose at = sdfccd_pose_identity();
+    at.position.x = 0.005;
+    ck_assert_int_eq(sdfccd_create_transformed(box, at, 1.0, &wall), SDFCCD_OK);
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.x = -0.1;
+    m.pose.orientation = (sdfccd_Quat){ cos(M_PI / 8), 0, 0, sin(M_PI / 8) };
+    m.linear_velocity.x = 500;
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set = generate(ws, wall, plate, &m, c, 4);
+    const double lead = 0.1 - 0.052 / sqrt(2.0);
+    ck_assert_int_eq(set.ccd_ran, 1);
+    ck_assert_int_eq(set.ccd_state, SDFCCD_STATE_HIT);
+    ck_assert_double_near(set.toi, lead / 500.0, 1e-9);
+    ck_assert_int_ge(set.count, 2); /* the leading edge: both its ends */
+    ck_assert_double_near(c[0].gap, lead, 1e-9);
+    for (int i = 0; i < set.count; ++i) {
+        ck_assert_double_near(c[i].normal.x, -1.0, 1e-9);
+        ck_assert(c[i].gap >= lead - 1e-9);
+    }
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(box), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(plate), SDFCCD_OK);
+}
+END_TEST
+
+/* A 20 cm cloth (5 x 5 vertices) dropping linearly from z = 2 cm to z = -3 cm onto the floor. */
+START_TEST(test_generate_linear_cloth)
+{
+    double v[75];
+    uint32_t f[96];
+    sdfccd_Vec3 start[25], end[25];
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j) {
+            int k = 5 * i + j;
+            v[3 * k] = -0.1 + 0.05 * i;
+            v[3 * k + 1] = -0.1 + 0.05 * j;
+            v[3 * k + 2] = 0.0;
+            start[k] = (sdfccd_Vec3){ v[3 * k], v[3 * k + 1], 0.02 };
+            end[k] = (sdfccd_Vec3){ v[3 * k], v[3 * k + 1], -0.03 };
+        }
+    int t = 0;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+            uint32_t a = (uint32_t)(5 * i + j);
+            uint32_t q[6] = { a, a + 5, a + 6, a, a + 6, a + 1 };
+            memcpy(f + 6 * t++, q, sizeof q);
+        }
+    sdfccd_MeshDef d = sdfccd_default_mesh_def();
+    d.vertices = v;
+    d.vertex_count = 25;
+    d.indices = f;
+    d.triangle_count = 32;
+    sdfccd_MeshId cloth;
+    ck_assert_int_eq(sdfccd_create_mesh(&d, &cloth), SDFCCD_OK);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set;
+    ck_assert_int_eq(sdfccd_generate_contacts_linear(ws, floor, NULL, cloth, start, end, 0.0, DT, &p, c, 4, &set), SDFCCD_OK);
+    ck_assert_int_eq(set.ccd_state, SDFCCD_STATE_HIT);
+    ck_assert_double_near(set.toi, 0.4 * DT, 1e-7);
+    ck_assert_int_eq(set.count, 4);
+    uint32_t corners = 0;
+    for (int i = 0; i < 4; ++i) {
+        ck_assert_double_near(c[i].gap, 0.02, 1e-9);
+        ck_assert_double_near(c[i].normal.z, 1.0, 1e-12);
+        ck_assert_int_eq(c[i].feature_kind, SDFCCD_FEATURE_VERTEX);
+        ck_assert(c[i].id == 0 || c[i].id == 4 || c[i].id == 20 || c[i].id == 24);
+        corners |= 1u << (c[i].id % 5 == 0 ? c[i].id / 20 : 2 + c[i].id / 20);
+    }
+    ck_assert_int_eq(corners, 15);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cloth), SDFCCD_OK);
+}
+END_TEST
+
+START_TEST(test_generate_bad_input)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    sdfccd_ContactParams p = sdfccd_default_contact_params(), bad;
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set, untouched;
+    memset(&untouched, 0x5a, sizeof untouched);
+    set = untouched;
+#define EXPECT(call, status)                                          \
+    do {                                                              \
+        ck_assert_int_eq((call), (status));                           \
+        ck_assert_msg(strlen(sdfccd_last_error()) > 0, "no message"); \
+        ck_assert(memcmp(&set, &untouched, sizeof set) == 0);         \
+    } while (0)
+    EXPECT(sdfccd_generate_contacts(NULL, floor, NULL, cube, &m, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &p, c, 4, NULL), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, NULL, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, NULL, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &p, NULL, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &p, c, -1, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, DT, 0, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    memset(&bad, 0, sizeof bad);
+    bad.query = sdfccd_default_query_params();
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
+    bad.vertex_distance = -1;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
+    bad.same_place_distance = NAN;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
+    bad.query.margin = INFINITY;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_RigidMotion nan_m = m;
+    nan_m.angular_velocity.x = NAN;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &nan_m, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts(ws, floor, &nan_m, cube, &m, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_MeshId null_mesh = { 0, 0 };
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, null_mesh, &m, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_HANDLE);
+    sdfccd_Vec3 pts[8];
+    memset(pts, 0, sizeof pts);
+    EXPECT(sdfccd_generate_contacts_linear(ws, floor, NULL, cube, NULL, pts, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_generate_contacts_linear(ws, floor, NULL, cube, pts, NULL, 0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+#undef EXPECT
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+int main(void)
+{
+    Suite* s = suite_create("contacts");
+    TCase* tg = tcase_create("generate");
+    test_add_memory_fixture(tg);
+    tcase_add_test(tg, test_generate_no_allocation_after_warm_up); /* first: it installs an allocator */
+    tcase_add_test(tg, test_generate_resting_box);
+    tcase_add_test(tg, test_generate_falling_box);
+    tcase_add_test(tg, test_generate_fast_plate_thin_wall);
+    tcase_add_test(tg, test_generate_linear_cloth);
+    tcase_add_test(tg, test_generate_bad_input);
+    suite_add_tcase(s, tg);
+    TCase* tc = tcase_create("reduce");
+    test_add_memory_fixture(tc);
+    tcase_add_test(tc, test_reduce_single_point);
+    tcase_add_test(tc, test_reduce_coincident);
+    tcase_add_test(tc, test_reduce_collinear);
+    tcase_add_test(tc, test_reduce_face_corners);
+    tcase_add_test(tc, test_reduce_thousand_points);
+    tcase_add_test(tc, test_reduce_same_place);
+    tcase_add_test(tc, test_reduce_bad_input);
+    suite_add_tcase(s, tc);
+    TCase* tq = tcase_create("mesh query");
+    test_add_memory_fixture(tq);
+    tcase_add_test(tq, test_mesh_query_reduces_contacts);
+    suite_add_tcase(s, tq);
+    return test_run_suite(s);
+}
