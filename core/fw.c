@@ -26,6 +26,7 @@ void scc_fw_prepare_motion(scc_fw_state* s)
     const scc_tri_motion* m = s->m;
     s->fast = m->kind == SCC_TRI_RIGID && m->sdf == NULL;
     s->cache_t = NAN;
+    s->pt_valid = 0;
     s->wlen = 0.0;
     if (!s->fast) return;
     const scc_rigid* r = m->body;
