@@ -30,6 +30,8 @@ typedef struct scc_fw_state {
     double base_t, base_c, base_s; /* rotation angle's sine and cosine at base_t (mid-interval) */
     /* The offset r of the last weights evaluated (pt_b, compared bit for bit) with axis x r and
      * axis . r: a temporal search or a vertex trace evaluates one point at many times. */
+    scc_vec3 kr0[3];     /* axis x r0[i] */
+    double kd0[3];       /* axis . r0[i] */
     int pt_valid;
     double pt_b[3];
     scc_vec3 pt_r, pt_kr;
@@ -75,13 +77,6 @@ static inline scc_vec3 scc_fw_rotate_pre(scc_fw_state* s, double t, scc_vec3 r, 
     return scc_add(scc_add(scc_scale(r, c), scc_scale(kr, sn)), scc_scale(s->axis, kd * (1.0 - c)));
 }
 
-/* Offset R(w tau) r and its time for the cached rotation. */
-static inline scc_vec3 scc_fw_rotate(scc_fw_state* s, double t, scc_vec3 r)
-{
-    if (s->wlen == 0.0) return r;
-    return scc_fw_rotate_pre(s, t, r, scc_cross(s->axis, r), scc_dot(s->axis, r));
-}
-
 /* Point with weights b at time t (SDF frame) and its velocity when vel is not NULL. */
 static inline scc_vec3 scc_fw_point(scc_fw_state* s, const double b[3], double t, scc_vec3* vel)
 {
@@ -108,7 +103,7 @@ static inline void scc_fw_tri_state(scc_fw_state* s, double t, scc_tri_state* st
     st->t = t;
     scc_vec3 g = scc_madd(s->g0, s->v, t - s->t0);
     for (int i = 0; i < 3; ++i) {
-        scc_vec3 rr = scc_fw_rotate(s, t, s->r0[i]);
+        scc_vec3 rr = scc_fw_rotate_pre(s, t, s->r0[i], s->kr0[i], s->kd0[i]);
         st->x[i] = scc_add(g, rr);
         st->v[i] = scc_add(s->v, scc_cross(s->w, rr));
     }
