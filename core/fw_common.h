@@ -5,6 +5,7 @@
 #define SCC_FW_COMMON_H
 
 #include "ccd.h"
+#include "sdf_analytic.h"
 
 #include <string.h>
 
@@ -124,7 +125,7 @@ static inline void scc_fw_witness(scc_fw_state* s, double t, const double b[3], 
 static inline double scc_fw_eval(scc_fw_state* s, const double b[3], double t, scc_vec3* x, scc_vec3* g, scc_vec3* v)
 {
     *x = scc_fw_point(s, b, t, v);
-    double phi = scc_sdf_eval(s->sdf, *x, g);
+    double phi = scc_sdf_eval_builtin(s->sdf, *x, g);
     s->evals++;
     scc_fw_witness(s, t, b, phi);
     return phi;
