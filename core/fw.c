@@ -26,6 +26,7 @@ void scc_fw_prepare_motion(scc_fw_state* s)
     const scc_tri_motion* m = s->m;
     s->fast = m->kind == SCC_TRI_RIGID && m->sdf == NULL;
     s->cache_t = NAN;
+    s->pt_valid = 0;
     s->wlen = 0.0;
     if (!s->fast) return;
     const scc_rigid* r = m->body;
@@ -35,7 +36,11 @@ void scc_fw_prepare_motion(scc_fw_state* s)
     s->w = r->w;
     s->wlen = scc_len(r->w);
     s->axis = s->wlen > 0.0 ? scc_scale(r->w, 1.0 / s->wlen) : scc_v3(0, 0, 1);
-    for (int i = 0; i < 3; ++i) s->r0[i] = scc_quat_rotate(r->q0, scc_sub(m->local[i], r->c_local));
+    for (int i = 0; i < 3; ++i) {
+        s->r0[i] = scc_quat_rotate(r->q0, scc_sub(m->local[i], r->c_local));
+        s->kr0[i] = scc_cross(s->axis, s->r0[i]);
+        s->kd0[i] = scc_dot(s->axis, s->r0[i]);
+    }
     s->base_t = isfinite(s->ts) && isfinite(s->te) ? 0.5 * (s->ts + s->te) : s->t0;
     double a = s->wlen * (s->base_t - s->t0);
     s->base_c = cos(a);

@@ -5,6 +5,9 @@
 #define SCC_FW_COMMON_H
 
 #include "ccd.h"
+#include "sdf_analytic.h"
+
+#include <string.h>
 
 typedef struct scc_fw_state {
     const scc_sdf* sdf;
@@ -26,14 +29,23 @@ typedef struct scc_fw_state {
     double t0, wlen;
     double cache_t, cache_c, cache_s;
     double base_t, base_c, base_s; /* rotation angle's sine and cosine at base_t (mid-interval) */
+    /* The offset r of the last weights evaluated (pt_b, compared bit for bit) with axis x r and
+     * axis . r: a temporal search or a vertex trace evaluates one point at many times. */
+    scc_vec3 kr0[3];     /* axis x r0[i] */
+    double kd0[3];       /* axis . r0[i] */
+    int pt_valid;
+    double pt_b[3];
+    scc_vec3 pt_r, pt_kr;
+    double pt_kd;
 } scc_fw_state;
 
 /* Fills the closed-form motion cache of s (s->m set); leaves s->fast = 0 when the motion is not
  * a rigid body against a static SDF. */
 void scc_fw_prepare_motion(scc_fw_state* s);
 
-/* Offset R(w tau) r and its time for the cached rotation. */
-static inline scc_vec3 scc_fw_rotate(scc_fw_state* s, double t, scc_vec3 r)
+/* Offset R(w tau) r at time t by Rodrigues' formula, with kr = axis x r and kd = axis . r given
+ * (constant for one point); the rotation's sine and cosine are cached for the last time. */
+static inline scc_vec3 scc_fw_rotate_pre(scc_fw_state* s, double t, scc_vec3 r, scc_vec3 kr, double kd)
 {
     if (s->wlen == 0.0) return r;
     if (t != s->cache_t) {
@@ -63,16 +75,21 @@ static inline scc_vec3 scc_fw_rotate(scc_fw_state* s, double t, scc_vec3 r)
         s->cache_t = t;
     }
     double c = s->cache_c, sn = s->cache_s;
-    scc_vec3 k = s->axis;
-    return scc_add(scc_add(scc_scale(r, c), scc_scale(scc_cross(k, r), sn)), scc_scale(k, scc_dot(k, r) * (1.0 - c)));
+    return scc_add(scc_add(scc_scale(r, c), scc_scale(kr, sn)), scc_scale(s->axis, kd * (1.0 - c)));
 }
 
 /* Point with weights b at time t (SDF frame) and its velocity when vel is not NULL. */
 static inline scc_vec3 scc_fw_point(scc_fw_state* s, const double b[3], double t, scc_vec3* vel)
 {
     if (!s->fast) return scc_tri_point_at(s->m, b, t, vel);
-    scc_vec3 r = scc_add(scc_add(scc_scale(s->r0[0], b[0]), scc_scale(s->r0[1], b[1])), scc_scale(s->r0[2], b[2]));
-    scc_vec3 rr = scc_fw_rotate(s, t, r);
+    if (!s->pt_valid || memcmp(b, s->pt_b, sizeof s->pt_b) != 0) {
+        memcpy(s->pt_b, b, sizeof s->pt_b);
+        s->pt_r = scc_add(scc_add(scc_scale(s->r0[0], b[0]), scc_scale(s->r0[1], b[1])), scc_scale(s->r0[2], b[2]));
+        s->pt_kr = scc_cross(s->axis, s->pt_r);
+        s->pt_kd = scc_dot(s->axis, s->pt_r);
+        s->pt_valid = 1;
+    }
+    scc_vec3 rr = scc_fw_rotate_pre(s, t, s->pt_r, s->pt_kr, s->pt_kd);
     if (vel) *vel = scc_add(s->v, scc_cross(s->w, rr));
     return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
 }
@@ -87,7 +104,7 @@ static inline void scc_fw_tri_state(scc_fw_state* s, double t, scc_tri_state* st
     st->t = t;
     scc_vec3 g = scc_madd(s->g0, s->v, t - s->t0);
     for (int i = 0; i < 3; ++i) {
-        scc_vec3 rr = scc_fw_rotate(s, t, s->r0[i]);
+        scc_vec3 rr = scc_fw_rotate_pre(s, t, s->r0[i], s->kr0[i], s->kd0[i]);
         st->x[i] = scc_add(g, rr);
         st->v[i] = scc_add(s->v, scc_cross(s->w, rr));
     }
@@ -108,7 +125,7 @@ static inline void scc_fw_witness(scc_fw_state* s, double t, const double b[3], 
 static inline double scc_fw_eval(scc_fw_state* s, const double b[3], double t, scc_vec3* x, scc_vec3* g, scc_vec3* v)
 {
     *x = scc_fw_point(s, b, t, v);
-    double phi = scc_sdf_eval(s->sdf, *x, g);
+    double phi = scc_sdf_eval_builtin(s->sdf, *x, g);
     s->evals++;
     scc_fw_witness(s, t, b, phi);
     return phi;

@@ -12,7 +12,7 @@ static double phi_at_time(double t, void* c)
 {
     scc_fw_state* s = c;
     scc_vec3 x = scc_fw_point(s, s->b, t, NULL);
-    double phi = scc_sdf_eval(s->sdf, x, NULL);
+    double phi = scc_sdf_eval_builtin(s->sdf, x, NULL);
     s->evals++;
     scc_fw_witness(s, t, s->b, phi);
     return phi - s->p->margin;
@@ -110,7 +110,7 @@ typedef struct space_ctx {
 static double eval_on_segment(space_ctx* k, double l, double* df)
 {
     scc_vec3 g;
-    double phi = scc_sdf_eval(k->s->sdf, scc_lerp(k->a, k->b, l), df ? &g : NULL);
+    double phi = scc_sdf_eval_builtin(k->s->sdf, scc_lerp(k->a, k->b, l), df ? &g : NULL);
     k->s->evals++;
     if (df) *df = scc_dot(g, scc_sub(k->b, k->a));
     if (phi <= k->s->p->margin) {
@@ -277,7 +277,7 @@ static void refine_entry(scc_fw_state* s, const double b[3], double lo, double f
     for (int k = 0; k < 3 && hi - lo > 1e-3 * s->p->time_tol; ++k) {
         double t = hi - fhi * (hi - lo) / (fhi - flo);
         if (!(t > lo && t < hi)) t = 0.5 * (lo + hi);
-        double phi = scc_sdf_eval(s->sdf, scc_fw_point(s, b, t, NULL), NULL);
+        double phi = scc_sdf_eval_builtin(s->sdf, scc_fw_point(s, b, t, NULL), NULL);
         s->evals++;
         if (phi - margin > 0.0) {
             lo = t;
@@ -319,7 +319,7 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
     double t_prev = t, f_prev = INFINITY, clear_to = t;
     for (int k = 0; k < cap && t < s->te && s->evals < s->p->max_evals; ++k) {
         scc_vec3 x = scc_fw_point(s, b, t, NULL);
-        double phi = scc_sdf_eval(s->sdf, x, NULL);
+        double phi = scc_sdf_eval_builtin(s->sdf, x, NULL);
         s->evals++;
         if (phi <= s->p->margin) {
             if (k > 0) refine_entry(s, b, t_prev, f_prev, &t, &phi);
@@ -405,7 +405,7 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
                 c = scc_add(scc_add(scc_scale(st.x[0], bc[0]), scc_scale(st.x[1], bc[1])), scc_scale(st.x[2], bc[2]));
                 rad = region_radius(st.x, r.u, r.v, c);
             }
-            double phi = scc_sdf_eval(s->sdf, c, NULL);
+            double phi = scc_sdf_eval_builtin(s->sdf, c, NULL);
             s->evals++;
             if (phi <= margin) {
                 scc_fw_witness(s, r.t, bc, phi);

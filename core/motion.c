@@ -100,7 +100,8 @@ scc_vec3 scc_tri_point_at(const scc_tri_motion* m, const double b[3], double t, 
     return x;
 }
 
-double scc_tri_speed_bound(const scc_tri_motion* m)
+/* scc_tri_speed_bound of the triangle with vertices idx[0..2] of m (a vertex alone: i, i, i). */
+static double speed_bound_of(const scc_tri_motion* m, const int idx[3])
 {
     double T = m->t1 - m->t0;
     double speed = 0.0, reach = 0.0; /* reach: bound on |x_world(t) - g_sdf(t)| */
@@ -108,7 +109,7 @@ double scc_tri_speed_bound(const scc_tri_motion* m)
     if (m->kind == SCC_TRI_RIGID) {
         scc_vec3 c = m->body->c_local;
         double r = 0.0;
-        for (int i = 0; i < 3; ++i) r = fmax(r, scc_dist(m->local[i], c));
+        for (int i = 0; i < 3; ++i) r = fmax(r, scc_dist(m->local[idx[i]], c));
         speed = scc_len(m->body->v) + scc_len(m->body->w) * r;
         if (m->sdf) {
             scc_vec3 g0 = scc_rigid_center_at(m->body, m->t0);
@@ -116,24 +117,25 @@ double scc_tri_speed_bound(const scc_tri_motion* m)
         }
     } else {
         for (int i = 0; i < 3; ++i) {
-            double d = scc_dist(m->end[i], m->start[i]);
+            double d = scc_dist(m->end[idx[i]], m->start[idx[i]]);
             speed = fmax(speed, T > 0.0 ? d / T : 0.0);
-            if (m->sdf) reach = fmax(reach, scc_dist(m->start[i], gs0) + d + scc_len(m->sdf->v) * fabs(T));
+            if (m->sdf) reach = fmax(reach, scc_dist(m->start[idx[i]], gs0) + d + scc_len(m->sdf->v) * fabs(T));
         }
     }
     if (m->sdf) speed += scc_len(m->sdf->v) + scc_len(m->sdf->w) * reach;
     return speed;
 }
 
+double scc_tri_speed_bound(const scc_tri_motion* m)
+{
+    static const int all[3] = { 0, 1, 2 };
+    return speed_bound_of(m, all);
+}
+
 double scc_vertex_speed_bound(const scc_tri_motion* m, int i)
 {
-    scc_tri_motion v = *m;
-    for (int k = 0; k < 3; ++k) {
-        v.local[k] = m->local[i];
-        v.start[k] = m->start[i];
-        v.end[k] = m->end[i];
-    }
-    return scc_tri_speed_bound(&v);
+    const int one[3] = { i, i, i };
+    return speed_bound_of(m, one);
 }
 
 double scc_tri_accel_bound(const scc_tri_motion* m)

@@ -33,61 +33,34 @@ static void base_init(scc_sdf* b, scc_sdf_eval_fn* fn, scc_sdf_kind kind, scc_aa
                 kind == SCC_SDF_CYLINDER || kind == SCC_SDF_HALF_SPACE;
 }
 
-static double sign_of(double x) { return x < 0.0 ? -1.0 : 1.0; }
 
 /* ---- sphere ---- */
-static double sphere_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+double scc_sdf_sphere_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
-    const scc_sdf_sphere* s = (const scc_sdf_sphere*)self;
-    double l = scc_len_safe(p);
-    if (g) *g = l > 0.0 ? scc_v3(p.x / l, p.y / l, p.z / l) : k_up;
-    return l - s->radius;
+    return scc_sdf_sphere_value((const scc_sdf_sphere*)self, p, g);
 }
 void scc_sdf_sphere_init(scc_sdf_sphere* s, double r)
 {
-    base_init(&s->base, sphere_eval, SCC_SDF_SPHERE, box_sym(scc_v3(r, r, r)));
+    base_init(&s->base, scc_sdf_sphere_eval, SCC_SDF_SPHERE, box_sym(scc_v3(r, r, r)));
     s->radius = r;
 }
 
 /* ---- box and rounded box: inner box of half (h - r), inflated by r ---- */
-static double box_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+double scc_sdf_box_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
-    const scc_sdf_box* s = (const scc_sdf_box*)self;
-    scc_vec3 inner = scc_sub(s->half, scc_v3(s->radius, s->radius, s->radius));
-    scc_vec3 q = scc_sub(scc_vabs(p), inner);
-    scc_vec3 qp = scc_vmax(q, scc_v3(0, 0, 0));
-    double outside = scc_len_safe(qp);
-    double inside = fmin(scc_maxc(q), 0.0);
-    if (g) {
-        if (outside > 0.0) {
-            *g = scc_v3(qp.x / outside * sign_of(p.x), qp.y / outside * sign_of(p.y), qp.z / outside * sign_of(p.z));
-        } else if (q.x >= q.y && q.x >= q.z) {
-            *g = scc_v3(sign_of(p.x), 0, 0);
-        } else if (q.y >= q.z) {
-            *g = scc_v3(0, sign_of(p.y), 0);
-        } else {
-            *g = scc_v3(0, 0, sign_of(p.z));
-        }
-    }
-    return outside + inside - s->radius;
+    return scc_sdf_box_value((const scc_sdf_box*)self, p, g);
 }
 void scc_sdf_box_init(scc_sdf_box* s, scc_vec3 half, double radius)
 {
-    base_init(&s->base, box_eval, radius > 0.0 ? SCC_SDF_ROUNDED_BOX : SCC_SDF_BOX, box_sym(half));
+    base_init(&s->base, scc_sdf_box_eval, radius > 0.0 ? SCC_SDF_ROUNDED_BOX : SCC_SDF_BOX, box_sym(half));
     s->half = half;
     s->radius = radius;
 }
 
 /* ---- torus around z ---- */
-static double torus_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+double scc_sdf_torus_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
-    const scc_sdf_torus* s = (const scc_sdf_torus*)self;
-    double rho = scc_hypot2(p.x, p.y);
-    double ex = rho > 0.0 ? p.x / rho : 1.0, ey = rho > 0.0 ? p.y / rho : 0.0;
-    double qx = rho - s->major, qz = p.z;
-    double l = scc_hypot2(qx, qz);
-    if (g) *g = l > 0.0 ? scc_v3(qx / l * ex, qx / l * ey, qz / l) : scc_v3(ex, ey, 0.0);
-    return l - s->minor;
+    return scc_sdf_torus_value((const scc_sdf_torus*)self, p, g);
 }
 /* phi = h(rho, z) with h(a, z) = |(a - R, z)| - r convex, and nondecreasing in a where a >= R; rho
  * is convex, so phi is convex wherever rho >= R on a convex set (the outer half of the torus). */
@@ -102,60 +75,40 @@ static int torus_convex_in(const scc_sdf* self, const scc_aabb* b)
 void scc_sdf_torus_init(scc_sdf_torus* s, double major, double minor)
 {
     double e = major + minor;
-    base_init(&s->base, torus_eval, SCC_SDF_TORUS, box_sym(scc_v3(e, e, minor)));
+    base_init(&s->base, scc_sdf_torus_eval, SCC_SDF_TORUS, box_sym(scc_v3(e, e, minor)));
     s->base.convex_in = torus_convex_in;
     s->major = major;
     s->minor = minor;
 }
 
 /* ---- capsule along z ---- */
-static double capsule_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+double scc_sdf_capsule_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
-    const scc_sdf_capsule* s = (const scc_sdf_capsule*)self;
-    scc_vec3 d = scc_v3(p.x, p.y, p.z - scc_clamp(p.z, -s->half_height, s->half_height));
-    double l = scc_len_safe(d);
-    if (g) *g = l > 0.0 ? scc_v3(d.x / l, d.y / l, d.z / l) : scc_v3(1.0, 0.0, 0.0);
-    return l - s->radius;
+    return scc_sdf_capsule_value((const scc_sdf_capsule*)self, p, g);
 }
 void scc_sdf_capsule_init(scc_sdf_capsule* s, double hh, double r)
 {
-    base_init(&s->base, capsule_eval, SCC_SDF_CAPSULE, box_sym(scc_v3(r, r, hh + r)));
+    base_init(&s->base, scc_sdf_capsule_eval, SCC_SDF_CAPSULE, box_sym(scc_v3(r, r, hh + r)));
     s->half_height = hh;
     s->radius = r;
 }
 
 /* ---- cylinder along z with flat caps ---- */
-static double cylinder_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+double scc_sdf_cylinder_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
-    const scc_sdf_cylinder* s = (const scc_sdf_cylinder*)self;
-    double rho = scc_hypot2(p.x, p.y);
-    double ex = rho > 0.0 ? p.x / rho : 1.0, ey = rho > 0.0 ? p.y / rho : 0.0;
-    double dr = rho - s->radius, dz = fabs(p.z) - s->half_height;
-    double or_ = fmax(dr, 0.0), oz = fmax(dz, 0.0);
-    double outside = scc_hypot2(or_, oz);
-    if (g) {
-        if (outside > 0.0)
-            *g = scc_v3(or_ / outside * ex, or_ / outside * ey, oz / outside * sign_of(p.z));
-        else if (dr > dz)
-            *g = scc_v3(ex, ey, 0.0);
-        else
-            *g = scc_v3(0.0, 0.0, sign_of(p.z));
-    }
-    return outside + fmin(fmax(dr, dz), 0.0);
+    return scc_sdf_cylinder_value((const scc_sdf_cylinder*)self, p, g);
 }
 void scc_sdf_cylinder_init(scc_sdf_cylinder* s, double hh, double r)
 {
-    base_init(&s->base, cylinder_eval, SCC_SDF_CYLINDER, box_sym(scc_v3(r, r, hh)));
+    base_init(&s->base, scc_sdf_cylinder_eval, SCC_SDF_CYLINDER, box_sym(scc_v3(r, r, hh)));
     s->half_height = hh;
     s->radius = r;
 }
 
 /* ---- half-space n.x <= offset ---- */
-static double half_space_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
+double scc_sdf_half_space_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
-    const scc_sdf_half_space* s = (const scc_sdf_half_space*)self;
-    if (g) *g = s->normal;
-    return scc_dot(s->normal, p) - s->offset;
+    return scc_sdf_half_space_value((const scc_sdf_half_space*)self, p, g);
 }
 void scc_sdf_half_space_init(scc_sdf_half_space* s, scc_vec3 n, double offset)
 {
@@ -164,7 +117,7 @@ void scc_sdf_half_space_init(scc_sdf_half_space* s, scc_vec3 n, double offset)
     if (n.x == 0.0 && n.y == 0.0) { if (n.z > 0) b.hi.z = offset / n.z; else b.lo.z = offset / n.z; }
     else if (n.x == 0.0 && n.z == 0.0) { if (n.y > 0) b.hi.y = offset / n.y; else b.lo.y = offset / n.y; }
     else if (n.y == 0.0 && n.z == 0.0) { if (n.x > 0) b.hi.x = offset / n.x; else b.lo.x = offset / n.x; }
-    base_init(&s->base, half_space_eval, SCC_SDF_HALF_SPACE, b);
+    base_init(&s->base, scc_sdf_half_space_eval, SCC_SDF_HALF_SPACE, b);
     s->normal = n;
     s->offset = offset;
 }

@@ -144,6 +144,17 @@ sdfccd_Status sdfccd__check_interval(double t0, double t1, const char* fn)
     return SDFCCD_OK;
 }
 
+/* "fn: suffix" into out (size n, truncated like snprintf): the argument name in error messages.
+ * Built on every query, so without snprintf's formatting cost (about 700 instructions). */
+static void what_name(char* out, size_t n, const char* fn, const char* suffix)
+{
+    size_t k = 0;
+    for (const char* c = fn; *c && k + 1 < n; ++c) out[k++] = *c;
+    for (const char* c = ": "; *c && k + 1 < n; ++c) out[k++] = *c;
+    for (const char* c = suffix; *c && k + 1 < n; ++c) out[k++] = *c;
+    out[k] = '\0';
+}
+
 /* Common prologue: out_result, params, interval, SDF handle (acquired) and SDF motion. */
 typedef struct query_setup {
     scc_params p;
@@ -158,14 +169,14 @@ static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motio
 {
     sdfccd_Status st;
     char what[96];
-    snprintf(what, sizeof what, "%s: out_result", fn);
+    what_name(what, sizeof what, fn, "out_result");
     if ((st = sdfccd__check_ptr(out_result, what))) return st;
     if (capacity < 0 || (capacity > 0 && !out_contacts))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_contacts is NULL or capacity (%d) < 0", fn, capacity);
     if ((st = sdfccd__convert_params(params, fn, &q->p)) || (st = sdfccd__check_interval(t0, t1, fn))) return st;
     q->sdf_motion_ptr = NULL;
     if (sdf_motion) {
-        snprintf(what, sizeof what, "%s: sdf_motion", fn);
+        what_name(what, sizeof what, fn, "sdf_motion");
         if ((st = sdfccd__convert_motion(sdf_motion, t0, t1, what, &q->sdf_motion))) return st;
         q->sdf_motion_ptr = &q->sdf_motion;
     }
@@ -336,7 +347,7 @@ static sdfccd_Status query_mesh(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, c
     sdfccd_Status st;
     char what[96];
     if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
-    snprintf(what, sizeof what, "%s: motion", fn);
+    what_name(what, sizeof what, fn, "motion");
     if ((st = sdfccd__check_ptr(motion, what))) return st;
     scc_rigid body;
     if ((st = sdfccd__convert_motion(motion, t0, t1, what, &body))) return st;
@@ -398,9 +409,9 @@ static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId
     sdfccd_Status st;
     char what[96];
     if ((st = setup(sdf, sdf_motion, t0, t1, params, out_contacts, capacity, out_result, fn, &q))) return st;
-    snprintf(what, sizeof what, "%s: start", fn);
+    what_name(what, sizeof what, fn, "start");
     if ((st = sdfccd__check_ptr(start, what))) return st;
-    snprintf(what, sizeof what, "%s: end", fn);
+    what_name(what, sizeof what, fn, "end");
     if ((st = sdfccd__check_ptr(end, what))) return st;
     sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
