@@ -334,14 +334,20 @@ int64_t sdfccd_case_run_row_count(const sdfccd_CaseRun* run) { return run ? run-
 
 const sdfccd_CaseRow* sdfccd_case_run_rows(const sdfccd_CaseRun* run) { return run && run->count ? run->rows : NULL; }
 
-/* Shared by both entry points: checks, runs the source, frees what the file created. */
-static sdfccd_Status run_cases(const char* fn, cases_source* src, const char* file, const char* dir,
-                               const sdfccd_CaseRunDef* def, sdfccd_CaseRun** out_run)
+/* The checks of both entry points: def, out_run and the query parameters. */
+static sdfccd_Status check_args(const char* fn, const sdfccd_CaseRunDef* def, sdfccd_CaseRun** out_run)
 {
     sdfccd_Status st = SDFCCD__CHECK_DEF_ARGS(fn, def, out_run, "out_run", "sdfccd_default_case_run_def");
     if (st != SDFCCD_OK) return st;
-    struct scc_params checked;
-    if ((st = sdfccd__convert_params(&def->params, fn, &checked)) != SDFCCD_OK) return st;
+    scc_params checked;
+    return sdfccd__convert_params(&def->params, fn, &checked);
+}
+
+/* Shared by both entry points (after check_args): runs the source, frees what the file created. */
+static sdfccd_Status run_cases(cases_source* src, const char* file, const char* dir,
+                               const sdfccd_CaseRunDef* def, sdfccd_CaseRun** out_run)
+{
+    sdfccd_Status st;
     cases_runner* r = sdfccd__calloc(sizeof *r);
     char* buf = sdfccd__alloc(CASES_LINE);
     if (r) {
@@ -374,7 +380,7 @@ sdfccd_Status sdfccd_run_case_file(const char* path, const sdfccd_CaseRunDef* de
 {
     if (out_run) *out_run = NULL;
     if (!path) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_run_case_file: path is NULL");
-    sdfccd_Status st = SDFCCD__CHECK_DEF_ARGS("sdfccd_run_case_file", def, out_run, "out_run", "sdfccd_default_case_run_def");
+    sdfccd_Status st = check_args("sdfccd_run_case_file", def, out_run);
     if (st != SDFCCD_OK) return st;
     FILE* f = fopen(path, "r");
     if (!f) return sdfccd__error(SDFCCD_IO_ERROR, "cannot open '%s': %s", path, strerror(errno));
@@ -382,7 +388,7 @@ sdfccd_Status sdfccd_run_case_file(const char* path, const sdfccd_CaseRunDef* de
     const char* slash = strrchr(path, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
     cases_source src = { f, NULL, 0, 0, 0 };
-    st = run_cases("sdfccd_run_case_file", &src, path, dir, def, out_run);
+    st = run_cases(&src, path, dir, def, out_run);
     fclose(f);
     return st;
 }
@@ -391,6 +397,8 @@ sdfccd_Status sdfccd_run_case_memory(const char* text, size_t size, const sdfccd
 {
     if (out_run) *out_run = NULL;
     if (!text && size) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_run_case_memory: text is NULL");
+    sdfccd_Status st = check_args("sdfccd_run_case_memory", def, out_run);
+    if (st != SDFCCD_OK) return st;
     cases_source src = { NULL, text, size, 0, 0 };
-    return run_cases("sdfccd_run_case_memory", &src, "memory", "", def, out_run);
+    return run_cases(&src, "memory", "", def, out_run);
 }
