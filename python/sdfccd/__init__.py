@@ -36,6 +36,12 @@ __all__ = [
 ]
 
 __version__ = _L.sdfccd_version_string().decode()
+try:
+    from . import _libpath as _lp
+    if getattr(_lp, "VERSION", __version__) != __version__:
+        raise ImportError(f"sdfccd: the package is version {_lp.VERSION} but {_lib.library_path} is {__version__}")
+except ModuleNotFoundError:
+    pass
 configuration = _L.sdfccd_configuration_string().decode()
 library_path = _lib.library_path
 

@@ -41,6 +41,32 @@ def test_readme_example_in_python_gives_the_same_numbers(readme_example):
     assert line == out.stdout
 
 
+def test_readme_python_block_runs(source_dir):
+    text = (source_dir / "README.md").read_text()
+    block = re.search(r"```python\n(.*?)```", text, re.S).group(1)
+    scope = {}
+    exec(compile(block, "README.md", "exec"), scope)
+    assert scope["r"].hit and abs(scope["r"].toi - 0.15 / 36.0) < 1e-6
+
+
+def test_python_threads_share_handles():
+    import threading
+    tri, mo = random_queries(32, 11)
+    with sdfccd.torus(0.1, 0.05) as torus:
+        want = [sdfccd.query_triangle(torus, tri[i], motion_of(mo[i])).toi for i in range(len(tri))]
+        got = {}
+
+        def worker(k):
+            got[k] = [sdfccd.query_triangle(torus, tri[i], motion_of(mo[i])).toi for i in range(len(tri))]
+
+        threads = [threading.Thread(target=worker, args=(k,)) for k in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert all(got[k] == want for k in range(4))
+
+
 def test_analytic_csg_and_transformed_values():
     rng = np.random.default_rng(1)
     p = rng.uniform(-0.3, 0.3, (200, 3))
