@@ -181,5 +181,48 @@ int main(void)
     OFF(sdfccd_CaseRunDef, name);
     OFF(sdfccd_CaseRunDef, base_dir);
     OFF(sdfccd_CaseRunDef, internal_value);
+#ifdef SDFCCD_CONTACT_H /* contact.h (issue 19) */
+    SIZE(sdfccd_GuardParams);
+    OFF(sdfccd_GuardParams, tolerance);
+    OFF(sdfccd_GuardParams, query);
+    OFF(sdfccd_GuardParams, internal_value);
+    SIZE(sdfccd_GuardResult);
+    OFF(sdfccd_GuardResult, state);
+    OFF(sdfccd_GuardResult, toi);
+    OFF(sdfccd_GuardResult, fraction);
+    OFF(sdfccd_GuardResult, safe_pose);
+    OFF(sdfccd_GuardResult, point);
+    OFF(sdfccd_GuardResult, normal);
+    OFF(sdfccd_GuardResult, min_gap_start);
+    OFF(sdfccd_GuardResult, triangle);
+    OFF(sdfccd_GuardResult, deep_triangles);
+    OFF(sdfccd_GuardResult, query_state);
+    OFF(sdfccd_GuardResult, queries);
+    OFF(sdfccd_GuardResult, sdf_evaluations);
+    SIZE(sdfccd_ContactPoint);
+    OFF(sdfccd_ContactPoint, point);
+    OFF(sdfccd_ContactPoint, surface_point);
+    OFF(sdfccd_ContactPoint, normal);
+    OFF(sdfccd_ContactPoint, gap);
+    OFF(sdfccd_ContactPoint, toi);
+    OFF(sdfccd_ContactPoint, barycentric);
+    OFF(sdfccd_ContactPoint, triangle);
+    OFF(sdfccd_ContactPoint, feature_kind);
+    OFF(sdfccd_ContactPoint, feature);
+    OFF(sdfccd_ContactPoint, id);
+    SIZE(sdfccd_ContactParams);
+    OFF(sdfccd_ContactParams, query);
+    OFF(sdfccd_ContactParams, vertex_distance);
+    OFF(sdfccd_ContactParams, same_place_distance);
+    OFF(sdfccd_ContactParams, internal_value);
+    SIZE(sdfccd_ContactSet);
+    OFF(sdfccd_ContactSet, count);
+    OFF(sdfccd_ContactSet, candidates);
+    OFF(sdfccd_ContactSet, started_in_contact);
+    OFF(sdfccd_ContactSet, ccd_ran);
+    OFF(sdfccd_ContactSet, ccd_state);
+    OFF(sdfccd_ContactSet, toi);
+    OFF(sdfccd_ContactSet, sdf_evaluations);
+#endif
     return 0;
 }

@@ -32,7 +32,8 @@ __all__ = [
     "torus", "capsule", "cylinder", "half_space", "spike_grid", "union", "intersection", "difference",
     "transformed", "callback", "load_grid", "grid_from_mesh", "grid_from_sdf", "load_mesh", "query_triangle",
     "query_triangle_linear", "query_mesh", "query_mesh_linear", "query_batch", "extract_isosurface", "run_cases",
-    "byte_count", "CONTACT_DTYPE", "RESULT_DTYPE", "MOTION_DTYPE", "CASES_DTYPE", "CASES_COLUMNS", "library_path",
+    "byte_count", "Workspace", "motion_from_poses", "guard_rigid", "guard_linear", "GuardResult", "generate_contacts",
+    "generate_contacts_linear", "reduce_contacts", "CONTACT_POINT_DTYPE", "HAVE_CONTACTS", "CONTACT_DTYPE", "RESULT_DTYPE", "MOTION_DTYPE", "CASES_DTYPE", "CASES_COLUMNS", "library_path",
 ]
 
 __version__ = _L.sdfccd_version_string().decode()
@@ -819,6 +820,237 @@ def extract_isosurface(sdf, lo, hi, resolution=64):
     _check(st)
     with Mesh._wrap(mid) as m:
         return m.arrays()
+
+
+# ---------------------------------------------------------------------------------------------
+# contacts and the no-tunnelling guard (contact.h)
+
+#: sdfccd_ContactPoint: point, surface_point, normal, gap, toi, barycentric, triangle, feature_kind,
+#: feature, id.
+CONTACT_POINT_DTYPE = np.dtype(_lib.ContactPoint)
+GUARD_STATES = ("clear", "rolled_back", "inside_at_start")
+
+
+#: True when the loaded libsdfccd has contact.h's functions (otherwise those raise Error SDFCCD_UNSUPPORTED).
+HAVE_CONTACTS = _lib.HAVE_CONTACTS
+
+
+class Workspace:
+    """Reusable scratch storage of the guard and contact calls (sdfccd_Workspace): after a first call
+    of a given size they allocate nothing. One thread at a time; freed by close(), ``with`` or GC."""
+
+    def __init__(self):
+        _need_contacts()
+        ptr = C.c_void_p()
+        _check(_L.sdfccd_create_workspace(C.byref(ptr)))
+        self._ptr = ptr
+        self._lock = threading.Lock()
+
+    def _handle(self):
+        if self._ptr is None:
+            raise Error("SDFCCD_INVALID_HANDLE", "Workspace is closed")
+        return self._ptr
+
+    def close(self):
+        with self._lock:
+            ptr, self._ptr = self._ptr, None
+        if ptr is not None:
+            _L.sdfccd_destroy_workspace(ptr)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        if getattr(self, "_ptr", None) is not None:
+            try:
+                self.close()
+            except Exception:
+                pass
+
+
+def _need_contacts():
+    if not _lib.HAVE_CONTACTS:
+        raise Error("SDFCCD_UNSUPPORTED", f"{_lib.library_path} has no contact functions (contact.h, issue 19)")
+
+
+def _with_workspace(workspace, fn):
+    if workspace is None:
+        with Workspace() as ws:
+            return fn(ws._handle())
+    if not isinstance(workspace, Workspace):
+        raise TypeError(f"workspace: expected an sdfccd.Workspace, got {type(workspace).__name__}")
+    with workspace._lock:
+        return fn(workspace._handle())
+
+
+def motion_from_poses(start_position, start_orientation, end_position, end_orientation, t0, t1,
+                      center=(0.0, 0.0, 0.0)):
+    """The rigid Motion that moves `center` (local frame) linearly and turns by the shortest arc from the
+    start pose to the end pose over [t0, t1] (sdfccd_rigid_motion_from_poses)."""
+    _need_contacts()
+    a, b = _lib.Pose(), _lib.Pose()
+    a.position[:] = _float_array(start_position, "start_position", (3,))
+    a.orientation[:] = _float_array(start_orientation, "start_orientation", (4,))
+    b.position[:] = _float_array(end_position, "end_position", (3,))
+    b.orientation[:] = _float_array(end_orientation, "end_orientation", (4,))
+    m = Motion()
+    _check(_L.sdfccd_rigid_motion_from_poses(C.byref(a), C.byref(b), _vec3(center, "center"), _scalar(t0, "t0"),
+                                             _scalar(t1, "t1"), C.byref(m._c)))
+    return m
+
+
+class GuardResult:
+    """What the guard found: ``state`` ("clear", "rolled_back", "inside_at_start"), ``toi``, ``fraction``,
+    ``safe_position`` / ``safe_orientation`` (rigid), ``point``, ``normal``, ``triangle`` (rolled back),
+    ``min_gap_start``, ``deep_triangles``, ``query_state``, ``queries``, ``sdf_evaluations``; for the
+    linear guard ``positions`` (the vertices at ``toi``)."""
+
+    def __init__(self, g, positions=None):
+        self.state = GUARD_STATES[g.state] if 0 <= g.state < len(GUARD_STATES) else g.state
+        self.toi = g.toi
+        self.fraction = g.fraction
+        self.safe_position = np.array(g.safe_pose.position)
+        self.safe_orientation = np.array(g.safe_pose.orientation)
+        self.point = np.array(g.point)
+        self.normal = np.array(g.normal)
+        self.min_gap_start = g.min_gap_start
+        self.triangle = g.triangle
+        self.deep_triangles = g.deep_triangles
+        self.query_state = STATES[g.query_state] if 0 <= g.query_state < len(STATES) else g.query_state
+        self.queries = g.queries
+        self.sdf_evaluations = g.sdf_evaluations
+        self.positions = positions
+
+    def __repr__(self):
+        return f"GuardResult(state={self.state!r}, toi={self.toi!r}, sdf_evaluations={self.sdf_evaluations})"
+
+
+def _guard_params(tolerance, params, method):
+    g = _L.sdfccd_default_guard_params()
+    if tolerance is not None:
+        g.tolerance = _scalar(tolerance, "tolerance")
+    if params is not None or method != "fwgss":
+        g.query = _params_arg(params, method)
+    return g
+
+
+def guard_rigid(sdf, mesh, executed, t0=0.0, t1=1.0 / 60.0, tolerance=None, params=None, method="fwgss",
+                sdf_motion=None, workspace=None):
+    """The no-tunnelling guarantee (sdfccd_guard_rigid): checks the motion a rigid mesh executed over
+    [t0, t1] and, when a point went deeper than `tolerance` (default 5e-4 m), returns the safe pose at
+    the time of impact ("rolled_back")."""
+    _need_contacts()
+    h_sdf, h_mesh = _sdf_arg(sdf, "sdf"), _mesh_arg(mesh)
+    m = _motion_arg(executed, "executed", False)
+    sm = _motion_arg(sdf_motion, "sdf_motion", True)
+    g = _guard_params(tolerance, params, method)
+    out = _lib.GuardResult()
+    a, b = _scalar(t0, "t0"), _scalar(t1, "t1")
+    st = _with_workspace(workspace, lambda ws: _L.sdfccd_guard_rigid(
+        ws, h_sdf, C.byref(sm) if sm is not None else None, h_mesh, C.byref(m), a, b, C.byref(g), C.byref(out)))
+    _raise_callback_errors(sdf)
+    _check(st)
+    return GuardResult(out)
+
+
+def guard_linear(sdf, mesh, start, end, t0=0.0, t1=1.0 / 60.0, tolerance=None, params=None, method="fwgss",
+                 sdf_motion=None, workspace=None):
+    """The guarantee for a deforming mesh (sdfccd_guard_linear): world vertices (V, 3) moving linearly
+    from `start` to `end`; the result's ``positions`` are the safe vertex positions at its ``toi``."""
+    _need_contacts()
+    h_sdf, h_mesh = _sdf_arg(sdf, "sdf"), _mesh_arg(mesh)
+    nv = mesh.info()["vertex_count"]
+    a_pos = _float_array(start, "start", (nv, 3))
+    b_pos = _float_array(end, "end", (nv, 3))
+    sm = _motion_arg(sdf_motion, "sdf_motion", True)
+    g = _guard_params(tolerance, params, method)
+    out = _lib.GuardResult()
+    positions = np.empty((nv, 3))
+    a, b = _scalar(t0, "t0"), _scalar(t1, "t1")
+    st = _with_workspace(workspace, lambda ws: _L.sdfccd_guard_linear(
+        ws, h_sdf, C.byref(sm) if sm is not None else None, h_mesh, a_pos.ctypes.data, b_pos.ctypes.data, a, b,
+        C.byref(g), C.byref(out), positions.ctypes.data))
+    _raise_callback_errors(sdf)
+    _check(st)
+    return GuardResult(out, positions)
+
+
+def _contact_params(params, method, vertex_distance, same_place_distance):
+    c = _L.sdfccd_default_contact_params()
+    if params is not None or method != "fwgss":
+        c.query = _params_arg(params, method)
+    if vertex_distance is not None:
+        c.vertex_distance = _scalar(vertex_distance, "vertex_distance")
+    if same_place_distance is not None:
+        c.same_place_distance = _scalar(same_place_distance, "same_place_distance")
+    return c
+
+
+def _contact_set(cs):
+    return {"count": cs.count, "candidates": cs.candidates, "started_in_contact": bool(cs.started_in_contact),
+            "ccd_ran": bool(cs.ccd_ran), "ccd_state": STATES[cs.ccd_state] if 0 <= cs.ccd_state < len(STATES)
+            else cs.ccd_state, "toi": cs.toi, "sdf_evaluations": cs.sdf_evaluations}
+
+
+def _generate(fn_call, sdf, capacity):
+    cap = _capacity(capacity)
+    pts = np.zeros(cap, dtype=CONTACT_POINT_DTYPE)
+    cs = _lib.ContactSet()
+    st = fn_call(pts.ctypes.data if cap else None, cap, C.byref(cs))
+    _raise_callback_errors(sdf)
+    _check(st)
+    return pts[: cs.count], _contact_set(cs)
+
+
+def generate_contacts(sdf, mesh, motion=None, t0=0.0, t1=1.0 / 60.0, capacity=4, params=None, method="fwgss",
+                      vertex_distance=None, same_place_distance=None, sdf_motion=None, workspace=None):
+    """The contact set of a rigid mesh against an SDF over a step (sdfccd_generate_contacts), reduced to
+    `capacity` points -> (CONTACT_POINT_DTYPE array, summary dict). ``params`` are the CCD's (its
+    margin is the contact distance)."""
+    _need_contacts()
+    h_sdf, h_mesh = _sdf_arg(sdf, "sdf"), _mesh_arg(mesh)
+    m = _motion_arg(motion, "motion", False)
+    sm = _motion_arg(sdf_motion, "sdf_motion", True)
+    c = _contact_params(params, method, vertex_distance, same_place_distance)
+    a, b = _scalar(t0, "t0"), _scalar(t1, "t1")
+    return _generate(lambda out, cap, cs: _with_workspace(workspace, lambda ws: _L.sdfccd_generate_contacts(
+        ws, h_sdf, C.byref(sm) if sm is not None else None, h_mesh, C.byref(m), a, b, C.byref(c), out, cap, cs)),
+        sdf, capacity)
+
+
+def generate_contacts_linear(sdf, mesh, start, end, t0=0.0, t1=1.0 / 60.0, capacity=4, params=None, method="fwgss",
+                             vertex_distance=None, same_place_distance=None, sdf_motion=None, workspace=None):
+    """generate_contacts for a deforming mesh: world vertices (V, 3) moving linearly from `start` to `end`."""
+    _need_contacts()
+    h_sdf, h_mesh = _sdf_arg(sdf, "sdf"), _mesh_arg(mesh)
+    nv = mesh.info()["vertex_count"]
+    a_pos = _float_array(start, "start", (nv, 3))
+    b_pos = _float_array(end, "end", (nv, 3))
+    sm = _motion_arg(sdf_motion, "sdf_motion", True)
+    c = _contact_params(params, method, vertex_distance, same_place_distance)
+    a, b = _scalar(t0, "t0"), _scalar(t1, "t1")
+    return _generate(lambda out, cap, cs: _with_workspace(workspace, lambda ws: _L.sdfccd_generate_contacts_linear(
+        ws, h_sdf, C.byref(sm) if sm is not None else None, h_mesh, a_pos.ctypes.data, b_pos.ctypes.data, a, b,
+        C.byref(c), out, cap, cs)), sdf, capacity)
+
+
+def reduce_contacts(points, capacity, same_place_distance=1e-4):
+    """Indices (int32) of at most `capacity` points of a CONTACT_POINT_DTYPE array that the library's
+    reduction keeps (deepest, then the most contact area, never two at one place)."""
+    _need_contacts()
+    if not isinstance(points, np.ndarray) or points.dtype != CONTACT_POINT_DTYPE or points.ndim != 1:
+        raise TypeError("points: expected a 1-D CONTACT_POINT_DTYPE array")
+    pts = np.ascontiguousarray(points)
+    cap = _capacity(capacity)
+    idx = np.zeros(max(cap, 1), dtype=np.int32)
+    n = C.c_int32()
+    _check(_L.sdfccd_reduce_contacts(pts.ctypes.data if len(pts) else None, len(pts),
+                                     _scalar(same_place_distance, "same_place_distance"), idx.ctypes.data, cap,
+                                     C.byref(n)))
+    return idx[: n.value].copy()
 
 
 # ---------------------------------------------------------------------------------------------

@@ -253,6 +253,64 @@ class CaseRunDef(C.Structure):
     ]
 
 
+# contact.h (issue 19): the guard, contact generation and reduction.
+class GuardParams(C.Structure):
+    _fields_ = [("tolerance", C.c_double), ("query", QueryParams), ("internal_value", C.c_int32)]
+
+
+class GuardResult(C.Structure):
+    _fields_ = [
+        ("state", C.c_int32),
+        ("toi", C.c_double),
+        ("fraction", C.c_double),
+        ("safe_pose", Pose),
+        ("point", c_double3),
+        ("normal", c_double3),
+        ("min_gap_start", C.c_double),
+        ("triangle", C.c_uint32),
+        ("deep_triangles", C.c_int32),
+        ("query_state", C.c_int32),
+        ("queries", C.c_int32),
+        ("sdf_evaluations", C.c_int64),
+    ]
+
+
+class ContactPoint(C.Structure):
+    _fields_ = [
+        ("point", c_double3),
+        ("surface_point", c_double3),
+        ("normal", c_double3),
+        ("gap", C.c_double),
+        ("toi", C.c_double),
+        ("barycentric", c_double3),
+        ("triangle", C.c_uint32),
+        ("feature_kind", C.c_int32),
+        ("feature", C.c_uint32),
+        ("id", C.c_uint64),
+    ]
+
+
+class ContactParams(C.Structure):
+    _fields_ = [
+        ("query", QueryParams),
+        ("vertex_distance", C.c_double),
+        ("same_place_distance", C.c_double),
+        ("internal_value", C.c_int32),
+    ]
+
+
+class ContactSet(C.Structure):
+    _fields_ = [
+        ("count", C.c_int32),
+        ("candidates", C.c_int32),
+        ("started_in_contact", C.c_int32),
+        ("ccd_ran", C.c_int32),
+        ("ccd_state", C.c_int32),
+        ("toi", C.c_double),
+        ("sdf_evaluations", C.c_int64),
+    ]
+
+
 # Every struct the layout test compares with the C compiler's sizeof / offsetof.
 STRUCTS = {
     "sdfccd_Vec3": Vec3, "sdfccd_Aabb": Aabb, "sdfccd_Pose": Pose, "sdfccd_SdfId": SdfId,
@@ -262,6 +320,11 @@ STRUCTS = {
     "sdfccd_MeshDef": MeshDef, "sdfccd_MeshInfo": MeshInfo, "sdfccd_MeshLoadDef": MeshLoadDef,
     "sdfccd_GridDef": GridDef, "sdfccd_GridInfo": GridInfo, "sdfccd_CaseRow": CaseRow,
     "sdfccd_CaseRunDef": CaseRunDef,
+}
+# contact.h's structs (compared only when the C headers have contact.h).
+CONTACT_STRUCTS = {
+    "sdfccd_GuardParams": GuardParams, "sdfccd_GuardResult": GuardResult, "sdfccd_ContactPoint": ContactPoint,
+    "sdfccd_ContactParams": ContactParams, "sdfccd_ContactSet": ContactSet,
 }
 
 _S = C.c_int  # sdfccd_Status
@@ -322,6 +385,27 @@ _PROTOTYPES = {
 }
 
 
+# contact.h (issue 19, branch t19core): bound when the library has it (HAVE_CONTACTS).
+_OPTIONAL_PROTOTYPES = {
+    "sdfccd_create_workspace": (_S, [_P(C.c_void_p)]),
+    "sdfccd_destroy_workspace": (None, [C.c_void_p]),
+    "sdfccd_rigid_motion_from_poses": (_S, [_P(Pose), _P(Pose), Vec3, C.c_double, C.c_double, _P(RigidMotion)]),
+    "sdfccd_default_guard_params": (GuardParams, []),
+    "sdfccd_guard_rigid": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, _P(RigidMotion), C.c_double, C.c_double,
+                                _P(GuardParams), _P(GuardResult)]),
+    "sdfccd_guard_linear": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, C.c_void_p, C.c_void_p, C.c_double,
+                                 C.c_double, _P(GuardParams), _P(GuardResult), C.c_void_p]),
+    "sdfccd_reduce_contacts": (_S, [C.c_void_p, C.c_int32, C.c_double, C.c_void_p, C.c_int32, _P(C.c_int32)]),
+    "sdfccd_default_contact_params": (ContactParams, []),
+    "sdfccd_generate_contacts": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, _P(RigidMotion), C.c_double,
+                                      C.c_double, _P(ContactParams), C.c_void_p, C.c_int32, _P(ContactSet)]),
+    "sdfccd_generate_contacts_linear": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, C.c_void_p, C.c_void_p,
+                                             C.c_double, C.c_double, _P(ContactParams), C.c_void_p, C.c_int32,
+                                             _P(ContactSet)]),
+}
+HAVE_CONTACTS = False
+
+
 def _library_path():
     """SDFCCD_LIBRARY if set, else the path the build or the install wrote into _libpath.py."""
     env = os.environ.get("SDFCCD_LIBRARY")
@@ -345,6 +429,13 @@ def load():
         fn = getattr(lib, name)
         fn.restype = restype
         fn.argtypes = argtypes
+    global HAVE_CONTACTS
+    HAVE_CONTACTS = all(hasattr(lib, name) for name in _OPTIONAL_PROTOTYPES)
+    if HAVE_CONTACTS:
+        for name, (restype, argtypes) in _OPTIONAL_PROTOTYPES.items():
+            fn = getattr(lib, name)
+            fn.restype = restype
+            fn.argtypes = argtypes
     return lib, path
 
 

@@ -219,3 +219,12 @@ def test_progress_callback_cancel_and_exception(source_dir):
         sdfccd.grid_from_mesh(box, resolution=0)
     with pytest.raises(ValueError):
         sdfccd.grid_from_mesh(box, resolution=(8, 8))
+
+
+@pytest.mark.skipif(sdfccd.HAVE_CONTACTS, reason="the library has contact.h")
+def test_contact_functions_without_contact_h_raise():
+    with pytest.raises(sdfccd.Error) as e:
+        sdfccd.Workspace()
+    assert e.value.status == "SDFCCD_UNSUPPORTED"
+    with pytest.raises(sdfccd.Error):
+        sdfccd.reduce_contacts(np.zeros(0, dtype=sdfccd.CONTACT_POINT_DTYPE), 4)

@@ -12,10 +12,15 @@ def test_struct_layouts_match_the_c_headers(layout_probe):
         name, value = line.split()
         c[name.replace(".pose.", ".")] = int(value)
     checked = 0
-    for cname, S in _lib.STRUCTS.items():
+    structs = dict(_lib.STRUCTS)
+    has_contact_h = "sdfccd_GuardParams" in c
+    assert has_contact_h == _lib.HAVE_CONTACTS  # headers and library agree
+    if has_contact_h:
+        structs.update(_lib.CONTACT_STRUCTS)
+    for cname, S in structs.items():
         assert c[cname] == _lib.C.sizeof(S), f"sizeof({cname}): C {c[cname]}, ctypes {_lib.C.sizeof(S)}"
         for f in S._fields_:
             key = f"{cname}.{f[0]}"
             assert c[key] == getattr(S, f[0]).offset, f"offsetof({key}): C {c[key]}, ctypes {getattr(S, f[0]).offset}"
             checked += 1
-    assert checked == len(c) - len(_lib.STRUCTS)
+    assert checked == len(c) - len(structs)
