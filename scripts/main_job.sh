@@ -17,3 +17,8 @@ cp -r samples/report/dataset build/report/
 bash scripts/bench_report.sh build/report --build build
 echo "report: build/report/report.md (chart: build/report/speed_accuracy.png); the committed full run is samples/report/report.md"
 
+# The Python package (README "Python"): build/python holds it; the first python3 with numpy imports it.
+py=python3
+python3 -c "import numpy" 2>/dev/null || py=/usr/bin/python3
+echo "== python: PYTHONPATH=\$PWD/build/python python3 -c \"import sdfccd; print(sdfccd.__version__)\""
+PYTHONPATH="$PWD/build/python" "$py" -c "import sdfccd; print(sdfccd.__version__)"

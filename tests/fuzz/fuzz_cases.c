@@ -1,21 +1,16 @@
 /* SPDX-License-Identifier: MIT
- * libFuzzer target: the benchmark case-file parser and runner (samples/sdfccd_cases.c, included
- * with its main() left out) on fuzzer-written case files read from memory. Its CSV goes to
- * /dev/null and its error lines to a sink; relative file paths resolve in a folder that does not
- * exist. Every handle the file creates is destroyed and no library memory may remain. */
+ * libFuzzer target: the benchmark case-file parser and runner (sdfccd_run_case_memory, cases.h: the
+ * code behind sdfccd_cases and the Python package's run_cases) on fuzzer-written case files. Relative
+ * file paths resolve in a folder that does not exist. A run either fails with a message or gives
+ * rows with a known state and finite values when hit; every handle the file creates is destroyed
+ * and no library memory may remain once the run is freed. */
+#include <math.h>
 #include <stdio.h>
-
-static FILE* g_sink;
-#define SDFCCD_CASES_NO_MAIN 1
-#undef stderr
-#define stderr g_sink
-#include "../../samples/sdfccd_cases.c"
-#undef stderr
-#define stderr stderr
+#include <stdlib.h>
+#include <string.h>
 
 #include "fuzz_common.h"
-
-static void (*const g_usage_unused)(FILE*) = usage; /* the included main()'s helper */
+#include "sdfccd/sdfccd.h"
 
 static int64_t g_bytes;
 
@@ -23,30 +18,30 @@ int LLVMFuzzerInitialize(int* argc, char*** argv)
 {
     (void)argc;
     (void)argv;
-    (void)g_usage_unused;
-    g_sink = fopen("/dev/null", "w");
-    if (!g_sink || !freopen("/dev/null", "w", stdout)) abort();
     g_bytes = sdfccd_byte_count();
     return 0;
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
-    static runner r;
-    memset(&r, 0, sizeof r);
-    r.params = sdfccd_default_query_params();
-    r.file = "fuzz";
-    snprintf(r.dir, sizeof r.dir, "/nonexistent-sdfccd-fuzz");
-    r.capacity = 8;
-    sdfccd_Contact contacts[8];
-    r.contacts = contacts;
-    if (size == 0) return 0; /* fmemopen refuses an empty buffer */
-    FILE* f = fmemopen((void*)data, size, "r");
-    if (!f) return 0;
-    run_file(&r, f);
-    fclose(f);
-    for (int i = 0; i < r.sdf_count; ++i) sdfccd_destroy_sdf(r.sdfs[i].id);
-    for (int i = 0; i < r.mesh_count; ++i) sdfccd_destroy_mesh(r.meshes[i].id);
+    sdfccd_CaseRunDef def = sdfccd_default_case_run_def();
+    def.name = "fuzz";
+    def.base_dir = "/nonexistent-sdfccd-fuzz";
+    sdfccd_CaseRun* run = NULL;
+    sdfccd_Status st = sdfccd_run_case_memory((const char*)data, size, &def, &run);
+    if (st != SDFCCD_OK) {
+        FZ_CHECK(run == NULL, "a failed run returned rows");
+        FZ_CHECK(sdfccd_last_error()[0] != '\0', "status %d without a message", (int)st);
+    } else {
+        const sdfccd_CaseRow* rows = sdfccd_case_run_rows(run);
+        for (int64_t i = 0; i < sdfccd_case_run_row_count(run); ++i) {
+            FZ_CHECK(rows[i].state >= 0 && rows[i].state < SDFCCD_CASE_STATE_COUNT, "row %lld: state %d", (long long)i,
+                     (int)rows[i].state);
+            FZ_CHECK(!rows[i].hit || (isfinite(rows[i].toi) && isfinite(rows[i].point.x) && isfinite(rows[i].normal.z)),
+                     "row %lld: a hit with non-finite values", (long long)i);
+        }
+        sdfccd_destroy_case_run(run);
+    }
     FZ_CHECK(sdfccd_byte_count() == g_bytes, "%lld bytes left after a case file", (long long)(sdfccd_byte_count() - g_bytes));
     return 0;
 }

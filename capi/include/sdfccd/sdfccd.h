@@ -11,5 +11,6 @@
 #include "extract.h"
 #include "grid.h"
 #include "contact.h"
+#include "cases.h"
 
 #endif
