@@ -283,6 +283,11 @@ static Outcome fire(const Shuriken& sh, btGImpactMeshShape* mesh, btCollisionSha
         if (minPhiOnSegment(T.exact, c0, c1, -0.4 * T.thickness) < -0.4 * T.thickness) o.crossed = true;
         const double pen = penetration(sh, T.exact, body.getWorldTransform(), pts, phi);
         if (pen > kMaxPenetration && o.first_deep_step < 0) o.first_deep_step = step;
+        if (std::getenv("SDFCCD_BATTERY_TRACE"))
+            std::printf("    step %d: centre (%.4f %.4f %.4f) v (%.2f %.2f %.2f) w %.1f, deepest %.5f m%s\n", step, (double)c1.x(), (double)c1.y(),
+                        (double)c1.z(), (double)body.getLinearVelocity().x(), (double)body.getLinearVelocity().y(),
+                        (double)body.getLinearVelocity().z(), (double)body.getAngularVelocity().length(), pen,
+                        bridge ? (" rollbacks " + std::to_string(bridge->stats().rollbacks)).c_str() : "");
         o.max_pen = std::max(o.max_pen, pen);
     }
     if (bridge) *stats = bridge->stats();
@@ -351,7 +356,9 @@ int main(int argc, char** argv)
     int crossed = 0, deep = 0;
     double worst = 0;
     int64_t query_errors = 0, hits = 0;
+    const char* only = std::getenv("SDFCCD_BATTERY_SHOT");
     for (size_t i = 0; i < shots.size(); ++i) {
+        if (only && std::atoi(only) != (int)i) continue;
         const Shot& s = shots[i];
         const Target& T = targets[s.target];
         SdfShape shape(T.collide);
