@@ -118,6 +118,11 @@ typedef struct scc_mesh_motion {
     const scc_vec3* end;        /* linear: world vertices at t1 */
     const scc_rigid* sdf;       /* NULL: static SDF */
     double t0, t1;
+    /* Optional per-triangle contact levels (NULL: params->margin for every triangle): triangle t is in
+     * contact when phi <= tri_margin[t]. Each must be <= params->margin, which the broad phase culls
+     * with; -INFINITY leaves the triangle out. Used by the guard (guard.c); the FWGSS vertex traces are
+     * then kept per triangle, since a vertex's neighbours may have different levels. */
+    const double* tri_margin;
 } scc_mesh_motion;
 
 /* The inputs of one mesh query: the field, the mesh's motion, the parameters and the scratch

@@ -92,6 +92,10 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
         c->budget_exhausted = 1;
         return 1;
     }
+    if (mm->tri_margin) {
+        if (!(mm->tri_margin[t] > -INFINITY)) return 1; /* left out by the caller */
+        tp.margin = mm->tri_margin[t];
+    }
     scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     double tb = fmin(mm->t1, c->best + p->toi_window);
     scc_tri_motion m;
@@ -230,7 +234,7 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     c.traces = NULL;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
     int ok = 1;
-    if (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0 && mm->mesh->vertex_count > 0) {
+    if (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0 && mm->mesh->vertex_count > 0 && !mm->tri_margin) {
         /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
         size_t need = (size_t)mm->mesh->vertex_count * sizeof *c.traces;
         int fresh = ws->slot[SCC_WS_TRACES].bytes < need;

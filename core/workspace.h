@@ -12,7 +12,8 @@
 #include "alloc.h"
 
 enum {
-    SCC_WS_CONTACTS,  /* mesh query: contacts of the triangles within the TOI window */
+    SCC_WS_CONTACTS,  /* mesh query: contacts of the triangles within the TOI window; after a query it
+                         holds all sum->contacts_found of them, earliest first */
     SCC_WS_HEAP,      /* broad phase: earliest-candidate heap */
     SCC_WS_SEGMENTS,  /* broad phase: time segments */
     SCC_WS_TESTED,    /* broad phase: one bit per triangle */
@@ -21,6 +22,7 @@ enum {
     SCC_WS_STAGING,   /* the ABI: contacts before conversion to the world frame */
     SCC_WS_VERTICES,  /* the ABI: linear-motion vertex copies */
     SCC_WS_TRACES,    /* mesh query: one FWGSS vertex trace record per mesh vertex (motion.h) */
+    SCC_WS_GUARD,     /* guard: per-triangle contact levels (guard.c) */
     SCC_WS_SLOTS
 };
 

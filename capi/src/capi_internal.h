@@ -15,6 +15,7 @@
 #include "../../core/alloc.h"
 #include "../../core/mesh.h"
 #include "../../core/sdf.h"
+#include "../../core/workspace.h"
 
 /* ---- allocation (counted; routed to the user's hooks) ---- */
 void* sdfccd__alloc(size_t size);          /* NULL on failure (no message set) */
@@ -147,5 +148,25 @@ sdfccd_Status sdfccd__mesh_topology_message(const struct scc_mesh_topology* t, c
  * this header does not pull in core/ccd.h. */
 struct scc_params;
 sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* fn, struct scc_params* out);
+
+/* ---- query arguments (ccd_api.c), shared by every call that runs a query ---- */
+struct scc_rigid;
+/* A public rigid motion over [t0, t1] (validated: finite, within SDFCCD_MAX_QUERY_MAGNITUDE and
+ * SDFCCD_MAX_ROTATION_ANGLE) as the core's; `what` names it in messages. */
+sdfccd_Status sdfccd__convert_motion(const sdfccd_RigidMotion* in, double t0, double t1, const char* what, struct scc_rigid* out);
+/* The body's and the SDF's rotations together within SDFCCD_MAX_ROTATION_ANGLE (`sdf` may be NULL). */
+sdfccd_Status sdfccd__check_total_rotation(const struct scc_rigid* body, const struct scc_rigid* sdf, double dt, const char* fn);
+/* Finite t0 <= t1 with a finite difference. */
+sdfccd_Status sdfccd__check_interval(double t0, double t1, const char* fn);
+/* The public result state of a core scc_state (core/ccd.h). */
+sdfccd_ResultState sdfccd__public_state(int core_state);
+/* The mesh's coordinates within SDFCCD_MAX_QUERY_MAGNITUDE. */
+sdfccd_Status sdfccd__check_mesh_bounds(const sdfccd__mesh* m, const char* fn);
+
+/* A caller-kept workspace: the mesh query's scratch storage, reused from call to call. */
+struct sdfccd_Workspace {
+    scc_workspace ws;
+};
+
 
 #endif

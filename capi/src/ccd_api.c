@@ -89,7 +89,7 @@ static sdfccd_Status check_magnitude(sdfccd_Vec3 v, const char* what)
     return SDFCCD_OK;
 }
 
-static sdfccd_Status convert_motion(const sdfccd_RigidMotion* in, double t0, double t1, const char* what, scc_rigid* out)
+sdfccd_Status sdfccd__convert_motion(const sdfccd_RigidMotion* in, double t0, double t1, const char* what, scc_rigid* out)
 {
     sdfccd_Status st;
     scc_xform xf;
@@ -97,7 +97,7 @@ static sdfccd_Status convert_motion(const sdfccd_RigidMotion* in, double t0, dou
     if ((st = check_magnitude(in->pose.position, what)) || (st = check_magnitude(in->local_center, what)) ||
         (st = check_magnitude(in->linear_velocity, what)) || (st = check_magnitude(in->angular_velocity, what)))
         return st;
-    /* Lengths of vectors within the magnitude limit do not overflow; t1 - t0 is finite (check_interval). */
+    /* Lengths of vectors within the magnitude limit do not overflow; t1 - t0 is finite (sdfccd__check_interval). */
     double dt = t1 - t0;
     double shift = scc_len(sdfccd__v(in->linear_velocity)) * dt;
     if (!(shift <= SDFCCD_MAX_QUERY_MAGNITUDE))
@@ -117,7 +117,7 @@ static sdfccd_Status convert_motion(const sdfccd_RigidMotion* in, double t0, dou
 }
 
 /* The body's and the SDF's rotations add up: their sum must stay within SDFCCD_MAX_ROTATION_ANGLE. */
-static sdfccd_Status check_total_rotation(const scc_rigid* body, const scc_rigid* sdf, double dt, const char* fn)
+sdfccd_Status sdfccd__check_total_rotation(const scc_rigid* body, const scc_rigid* sdf, double dt, const char* fn)
 {
     double angle = (scc_len(body->w) + (sdf ? scc_len(sdf->w) : 0.0)) * dt;
     if (!(angle <= SDFCCD_MAX_ROTATION_ANGLE))
@@ -127,7 +127,7 @@ static sdfccd_Status check_total_rotation(const scc_rigid* body, const scc_rigid
     return SDFCCD_OK;
 }
 
-static sdfccd_Status check_mesh_bounds(const sdfccd__mesh* m, const char* fn)
+sdfccd_Status sdfccd__check_mesh_bounds(const sdfccd__mesh* m, const char* fn)
 {
     double b = fmax(scc_maxc(scc_vabs(m->mesh.bounds.lo)), scc_maxc(scc_vabs(m->mesh.bounds.hi)));
     if (!(b <= SDFCCD_MAX_QUERY_MAGNITUDE))
@@ -136,7 +136,7 @@ static sdfccd_Status check_mesh_bounds(const sdfccd__mesh* m, const char* fn)
     return SDFCCD_OK;
 }
 
-static sdfccd_Status check_interval(double t0, double t1, const char* fn)
+sdfccd_Status sdfccd__check_interval(double t0, double t1, const char* fn)
 {
     if (!isfinite(t0) || !isfinite(t1)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: t0 and t1 must be finite (got %g, %g)", fn, t0, t1);
     if (t1 < t0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: t1 (%g) < t0 (%g)", fn, t1, t0);
@@ -162,11 +162,11 @@ static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motio
     if ((st = sdfccd__check_ptr(out_result, what))) return st;
     if (capacity < 0 || (capacity > 0 && !out_contacts))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_contacts is NULL or capacity (%d) < 0", fn, capacity);
-    if ((st = sdfccd__convert_params(params, fn, &q->p)) || (st = check_interval(t0, t1, fn))) return st;
+    if ((st = sdfccd__convert_params(params, fn, &q->p)) || (st = sdfccd__check_interval(t0, t1, fn))) return st;
     q->sdf_motion_ptr = NULL;
     if (sdf_motion) {
         snprintf(what, sizeof what, "%s: sdf_motion", fn);
-        if ((st = convert_motion(sdf_motion, t0, t1, what, &q->sdf_motion))) return st;
+        if ((st = sdfccd__convert_motion(sdf_motion, t0, t1, what, &q->sdf_motion))) return st;
         q->sdf_motion_ptr = &q->sdf_motion;
     }
     q->sdf = sdfccd__sdf_acquire(sdf); /* held until the public call returns (SDFCCD__HELD_CALL) */
@@ -174,7 +174,7 @@ static sdfccd_Status setup(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motio
     return SDFCCD_OK;
 }
 
-static sdfccd_ResultState public_state(scc_state s)
+sdfccd_ResultState sdfccd__public_state(int s)
 {
     switch (s) {
     case SCC_HIT: return SDFCCD_STATE_HIT;
@@ -188,7 +188,7 @@ static sdfccd_ResultState public_state(scc_state s)
 static void write_result(const query_setup* q, double t0, double t1, const scc_query_summary* s, const scc_contact* c,
                          sdfccd_Contact* out, int32_t capacity, sdfccd_QueryResult* r)
 {
-    r->state = public_state(s->state);
+    r->state = sdfccd__public_state(s->state);
     r->hit = s->hit;
     r->toi = s->toi;
     r->toi_lower = s->toi_lower;
@@ -240,8 +240,8 @@ static sdfccd_Status query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* 
         m.local[i] = sdfccd__v(triangle[i]);
     }
     if (scc_triangle_is_degenerate(m.local[0], m.local[1], m.local[2])) return sdfccd__error(SDFCCD_DEGENERATE, "%s: the triangle has zero area", fn);
-    if ((st = convert_motion(motion, t0, t1, "sdfccd_query_triangle: motion", &body))) return st;
-    if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
+    if ((st = sdfccd__convert_motion(motion, t0, t1, "sdfccd_query_triangle: motion", &body))) return st;
+    if ((st = sdfccd__check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
     m.kind = SCC_TRI_RIGID;
     m.body = &body;
     m.sdf = q.sdf_motion_ptr;
@@ -276,11 +276,6 @@ static sdfccd_Status query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
     m.t1 = t1;
     return run_triangle(&q, &m, t0, t1, out_contacts, capacity, out_result, fn);
 }
-
-/* A caller-kept workspace: the mesh query's scratch storage, reused from call to call. */
-struct sdfccd_Workspace {
-    scc_workspace ws;
-};
 
 sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3],
                                     const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
@@ -344,12 +339,12 @@ static sdfccd_Status query_mesh(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, c
     snprintf(what, sizeof what, "%s: motion", fn);
     if ((st = sdfccd__check_ptr(motion, what))) return st;
     scc_rigid body;
-    if ((st = convert_motion(motion, t0, t1, what, &body))) return st;
-    if ((st = check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
+    if ((st = sdfccd__convert_motion(motion, t0, t1, what, &body))) return st;
+    if ((st = sdfccd__check_total_rotation(&body, q.sdf_motion_ptr, t1 - t0, fn))) return st;
     sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
-    if ((st = check_mesh_bounds(m, fn))) return st;
-    scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1 };
+    if ((st = sdfccd__check_mesh_bounds(m, fn))) return st;
+    scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1, NULL };
     if (workspace) return run_mesh(&q, &mm, &workspace->ws, out_contacts, capacity, out_result, fn);
     scc_workspace tmp;
     scc_ws_init(&tmp, sdfccd__allocator());
@@ -408,7 +403,7 @@ static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId
         v[i] = sdfccd__v(start[i]);
         v[nv + i] = sdfccd__v(end[i]);
     }
-    scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1 };
+    scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1, NULL };
     st = run_mesh(&q, &mm, ws, out_contacts, capacity, out_result, fn);
     scc_ws_release(&tmp);
     return st;

@@ -97,3 +97,12 @@ sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void)
     d.bounds.hi.x = d.bounds.hi.y = d.bounds.hi.z = INFINITY;
     return d;
 }
+
+sdfccd_GuardParams sdfccd_default_guard_params(void)
+{
+    sdfccd_GuardParams g;
+    SDFCCD__DEF_BEGIN(g);
+    g.tolerance = 5e-4;
+    g.query = sdfccd_default_query_params();
+    return g;
+}

@@ -10,5 +10,6 @@
 #include "ccd.h"
 #include "extract.h"
 #include "grid.h"
+#include "contact.h"
 
 #endif

@@ -1,0 +1,603 @@
+/* SPDX-License-Identifier: MIT
+ * The no-tunnelling guarantee (contact.h, issue 19 item 2): sdfccd_guard_rigid and
+ * sdfccd_rigid_motion_from_poses, public ABI only. Every time of impact is compared with a closed
+ * form (and the certified method where the motion allows), and every safe pose is checked by brute
+ * force: phi at the vertices and on a barycentric grid of every triangle. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "test_util.h"
+
+/* GUARD_VERBOSE=1 prints the measured figures (TOI against the exact one, depth at the safe pose). */
+#define REPORT(...) do { if (getenv("GUARD_VERBOSE")) { printf(__VA_ARGS__); fflush(stdout); } } while (0)
+
+enum { DIVS_MAX = 16 };
+static const double DT = 1.0 / 60.0;
+static const double TOL = 5e-4; /* the default guard tolerance */
+
+/* A box mesh [-h, h] with each face split into a grid (n[k] cells along axis k), kept for brute force. */
+typedef struct box_mesh {
+    sdfccd_MeshId id;
+    double* v;
+    uint32_t* f;
+    uint32_t nv, nt;
+} box_mesh;
+
+static box_mesh make_box(double hx, double hy, double hz, int nx, int ny, int nz)
+{
+    const double h[3] = { hx, hy, hz };
+    const int n[3] = { nx, ny, nz };
+    box_mesh b;
+    size_t maxv = 0, maxt = 0;
+    for (int k = 0; k < 3; ++k) {
+        int u = (k + 1) % 3, w = (k + 2) % 3;
+        maxv += 2 * (size_t)(n[u] + 1) * (n[w] + 1);
+        maxt += 4 * (size_t)n[u] * n[w];
+    }
+    b.v = malloc(3 * maxv * sizeof *b.v);
+    b.f = malloc(3 * maxt * sizeof *b.f);
+    b.nv = b.nt = 0;
+    for (int k = 0; k < 3; ++k)
+        for (int s = -1; s <= 1; s += 2) {
+            int u = (k + 1) % 3, w = (k + 2) % 3;
+            uint32_t base = b.nv;
+            for (int i = 0; i <= n[u]; ++i)
+                for (int j = 0; j <= n[w]; ++j) {
+                    double* p = b.v + 3 * b.nv++;
+                    p[k] = s * h[k];
+                    p[u] = -h[u] + 2.0 * h[u] * i / n[u];
+                    p[w] = -h[w] + 2.0 * h[w] * j / n[w];
+                }
+            for (int i = 0; i < n[u]; ++i)
+                for (int j = 0; j < n[w]; ++j) {
+                    uint32_t a = base + (uint32_t)(i * (n[w] + 1) + j), c = a + (uint32_t)(n[w] + 1);
+                    uint32_t q[4] = { a, c, c + 1, a + 1 };
+                    if (s < 0) { uint32_t t = q[1]; q[1] = q[3]; q[3] = t; } /* outward winding */
+                    uint32_t* f = b.f + 3 * b.nt;
+                    f[0] = q[0]; f[1] = q[1]; f[2] = q[2];
+                    f[3] = q[0]; f[4] = q[2]; f[5] = q[3];
+                    b.nt += 2;
+                }
+        }
+    sdfccd_MeshDef d = sdfccd_default_mesh_def();
+    d.vertices = b.v;
+    d.vertex_count = b.nv;
+    d.indices = b.f;
+    d.triangle_count = b.nt;
+    ck_assert_msg(sdfccd_create_mesh(&d, &b.id) == SDFCCD_OK, "%s", sdfccd_last_error());
+    return b;
+}
+
+static void free_box(box_mesh* b)
+{
+    ck_assert_int_eq(sdfccd_destroy_mesh(b->id), SDFCCD_OK);
+    free(b->v);
+    free(b->f);
+}
+
+/* A box SDF of half extents `half` centred at `c`. */
+static sdfccd_SdfId box_at(sdfccd_Vec3 half, sdfccd_Vec3 c)
+{
+    sdfccd_SdfId box, moved;
+    ck_assert_int_eq(sdfccd_create_box(half, &box), SDFCCD_OK);
+    sdfccd_Pose pose = sdfccd_pose_identity();
+    pose.position = c;
+    ck_assert_int_eq(sdfccd_create_transformed(box, pose, 1.0, &moved), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(box), SDFCCD_OK);
+    return moved;
+}
+
+static sdfccd_Vec3 v3(double x, double y, double z) { return (sdfccd_Vec3){ x, y, z }; }
+
+static sdfccd_Vec3 rotate(sdfccd_Quat q, sdfccd_Vec3 v)
+{
+    /* v + 2w (u x v) + 2 u x (u x v) */
+    double tx = 2 * (q.y * v.z - q.z * v.y), ty = 2 * (q.z * v.x - q.x * v.z), tz = 2 * (q.x * v.y - q.y * v.x);
+    return v3(v.x + q.w * tx + (q.y * tz - q.z * ty), v.y + q.w * ty + (q.z * tx - q.x * tz), v.z + q.w * tz + (q.x * ty - q.y * tx));
+}
+
+static sdfccd_Quat axis_angle(sdfccd_Vec3 axis, double angle)
+{
+    double l = sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z), s = sin(0.5 * angle) / l;
+    return (sdfccd_Quat){ cos(0.5 * angle), axis.x * s, axis.y * s, axis.z * s };
+}
+
+static sdfccd_Quat qmul(sdfccd_Quat a, sdfccd_Quat b)
+{
+    return (sdfccd_Quat){ a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+                          a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w };
+}
+
+/* Brute force: the smallest phi over the mesh at `pose`, at the vertices and on a barycentric grid
+ * of 12 steps per edge of every triangle (SDF static; world point = pose applied to the local one). */
+static double min_phi_at(sdfccd_SdfId sdf, const box_mesh* b, sdfccd_Pose pose)
+{
+    enum { K = 12 };
+    double best = INFINITY;
+    for (uint32_t t = 0; t < b->nt; ++t) {
+        const double* a = b->v + 3 * b->f[3 * t];
+        const double* c = b->v + 3 * b->f[3 * t + 1];
+        const double* d = b->v + 3 * b->f[3 * t + 2];
+        for (int i = 0; i <= K; ++i)
+            for (int j = 0; i + j <= K; ++j) {
+                double u = (double)i / K, w = (double)j / K, s = 1.0 - u - w;
+                sdfccd_Vec3 local = v3(s * a[0] + u * c[0] + w * d[0], s * a[1] + u * c[1] + w * d[1], s * a[2] + u * c[2] + w * d[2]);
+                sdfccd_Vec3 r = rotate(pose.orientation, local);
+                sdfccd_Vec3 x = v3(r.x + pose.position.x, r.y + pose.position.y, r.z + pose.position.z);
+                double phi;
+                ck_assert_int_eq(sdfccd_sdf_eval(sdf, x, &phi, NULL), SDFCCD_OK);
+                best = fmin(best, phi);
+            }
+    }
+    return best;
+}
+
+/* The pose of Eq. 14 at time t (t0 = 0, centre at the local origin). */
+static sdfccd_Pose pose_at(const sdfccd_RigidMotion* m, double t)
+{
+    sdfccd_Vec3 w = m->angular_velocity;
+    double a = sqrt(w.x * w.x + w.y * w.y + w.z * w.z) * t;
+    sdfccd_Pose p;
+    p.orientation = a > 0 ? qmul(axis_angle(w, a), m->pose.orientation) : m->pose.orientation;
+    p.position = v3(m->pose.position.x + m->linear_velocity.x * t, m->pose.position.y + m->linear_velocity.y * t,
+                    m->pose.position.z + m->linear_velocity.z * t);
+    return p;
+}
+
+static void assert_pose_near(sdfccd_Pose a, sdfccd_Pose b, double tol)
+{
+    ck_assert_double_near(a.position.x, b.position.x, tol);
+    ck_assert_double_near(a.position.y, b.position.y, tol);
+    ck_assert_double_near(a.position.z, b.position.z, tol);
+    double sign = a.orientation.w * b.orientation.w + a.orientation.x * b.orientation.x + a.orientation.y * b.orientation.y +
+                  a.orientation.z * b.orientation.z < 0 ? -1.0 : 1.0;
+    ck_assert_double_near(a.orientation.w, sign * b.orientation.w, tol);
+    ck_assert_double_near(a.orientation.x, sign * b.orientation.x, tol);
+    ck_assert_double_near(a.orientation.y, sign * b.orientation.y, tol);
+    ck_assert_double_near(a.orientation.z, sign * b.orientation.z, tol);
+}
+
+static sdfccd_GuardResult guard(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                const sdfccd_RigidMotion* m, const sdfccd_GuardParams* gp)
+{
+    sdfccd_GuardResult r;
+    ck_assert_msg(sdfccd_guard_rigid(ws, sdf, sdf_motion, mesh, m, 0.0, DT, gp, &r) == SDFCCD_OK, "%s", sdfccd_last_error());
+    return r;
+}
+
+/* A rod (half extents R, A, A along x, y, z) spinning about z from rest across a 1 cm wall whose
+ * face is the plane y = H (x in [0.1, 1]): the corner (R, A) reaches the level y = H + TOL first,
+ * at angle asin((H + TOL) / sqrt(R^2 + A^2)) - atan2(A, R). Start and end poses are clear of the wall. */
+static const double ROD_R = 0.2, ROD_A = 0.01, WALL_H = 0.1;
+
+static void spin_through_wall(double total_angle, sdfccd_Method method)
+{
+    box_mesh rod = make_box(ROD_R, ROD_A, ROD_A, 10, 1, 1);
+    sdfccd_SdfId wall = box_at(v3(0.45, 0.005, 1), v3(0.55, WALL_H + 0.005, 0));
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    gp.query.method = method;
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.angular_velocity = v3(0, 0, total_angle / DT);
+    sdfccd_Pose end = pose_at(&m, DT);
+    ck_assert(min_phi_at(wall, &rod, m.pose) > 0.05);
+    ck_assert(min_phi_at(wall, &rod, end) > 0.0); /* the end pose is beyond (or beside) the wall */
+    double theta = asin((WALL_H + TOL) / hypot(ROD_R, ROD_A)) - atan2(ROD_A, ROD_R);
+    double t_exact = theta / (total_angle / DT);
+
+    sdfccd_GuardResult r = guard(ws, wall, NULL, rod.id, &m, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    ck_assert_int_eq(r.deep_triangles, 0);
+    ck_assert_int_eq(r.queries, 1);
+    /* never past the TOI, and at most a few time tolerances (1e-7 s) before it */
+    REPORT("%s: toi - exact %.3g s, evals %lld\n", __func__, r.toi - t_exact, (long long)r.sdf_evaluations);
+    ck_assert_msg(r.toi <= t_exact && r.toi >= t_exact - 3e-7, "toi %.12g, exact %.12g", r.toi, t_exact);
+    ck_assert_double_near(r.fraction, r.toi / DT, 1e-15);
+    assert_pose_near(r.safe_pose, pose_at(&m, r.toi), 1e-12);
+    double depth = min_phi_at(wall, &rod, r.safe_pose);
+    REPORT("%s: min phi at the safe pose %.9g\n", __func__, depth);
+    ck_assert_msg(depth >= -TOL && depth <= -0.8 * TOL, "min phi at the safe pose %.9g", depth);
+    ck_assert_double_near(r.normal.y, -1.0, 1e-9); /* out of the wall's face */
+    ck_assert_double_near(r.point.y, WALL_H + TOL, 0.1 * TOL);
+    ck_assert(r.min_gap_start > 0.05);
+
+    if (method != SDFCCD_METHOD_CERTIFIED) {
+        /* the certified method brackets the same TOI: the guard is never later */
+        sdfccd_QueryParams cp = sdfccd_default_query_params();
+        cp.method = SDFCCD_METHOD_CERTIFIED;
+        cp.margin = -TOL;
+        sdfccd_QueryResult q;
+        ck_assert_int_eq(sdfccd_query_mesh_ws(ws, wall, NULL, rod.id, &m, 0.0, DT, &cp, NULL, 0, &q), SDFCCD_OK);
+        ck_assert_int_eq(q.state, SDFCCD_STATE_HIT);
+        ck_assert(q.toi_lower <= t_exact + 1e-12 && q.toi >= t_exact - 1e-12);
+        ck_assert(r.toi <= q.toi && r.toi >= q.toi_lower - 3e-7);
+    }
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    free_box(&rod);
+}
+
+START_TEST(test_spun_through_thin_wall)
+{
+    spin_through_wall(1.5, SDFCCD_METHOD_FWGSS); /* 90 rad/s for one 60 Hz step */
+}
+END_TEST
+
+START_TEST(test_spun_more_than_a_turn)
+{
+    spin_through_wall(2 * M_PI + 1.5, SDFCCD_METHOD_FWGSS); /* > 2 pi in one step: the CCD splits it */
+}
+END_TEST
+
+START_TEST(test_spun_certified)
+{
+    spin_through_wall(1.5, SDFCCD_METHOD_CERTIFIED);
+}
+END_TEST
+
+/* A 4 mm plate, 10 cm wide, tilted 45 degrees, at 500 m/s across a 1 cm wall (x in [0, 0.01]):
+ * start and end poses both outside the wall. Its leading edge reaches x = TOL at
+ * (TOL - x_lead) / 500 with x_lead = -0.1 + (0.05 + 0.002) / sqrt(2). */
+START_TEST(test_fast_tilted_plate)
+{
+    box_mesh plate = make_box(0.05, 0.002, 0.05, 4, 1, 4);
+    sdfccd_SdfId wall = box_at(v3(0.005, 1, 1), v3(0.005, 0, 0));
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position = v3(-0.1, 0, 0);
+    m.pose.orientation = axis_angle(v3(0, 0, 1), M_PI / 4);
+    m.linear_velocity = v3(500, 0, 0);
+    ck_assert(min_phi_at(wall, &plate, m.pose) > 0.06);
+    ck_assert(min_phi_at(wall, &plate, pose_at(&m, DT)) > 8.0);
+    double t_exact = (TOL - (-0.1 + 0.052 / sqrt(2.0))) / 500.0;
+    sdfccd_GuardResult r = guard(ws, wall, NULL, plate.id, &m, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    REPORT("%s: toi - exact %.3g s, evals %lld\n", __func__, r.toi - t_exact, (long long)r.sdf_evaluations);
+    ck_assert_msg(r.toi <= t_exact && r.toi >= t_exact - 3e-7, "toi %.12g, exact %.12g", r.toi, t_exact);
+    double depth = min_phi_at(wall, &plate, r.safe_pose);
+    REPORT("%s: min phi at the safe pose %.9g\n", __func__, depth);
+    ck_assert_msg(depth >= -TOL && depth <= -0.8 * TOL, "min phi at the safe pose %.9g", depth);
+    ck_assert_double_near(r.normal.x, -1.0, 1e-9);
+    /* with the plate spinning about its normal as well, still caught before the wall */
+    m.angular_velocity = v3(0, 200, 0);
+    r = guard(ws, wall, NULL, plate.id, &m, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    depth = min_phi_at(wall, &plate, r.safe_pose);
+    REPORT("%s: min phi at the safe pose %.9g\n", __func__, depth);
+    ck_assert_msg(depth >= -TOL && depth <= -0.8 * TOL, "min phi at the safe pose %.9g", depth);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    free_box(&plate);
+}
+END_TEST
+
+/* A body moving and spinning away from the wall: CLEAR, and the safe pose is the end pose. */
+START_TEST(test_moving_away_is_clear)
+{
+    box_mesh rod = make_box(ROD_R, ROD_A, ROD_A, 10, 1, 1);
+    sdfccd_SdfId wall = box_at(v3(1, 0.005, 1), v3(0, WALL_H + 0.005, 0));
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    /* from two poses, as an engine that only has them would do */
+    sdfccd_Pose start = sdfccd_pose_identity(), end;
+    start.position = v3(0, 0.09 - ROD_A, 0); /* 1 cm below the wall */
+    end.position = v3(0.3, -0.5, 0.1);
+    end.orientation = axis_angle(v3(0.2, 0.1, 1), 2.0);
+    sdfccd_RigidMotion m;
+    ck_assert_int_eq(sdfccd_rigid_motion_from_poses(&start, &end, v3(0, 0, 0), 0.0, DT, &m), SDFCCD_OK);
+    sdfccd_GuardResult r = guard(ws, wall, NULL, rod.id, &m, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_CLEAR);
+    ck_assert(r.toi == DT);
+    ck_assert(r.fraction == 1.0);
+    assert_pose_near(r.safe_pose, end, 1e-12);
+    ck_assert(r.normal.x == 0 && r.normal.y == 0 && r.normal.z == 0);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    free_box(&rod);
+}
+END_TEST
+
+/* A 10 cm cube whose bottom starts 2 mm inside a ground (top face y = 0) and, in the third case,
+ * a 1 cm wall (x in [0.1, 0.11], above the ground) made one SDF with it. */
+typedef struct inside_scene {
+    box_mesh cube;
+    sdfccd_SdfId ground, wall, both;
+    sdfccd_Workspace* ws;
+    sdfccd_GuardParams gp;
+    sdfccd_RigidMotion m;
+} inside_scene;
+
+static void inside_setup(inside_scene* s)
+{
+    s->cube = make_box(0.05, 0.05, 0.05, 4, 4, 4);
+    s->ground = box_at(v3(1, 0.05, 1), v3(0, -0.05, 0));
+    s->wall = box_at(v3(0.005, 0.25, 1), v3(0.105, 0.25, 0));
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_UNION, s->ground, s->wall, &s->both), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_workspace(&s->ws), SDFCCD_OK);
+    s->gp = sdfccd_default_guard_params();
+    s->m = sdfccd_default_rigid_motion();
+    s->m.pose.position = v3(0, 0.05 - 0.002, 0);
+    ck_assert_double_near(min_phi_at(s->ground, &s->cube, s->m.pose), -0.002, 1e-12);
+}
+
+static void inside_teardown(inside_scene* s)
+{
+    sdfccd_destroy_workspace(s->ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(s->both), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(s->wall), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(s->ground), SDFCCD_OK);
+    free_box(&s->cube);
+}
+
+START_TEST(test_inside_at_start_left_to_contacts)
+{
+    inside_scene s;
+    inside_setup(&s);
+    /* resting 2 mm deep and sliding 1 mm: not frozen, the pose advances */
+    s.m.linear_velocity = v3(0.06, 0, 0);
+    sdfccd_GuardResult r = guard(s.ws, s.ground, NULL, s.cube.id, &s.m, &s.gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_INSIDE_AT_START);
+    ck_assert(r.toi == DT);
+    assert_pose_near(r.safe_pose, pose_at(&s.m, DT), 1e-12);
+    ck_assert_int_gt(r.deep_triangles, 0);
+    ck_assert_int_eq(r.queries, 2);
+    ck_assert_double_near(r.min_gap_start, -0.002, 1e-9);
+    /* at rest (a body the contacts hold): the same */
+    s.m.linear_velocity = v3(0, 0, 0);
+    r = guard(s.ws, s.ground, NULL, s.cube.id, &s.m, &s.gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_INSIDE_AT_START);
+    ck_assert(r.toi == DT);
+    inside_teardown(&s);
+}
+END_TEST
+
+START_TEST(test_inside_at_start_sinking_further)
+{
+    inside_scene s;
+    inside_setup(&s);
+    /* sinking 1 mm more in the step: stopped once it is TOL deeper than it started */
+    s.m.linear_velocity = v3(0, -0.06, 0);
+    double t_exact = TOL / 0.06;
+    sdfccd_GuardResult r = guard(s.ws, s.ground, NULL, s.cube.id, &s.m, &s.gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    REPORT("%s: toi - exact %.3g s, evals %lld\n", __func__, r.toi - t_exact, (long long)r.sdf_evaluations);
+    ck_assert_msg(r.toi <= t_exact && r.toi >= t_exact - 3e-7, "toi %.12g, exact %.12g", r.toi, t_exact);
+    double depth = min_phi_at(s.ground, &s.cube, r.safe_pose);
+    ck_assert_msg(depth >= -0.002 - TOL && depth <= -0.002 - 0.8 * TOL, "min phi at the safe pose %.9g", depth);
+    ck_assert_double_near(r.normal.y, 1.0, 1e-9);
+    inside_teardown(&s);
+}
+END_TEST
+
+START_TEST(test_inside_at_start_rest_guarded)
+{
+    inside_scene s;
+    inside_setup(&s);
+    /* 2 mm in the ground and thrown at 30 m/s into the wall: the cube's side above the ground is
+     * guarded at the level -TOL, reached at (0.05 + TOL) / 30 */
+    s.m.linear_velocity = v3(30, 0, 0);
+    ck_assert(min_phi_at(s.wall, &s.cube, pose_at(&s.m, DT)) > 0.2); /* beyond the wall at the end */
+    double t_exact = (0.05 + TOL) / 30.0;
+    sdfccd_GuardResult r = guard(s.ws, s.both, NULL, s.cube.id, &s.m, &s.gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    ck_assert_int_gt(r.deep_triangles, 0);
+    REPORT("%s: toi - exact %.3g s, evals %lld\n", __func__, r.toi - t_exact, (long long)r.sdf_evaluations);
+    ck_assert_msg(r.toi <= t_exact && r.toi >= t_exact - 3e-7, "toi %.12g, exact %.12g", r.toi, t_exact);
+    double depth = min_phi_at(s.wall, &s.cube, r.safe_pose);
+    ck_assert_msg(depth >= -TOL && depth <= -0.8 * TOL, "min phi in the wall at the safe pose %.9g", depth);
+    ck_assert_double_near(r.normal.x, -1.0, 1e-9);
+    inside_teardown(&s);
+}
+END_TEST
+
+/* The wall moves at 20 m/s onto a resting rod (top face y = ROD_A): it is TOL into the rod at
+ * (WALL_H - ROD_A + TOL) / 20, and has passed it by the end of the step. */
+START_TEST(test_moving_sdf)
+{
+    box_mesh rod = make_box(ROD_R, ROD_A, ROD_A, 10, 1, 1);
+    sdfccd_SdfId wall = box_at(v3(1, 0.005, 1), v3(0, WALL_H + 0.005, 0));
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    sdfccd_RigidMotion body = sdfccd_default_rigid_motion(), sm = sdfccd_default_rigid_motion();
+    sm.linear_velocity = v3(0, -20, 0);
+    double t_exact = (WALL_H - ROD_A + TOL) / 20.0;
+    sdfccd_GuardResult r = guard(ws, wall, &sm, rod.id, &body, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    REPORT("%s: toi - exact %.3g s, evals %lld\n", __func__, r.toi - t_exact, (long long)r.sdf_evaluations);
+    ck_assert_msg(r.toi <= t_exact && r.toi >= t_exact - 3e-7, "toi %.12g, exact %.12g", r.toi, t_exact);
+    ck_assert_double_near(r.normal.y, -1.0, 1e-9);
+    ck_assert_double_near(r.point.y, ROD_A, 1e-9 + 20 * 3e-7);
+    assert_pose_near(r.safe_pose, sdfccd_pose_identity(), 0.0);
+    /* moving together: clear */
+    body.linear_velocity = sm.linear_velocity;
+    r = guard(ws, wall, &sm, rod.id, &body, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_CLEAR);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    free_box(&rod);
+}
+END_TEST
+
+START_TEST(test_motion_from_poses)
+{
+    test_rng rng = { 19 };
+    for (int i = 0; i < 50; ++i) {
+        sdfccd_Pose a, b;
+        a.position = test_rng_unit_vector(&rng);
+        b.position = test_rng_unit_vector(&rng);
+        a.orientation = axis_angle(test_rng_unit_vector(&rng), test_rng_uniform(&rng, -6, 6));
+        b.orientation = axis_angle(test_rng_unit_vector(&rng), test_rng_uniform(&rng, -6, 6));
+        sdfccd_Vec3 c = v3(0.1, -0.2, 0.05);
+        sdfccd_RigidMotion m;
+        ck_assert_int_eq(sdfccd_rigid_motion_from_poses(&a, &b, c, 1.0, 1.0 + DT, &m), SDFCCD_OK);
+        /* shortest arc: at most pi */
+        sdfccd_Vec3 w = m.angular_velocity;
+        ck_assert(sqrt(w.x * w.x + w.y * w.y + w.z * w.z) * DT <= M_PI + 1e-12);
+        /* Eq. 14 at t1 gives b: the centre moved linearly, the frame turned about it */
+        double ang = sqrt(w.x * w.x + w.y * w.y + w.z * w.z) * DT;
+        sdfccd_Quat q1 = ang > 0 ? qmul(axis_angle(w, ang), a.orientation) : a.orientation;
+        sdfccd_Vec3 ca = rotate(a.orientation, c), c1 = rotate(q1, c);
+        sdfccd_Pose e;
+        e.orientation = q1;
+        e.position = v3(a.position.x + ca.x + m.linear_velocity.x * DT - c1.x, a.position.y + ca.y + m.linear_velocity.y * DT - c1.y,
+                        a.position.z + ca.z + m.linear_velocity.z * DT - c1.z);
+        assert_pose_near(e, b, 1e-12);
+    }
+    /* three quarters of a turn one way is a quarter turn the other way */
+    sdfccd_Pose a = sdfccd_pose_identity(), b = sdfccd_pose_identity();
+    b.orientation = axis_angle(v3(0, 0, 1), 1.5 * M_PI);
+    sdfccd_RigidMotion m;
+    ck_assert_int_eq(sdfccd_rigid_motion_from_poses(&a, &b, v3(0, 0, 0), 0.0, 2.0, &m), SDFCCD_OK);
+    ck_assert_double_near(m.angular_velocity.z, -0.25 * M_PI, 1e-14);
+    ck_assert_double_near(m.angular_velocity.x, 0.0, 1e-14);
+}
+END_TEST
+
+START_TEST(test_bad_input)
+{
+    box_mesh rod = make_box(ROD_R, ROD_A, ROD_A, 2, 1, 1);
+    sdfccd_SdfId wall = box_at(v3(1, 0.005, 1), v3(0, WALL_H + 0.005, 0));
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params(), bad;
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    sdfccd_GuardResult r, untouched;
+    memset(&untouched, 0x5a, sizeof untouched);
+    r = untouched;
+#define EXPECT(call, status)                                                              \
+    do {                                                                                  \
+        ck_assert_int_eq((call), (status));                                               \
+        ck_assert_msg(strlen(sdfccd_last_error()) > 0, "no message");                     \
+        ck_assert(memcmp(&r, &untouched, sizeof r) == 0);                                 \
+    } while (0)
+    EXPECT(sdfccd_guard_rigid(NULL, wall, NULL, rod.id, &m, 0, DT, &gp, &r), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, NULL, 0, DT, &gp, &r), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &m, 0, DT, NULL, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &m, 0, DT, &gp, NULL), SDFCCD_INVALID_ARGUMENT);
+    memset(&bad, 0, sizeof bad);
+    bad.tolerance = 1e-3;
+    bad.query = sdfccd_default_query_params();
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &m, 0, DT, &bad, &r), SDFCCD_INVALID_ARGUMENT); /* no default */
+    const double tols[] = { 0.0, -1e-3, NAN, INFINITY };
+    for (int i = 0; i < 4; ++i) {
+        bad = gp;
+        bad.tolerance = tols[i];
+        EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &m, 0, DT, &bad, &r), SDFCCD_INVALID_ARGUMENT);
+    }
+    bad = gp;
+    bad.query.method = SDFCCD_METHOD_DCD;
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &m, 0, DT, &bad, &r), SDFCCD_INVALID_ARGUMENT);
+    bad = gp;
+    bad.query.time_tolerance = -1;
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &m, 0, DT, &bad, &r), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &m, DT, 0, &gp, &r), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &m, 0, NAN, &gp, &r), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_RigidMotion nan_m = m;
+    nan_m.linear_velocity.y = NAN;
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, rod.id, &nan_m, 0, DT, &gp, &r), SDFCCD_INVALID_ARGUMENT);
+    EXPECT(sdfccd_guard_rigid(ws, wall, &nan_m, rod.id, &m, 0, DT, &gp, &r), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_MeshId null_mesh = { 0, 0 };
+    sdfccd_SdfId null_sdf = { 0, 0 };
+    EXPECT(sdfccd_guard_rigid(ws, wall, NULL, null_mesh, &m, 0, DT, &gp, &r), SDFCCD_INVALID_HANDLE);
+    EXPECT(sdfccd_guard_rigid(ws, null_sdf, NULL, rod.id, &m, 0, DT, &gp, &r), SDFCCD_INVALID_HANDLE);
+
+    sdfccd_Pose a = sdfccd_pose_identity(), b = sdfccd_pose_identity();
+    sdfccd_RigidMotion out, out_untouched;
+    memset(&out_untouched, 0x5a, sizeof out_untouched);
+    out = out_untouched;
+#define EXPECT_POSES(call)                                                                \
+    do {                                                                                  \
+        ck_assert_int_eq((call), SDFCCD_INVALID_ARGUMENT);                                \
+        ck_assert_msg(strlen(sdfccd_last_error()) > 0, "no message");                     \
+        ck_assert(memcmp(&out, &out_untouched, sizeof out) == 0);                         \
+    } while (0)
+    EXPECT_POSES(sdfccd_rigid_motion_from_poses(NULL, &b, v3(0, 0, 0), 0, DT, &out));
+    EXPECT_POSES(sdfccd_rigid_motion_from_poses(&a, NULL, v3(0, 0, 0), 0, DT, &out));
+    ck_assert_int_eq(sdfccd_rigid_motion_from_poses(&a, &b, v3(0, 0, 0), 0, DT, NULL), SDFCCD_INVALID_ARGUMENT);
+    EXPECT_POSES(sdfccd_rigid_motion_from_poses(&a, &b, v3(0, 0, 0), DT, DT, &out));
+    EXPECT_POSES(sdfccd_rigid_motion_from_poses(&a, &b, v3(0, 0, 0), DT, 0, &out));
+    EXPECT_POSES(sdfccd_rigid_motion_from_poses(&a, &b, v3(NAN, 0, 0), 0, DT, &out));
+    b.orientation.w = 1.01; /* not a unit quaternion */
+    EXPECT_POSES(sdfccd_rigid_motion_from_poses(&a, &b, v3(0, 0, 0), 0, DT, &out));
+    b.orientation.w = 1.0 + 1e-6; /* rounding: accepted */
+    ck_assert_int_eq(sdfccd_rigid_motion_from_poses(&a, &b, v3(0, 0, 0), 0, DT, &out), SDFCCD_OK);
+    b.position.x = INFINITY;
+    out = out_untouched;
+    EXPECT_POSES(sdfccd_rigid_motion_from_poses(&a, &b, v3(0, 0, 0), 0, DT, &out));
+#undef EXPECT
+#undef EXPECT_POSES
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    free_box(&rod);
+}
+END_TEST
+
+typedef struct counter { long allocs; } counter;
+static void* count_alloc(size_t n, void* u)
+{
+    ((counter*)u)->allocs++;
+    return malloc(n);
+}
+static void count_free(void* p, size_t n, void* u)
+{
+    (void)n;
+    (void)u;
+    free(p);
+}
+
+/* After a first call of each kind (clear, rolled back, inside at start), guard calls through a
+ * workspace allocate nothing. */
+START_TEST(test_no_allocation_after_warm_up)
+{
+    counter cnt = { 0 };
+    ck_assert_int_eq(sdfccd_set_allocator(count_alloc, count_free, &cnt), SDFCCD_OK);
+    {
+        inside_scene s;
+        inside_setup(&s);
+        sdfccd_RigidMotion ms[3] = { s.m, s.m, s.m };
+        ms[0].linear_velocity = v3(0.06, 0, 0);  /* inside at start */
+        ms[1].linear_velocity = v3(30, 0, 0);    /* rolled back */
+        ms[2].pose.position.y = 0.06;            /* clear */
+        for (int k = 0; k < 3; ++k) (void)guard(s.ws, s.both, NULL, s.cube.id, &ms[k], &s.gp);
+        long before = cnt.allocs;
+        int states[3] = { 0, 0, 0 };
+        for (int i = 0; i < 10; ++i)
+            for (int k = 0; k < 3; ++k) states[guard(s.ws, s.both, NULL, s.cube.id, &ms[k], &s.gp).state]++;
+        ck_assert_int_eq(cnt.allocs - before, 0);
+        ck_assert_int_eq(states[SDFCCD_GUARD_CLEAR], 10);
+        ck_assert_int_eq(states[SDFCCD_GUARD_ROLLED_BACK], 10);
+        ck_assert_int_eq(states[SDFCCD_GUARD_INSIDE_AT_START], 10);
+        inside_teardown(&s);
+    }
+    ck_assert_int_eq(sdfccd_set_allocator(NULL, NULL, NULL), SDFCCD_OK);
+}
+END_TEST
+
+int main(void)
+{
+    Suite* s = suite_create("guard");
+    TCase* tc = tcase_create("guard");
+    test_add_memory_fixture(tc);
+    tcase_set_timeout(tc, 600);
+    /* first: sdfccd_set_allocator needs no library memory live (without fork the suites share a process) */
+    tcase_add_test(tc, test_no_allocation_after_warm_up);
+    tcase_add_test(tc, test_spun_through_thin_wall);
+    tcase_add_test(tc, test_spun_more_than_a_turn);
+    tcase_add_test(tc, test_spun_certified);
+    tcase_add_test(tc, test_fast_tilted_plate);
+    tcase_add_test(tc, test_moving_away_is_clear);
+    tcase_add_test(tc, test_inside_at_start_left_to_contacts);
+    tcase_add_test(tc, test_inside_at_start_sinking_further);
+    tcase_add_test(tc, test_inside_at_start_rest_guarded);
+    tcase_add_test(tc, test_moving_sdf);
+    tcase_add_test(tc, test_motion_from_poses);
+    tcase_add_test(tc, test_bad_input);
+    suite_add_tcase(s, tc);
+    return test_run_suite(s);
+}
