@@ -78,26 +78,10 @@ void leaves(const btCollisionShape* s, const btTransform& offset, std::vector<st
 
 } // namespace
 
-sdfccd_Status motionFromPoses(const sdfccd_Pose& a, const sdfccd_Pose& b, sdfccd_Vec3 c, double dt, sdfccd_RigidMotion* out)
+sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out)
 {
-    // Stand-in for the core's sdfccd_rigid_motion_from_poses (centre lerp, shortest-arc rotation).
-    if (!(dt > 0)) return SDFCCD_INVALID_ARGUMENT;
-    const btQuaternion qa((btScalar)a.orientation.x, (btScalar)a.orientation.y, (btScalar)a.orientation.z, (btScalar)a.orientation.w);
-    const btQuaternion qb((btScalar)b.orientation.x, (btScalar)b.orientation.y, (btScalar)b.orientation.z, (btScalar)b.orientation.w);
-    const btVector3 lc = bt(c);
-    const btVector3 ga = bt(a.position) + quatRotate(qa, lc), gb = bt(b.position) + quatRotate(qb, lc);
-    btQuaternion d = qb * qa.inverse();
-    if (d.w() < 0) d = -d;
-    const double s = std::sqrt((double)(d.x() * d.x() + d.y() * d.y() + d.z() * d.z()));
-    const double ang = 2 * std::atan2(s, (double)d.w());
-    btVector3 w(0, 0, 0);
-    if (s > 0) w = btVector3(d.x(), d.y(), d.z()) * (btScalar)(ang / s / dt);
-    *out = sdfccd_default_rigid_motion();
-    out->pose = a;
-    out->local_center = c;
-    out->linear_velocity = v3((gb - ga) / (btScalar)dt);
-    out->angular_velocity = v3(w);
-    return SDFCCD_OK;
+    const sdfccd_Pose pa = toPose(a), pb = toPose(b);
+    return sdfccd_rigid_motion_from_poses(&pa, &pb, v3(c), 0, dt, out);
 }
 
 btTransform poseAt(const sdfccd_RigidMotion& m, double t)
@@ -121,107 +105,81 @@ btTransform poseAt(const sdfccd_RigidMotion& m, double t)
 sdfccd_Status BridgeImpl::guardRigid(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sm, sdfccd_MeshId mesh, const sdfccd_RigidMotion& mm,
                                      double dt, GuardOut& out)
 {
-    // Stand-in for the core's sdfccd_guard_rigid. The contact level is the tolerance below the
-    // surface, or the tolerance below the depth the step starts with. (1) The CCD over the step at
-    // that level; (2) a discrete check of the end pose, which catches a contact the CCD's local
-    // search missed (a large triangle touching in two places); (3) the body goes back to the
-    // time it first came within half the tolerance of that level (the start if it began deeper),
-    // so a body put back starts the next step guarded.
+    // (1) sdfccd_guard_rigid at the tolerance; a body it rolls back goes back further, to where it
+    // first came within HALF the tolerance (a second check over [0, toi]), so that it starts the
+    // next step shallower than the tolerance and stays under the full check (put back at the
+    // tolerance itself, it would start the next step "inside", where the core lets a triangle sink
+    // a tolerance deeper than its start, step after step). (2) The pose the body is to take is
+    // checked once more with the discrete query (another local search: it catches what the CCD's
+    // missed, e.g. a large or thin triangle reaching the surface in two places); deeper than the
+    // tolerance, the body goes back by bisection to the last time it is not deeper than half.
     out = GuardOut();
     out.toi = dt;
     const double tol = cfg.guard_tolerance;
-    sdfccd_QueryParams ccd = sdfccd_default_query_params();
-    sdfccd_QueryParams dcd = ccd;
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    gp.tolerance = tol;
+    sdfccd_GuardResult r;
+    sdfccd_Status st = sdfccd_guard_rigid(workspace, sdf, sm, mesh, &mm, 0, dt, &gp, &r);
+    if (st != SDFCCD_OK) return st;
+    stats.sdf_evaluations += r.sdf_evaluations;
+    if (r.state == SDFCCD_GUARD_INSIDE_AT_START) return SDFCCD_OK; // left to the contacts
+    if (r.state == SDFCCD_GUARD_ROLLED_BACK) {
+        out.rolled_back = true;
+        out.toi = r.toi;
+        out.point = r.point;
+        out.normal = r.normal;
+        if (r.toi > 0) {
+            gp.tolerance = 0.5 * tol;
+            sdfccd_GuardResult h;
+            if ((st = sdfccd_guard_rigid(workspace, sdf, sm, mesh, &mm, 0, r.toi, &gp, &h)) != SDFCCD_OK) return st;
+            stats.sdf_evaluations += h.sdf_evaluations;
+            if (h.state == SDFCCD_GUARD_ROLLED_BACK) {
+                out.toi = h.toi;
+                out.point = h.point;
+                out.normal = h.normal;
+            }
+        }
+    }
+    // (2) A point of the mesh deeper than `level` at time t, if the discrete query finds one.
+    sdfccd_QueryParams dcd = sdfccd_default_query_params();
     dcd.method = SDFCCD_METHOD_DCD;
-    if (guard_contacts.size() < 64) guard_contacts.resize(64);
-    // Deepest phi of the mesh at time t of the motion when some point is at or below `level`.
-    auto deepest = [&](double t, double level, double* d, sdfccd_Contact* at) -> sdfccd_Status {
-        sdfccd_RigidMotion m = mm, s;
+    dcd.contact_slop = 0;
+    auto deep = [&](double t, double level, sdfccd_Contact* at, bool* found) -> sdfccd_Status {
+        dcd.margin = level;
+        sdfccd_RigidMotion m = mm, s = sm ? *sm : sdfccd_default_rigid_motion();
         m.pose = toPose(poseAt(mm, t));
         m.linear_velocity = m.angular_velocity = sdfccd_Vec3{ 0, 0, 0 };
         if (sm) {
-            s = *sm;
             s.pose = toPose(poseAt(*sm, t));
             s.linear_velocity = s.angular_velocity = sdfccd_Vec3{ 0, 0, 0 };
         }
-        dcd.margin = level;
-        sdfccd_QueryResult r;
-        for (;;) {
-            const sdfccd_Status st = sdfccd_query_mesh_ws(workspace, sdf, sm ? &s : nullptr, mesh, &m, 0, 0, &dcd, guard_contacts.data(),
-                                                          (int32_t)guard_contacts.size(), &r);
-            if (st != SDFCCD_OK) return st;
-            stats.sdf_evaluations += r.sdf_evaluations;
-            if (r.contacts_found <= r.contact_count) break;
-            guard_contacts.resize((size_t)r.contacts_found);
-        }
-        *d = INFINITY;
-        for (int k = 0; k < r.contact_count; ++k)
-            if (guard_contacts[(size_t)k].distance < *d) {
-                *d = guard_contacts[(size_t)k].distance;
-                if (at) *at = guard_contacts[(size_t)k];
-            }
-        return SDFCCD_OK;
+        sdfccd_QueryResult q;
+        const sdfccd_Status e = sdfccd_query_mesh_ws(workspace, sdf, sm ? &s : nullptr, mesh, &m, 0, 0, &dcd, at, 1, &q);
+        if (e == SDFCCD_OK) stats.sdf_evaluations += q.sdf_evaluations;
+        *found = e == SDFCCD_OK && q.hit && q.contact_count > 0;
+        return e;
     };
     sdfccd_Contact c;
-    auto sweep = [&](double level, double t1, sdfccd_QueryResult& r) {
-        ccd.margin = level;
-        const sdfccd_Status st = sdfccd_query_mesh_ws(workspace, sdf, sm, mesh, &mm, 0, t1, &ccd, &c, 1, &r);
-        if (st == SDFCCD_OK) stats.sdf_evaluations += r.sdf_evaluations;
-        return st;
-    };
-    double level = -tol, d = INFINITY;
-    sdfccd_QueryResult r;
-    sdfccd_Status st = sweep(level, dt, r);
-    if (st != SDFCCD_OK) return st;
-    if (r.hit && r.state == SDFCCD_STATE_PENETRATING) {
-        // Starts deeper than the tolerance: held to the tolerance below its starting depth.
-        if ((st = deepest(0, level, &d, nullptr)) != SDFCCD_OK) return st;
-        if (!std::isfinite(d)) return SDFCCD_OK;
-        level = d - tol;
-        if ((st = sweep(level, dt, r)) != SDFCCD_OK) return st;
-        if (r.hit && r.state == SDFCCD_STATE_PENETRATING) return SDFCCD_OK;
-    }
-    double bad = dt; // a time at which the mesh is at or below the level
-    if (r.hit) {
-        bad = r.toi;
-        out.point = c.point;
-        out.normal = c.normal;
-    } else {
-        if ((st = deepest(dt, level, &d, &c)) != SDFCCD_OK) return st;
-        if (!std::isfinite(d)) return SDFCCD_OK; // clear
-        out.point = c.point;
-        out.normal = c.normal;
-    }
+    bool found = false;
+    if ((st = deep(out.toi, -tol, &c, &found)) != SDFCCD_OK || !found) return st;
+    stats.guard_bisections++;
     out.rolled_back = true;
-    // The last time before `bad` at which the mesh is clear of the level plus half the tolerance:
-    // the CCD's entry time when it finds one, else bisection on the discrete check.
-    const double safe_level = level + 0.5 * tol;
-    sdfccd_QueryResult r2;
-    if ((st = sweep(safe_level, bad, r2)) != SDFCCD_OK) return st;
-    double good = 0;
-    if (r2.hit && r2.state != SDFCCD_STATE_PENETRATING) {
-        good = r2.toi;
-    } else if (!r2.hit) {
-        good = bad;
-    }
-    // Confirm with the discrete check (the CCD may have missed as above; its entry point itself
-    // lies at the safe level): no point deeper than a quarter of the tolerance below it, else
-    // bisection between the start and there for the last time that is.
-    const double accept = safe_level - 0.25 * tol;
-    if (good > 0) {
-        if ((st = deepest(good, accept, &d, nullptr)) != SDFCCD_OK) return st;
-        if (std::isfinite(d)) {
-            double lo = 0, hi = good;
-            for (int it = 0; it < 12; ++it) {
-                const double mid = 0.5 * (lo + hi);
-                if ((st = deepest(mid, accept, &d, nullptr)) != SDFCCD_OK) return st;
-                (std::isfinite(d) ? hi : lo) = mid;
-            }
-            good = lo;
+    out.point = c.point;
+    out.normal = c.normal;
+    double lo = 0, hi = out.toi;
+    for (int it = 0; it < 12; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        if ((st = deep(mid, -0.5 * tol, &c, &found)) != SDFCCD_OK) return st;
+        if (found) {
+            hi = mid;
+            out.point = c.point;
+            out.normal = c.normal;
+        } else {
+            lo = mid;
         }
     }
-    out.toi = good;
-    out.fraction = good / dt;
+    out.toi = lo;
+    out.fraction = out.toi / dt;
     return SDFCCD_OK;
 }
 
@@ -230,7 +188,7 @@ namespace detail {
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world)
 {
     btDynamicsWorld* dw = dynamic_cast<btDynamicsWorld*>(world);
-    if (!dw || !(impl->cfg.guard_tolerance > 0) || impl->guard_world) return;
+    if (!dw || !(impl->cfg.guard_tolerance > 0) || impl->cfg.query.method == SDFCCD_METHOD_DCD || impl->guard_world) return;
     impl->guard.reset(new GuardAction(impl));
     dw->addAction(impl->guard.get());
     impl->guard_world = dw;
@@ -299,7 +257,6 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             btTransform t0;
             if (!startOf(i, t0)) continue;
             const btTransform t1 = body->getWorldTransform();
-            if (std::getenv("SDFCCD_GUARD_TRACE")) std::fprintf(stderr, "body %d start %g %g %g end %g %g %g\n", i, (double)t0.getOrigin().x(), (double)t0.getOrigin().y(), (double)t0.getOrigin().z(), (double)t1.getOrigin().x(), (double)t1.getOrigin().y(), (double)t1.getOrigin().z());
             const btCollisionShape* shape = body->getCollisionShape();
             btVector3 lo, hi;
             sweptBox(shape, t0, t1, lo, hi);
@@ -319,7 +276,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                 }
                 sdfccd_RigidMotion sm;
                 const bool sdf_moves = !(o.t0 == o.t1);
-                if (sdf_moves && motionFromPoses(toPose(o.t0), toPose(o.t1), sdfccd_Vec3{ 0, 0, 0 }, dt, &sm) != SDFCCD_OK) {
+                if (sdf_moves && motionFromPoses(o.t0, o.t1, btVector3(0, 0, 0), dt, &sm) != SDFCCD_OK) {
                     stats.query_errors++;
                     continue;
                 }
@@ -329,7 +286,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     if (!me) continue;
                     const btTransform inv = part.second.inverse();
                     sdfccd_RigidMotion mm;
-                    if (motionFromPoses(toPose(t0 * part.second), toPose(t1 * part.second), v3(inv.getOrigin()), dt, &mm) !=
+                    if (motionFromPoses(t0 * part.second, t1 * part.second, inv.getOrigin(), dt, &mm) !=
                         SDFCCD_OK) {
                         stats.query_errors++;
                         continue;
@@ -340,8 +297,6 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                         stats.query_errors++;
                         continue;
                     }
-                    if (std::getenv("SDFCCD_GUARD_TRACE"))
-                        std::fprintf(stderr, "guard step %lld body %d: rolled %d toi %g\n", (long long)guard_step, i, (int)r.rolled_back, r.toi);
                     if (r.rolled_back && r.toi < best.toi) {
                         best = r;
                         best_sdf = &o;
@@ -351,20 +306,41 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             if (!best_sdf) continue;
             // Back to the time of impact along the executed motion (the body's own frame).
             sdfccd_RigidMotion bm;
-            if (motionFromPoses(toPose(t0), toPose(t1), sdfccd_Vec3{ 0, 0, 0 }, dt, &bm) != SDFCCD_OK) continue;
+            if (motionFromPoses(t0, t1, btVector3(0, 0, 0), dt, &bm) != SDFCCD_OK) continue;
             body->setCenterOfMassTransform(poseAt(bm, best.toi));
-            // An inelastic impulse at the contact point along the SDF's normal: the point's velocity
-            // into the surface (relative to the SDF body's velocity there) becomes zero; the SDF
-            // body counts as infinitely heavy. Tangential velocity and the spin it does not take are kept.
-            const btVector3 p = bt(best.point), n = bt(best.normal);
-            const btVector3 r = p - body->getCenterOfMassPosition();
-            btVector3 vs(0, 0, 0);
-            if (const btRigidBody* sb = btRigidBody::upcast(best_sdf->co)) vs = sb->getVelocityInLocalPoint(p - sb->getCenterOfMassPosition());
-            const btScalar vn = (body->getVelocityInLocalPoint(r) - vs).dot(n);
-            if (vn < 0) {
-                const btVector3 rxn = r.cross(n);
-                const btScalar k = body->getInvMass() + n.dot((body->getInvInertiaTensorWorld() * rxn).cross(r));
-                if (k > 0) body->applyImpulse(n * (-vn / k), r);
+            // The velocity. A body rolled back for the first time keeps it: the next step starts at
+            // the time of impact, in contact, and its contacts (every point, with friction) take the
+            // impact as the solver's response. A body rolled back again in the next step (its
+            // contacts did not stop it) loses its velocity into the surface: first its centre's
+            // (relative to the SDF body at the contact point), then, if the contact point still
+            // approaches (a spin), an inelastic impulse there along the normal makes the approach
+            // zero, with Coulomb friction (the pair's combined coefficient) reducing the point's
+            // tangential velocity by at most mu times that impulse. The SDF body counts as infinitely heavy.
+            auto last = last_rollback.find(body);
+            const bool again = last != last_rollback.end() && last->second == guard_step - 1;
+            last_rollback[body] = guard_step;
+            if (again) {
+                const btVector3 p = bt(best.point), n = bt(best.normal);
+                btVector3 vs(0, 0, 0);
+                if (const btRigidBody* sb = btRigidBody::upcast(best_sdf->co)) vs = sb->getVelocityInLocalPoint(p - sb->getCenterOfMassPosition());
+                const btScalar vc = (body->getLinearVelocity() - vs).dot(n);
+                if (vc < 0) body->setLinearVelocity(body->getLinearVelocity() - n * vc);
+                const btVector3 r = p - body->getCenterOfMassPosition();
+                const btScalar vn = (body->getVelocityInLocalPoint(r) - vs).dot(n);
+                const btScalar k = body->getInvMass() + n.dot((body->getInvInertiaTensorWorld() * r.cross(n)).cross(r));
+                if (vn < 0 && k > 0) {
+                    const btScalar j = -vn / k;
+                    body->applyImpulse(n * j, r);
+                    const btScalar mu = body->getFriction() * best_sdf->co->getFriction();
+                    btVector3 u = body->getVelocityInLocalPoint(r) - vs;
+                    u -= n * u.dot(n);
+                    const btScalar ul = u.length();
+                    if (ul > SIMD_EPSILON && mu > 0) {
+                        const btVector3 t = u / ul;
+                        const btScalar kt = body->getInvMass() + t.dot((body->getInvInertiaTensorWorld() * r.cross(t)).cross(r));
+                        if (kt > 0) body->applyImpulse(-t * btMin(mu * j, ul / kt), r);
+                    }
+                }
             }
             body->setInterpolationLinearVelocity(body->getLinearVelocity());
             body->setInterpolationAngularVelocity(body->getAngularVelocity());
@@ -374,6 +350,9 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
     }
     // The poses this step ends with start the next one, unless its narrow phase sees others.
     recordPoses(world);
+    for (auto it = last_rollback.begin(); it != last_rollback.end();)
+        if (it->second < guard_step) it = last_rollback.erase(it);
+        else ++it;
     ++guard_step;
 }
 

@@ -187,8 +187,8 @@ struct GuardOut {
     double toi = 0, fraction = 1;
     sdfccd_Vec3 point = { 0, 0, 0 }, normal = { 0, 0, 1 };
 };
-// The rigid motion from pose a (time 0) to pose b (time dt) with rotation centre c (local frame).
-sdfccd_Status motionFromPoses(const sdfccd_Pose& a, const sdfccd_Pose& b, sdfccd_Vec3 c, double dt, sdfccd_RigidMotion* out);
+// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
+sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out);
 // The frame of a rigid motion at time t.
 btTransform poseAt(const sdfccd_RigidMotion& m, double t);
 
@@ -246,7 +246,7 @@ public:
     std::unique_ptr<btActionInterface> guard;
     std::vector<std::pair<const btCollisionObject*, btTransform>> start_poses;
     int64_t guard_step = 0, snapshot_step = -1;
-    std::vector<sdfccd_Contact> guard_contacts;
+    std::unordered_map<const btCollisionObject*, int64_t> last_rollback; // the step each body was last put back
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
     std::vector<sdfccd_Contact> contacts, start_contacts;

@@ -930,7 +930,7 @@ static void test_kicked_into_sdf()
     CHECK(tolerance > 0, "the guarantee is on by default");
     CHECK(rollbacks > 0, "the guarantee never acted");
     CHECK(first <= tolerance, "the kicked cube ended its first step %.4f m deep (tolerance %.4f)", first, tolerance);
-    CHECK(worst <= tolerance, "a vertex ended a step %.4f m deep (tolerance %.4f)", worst, tolerance);
+    CHECK(worst <= tolerance, "a vertex ended a step %.5f m deep (tolerance %.4f)", worst, tolerance);
     std::printf("cube kicked into a slab by a 20 m/s GImpact cube (%s): deepest vertex after a step %.5f m (first step %.5f), %lld rollbacks\n",
                 SDFCCD_BULLET_PRECISION_NAME, worst, first, (long long)rollbacks);
     sdfccd_destroy_sdf(slab);

@@ -42,7 +42,7 @@
  *  - the guarantee (on by default, Config::guard_tolerance): after Bullet integrates a step, every
  *    dynamic body that can reach an SDF has its executed motion (start pose to the pose the solver
  *    produced) checked with the CCD; a body that went deeper than the tolerance is put back at its
- *    time of impact and loses its velocity into the surface there (see Config::guard_tolerance).
+ *    time of impact (see Config::guard_tolerance for its velocity).
  *
  * Manifold convention: body A = the mesh (or convex/moving SDF) body, body B = the SDF body; the
  * normal is grad phi (out of the SDF, towards the mesh); the point on B is on the surface;
@@ -201,11 +201,14 @@ struct Config {
      * checks the executed motion of every dynamic body whose swept box meets an SDF's: from its
      * pose at the start of the step to the pose the solver produced (constant velocities, shortest
      * rotation), every compound child and convex shape as its triangles. If any point went deeper
-     * than this below an SDF's surface, the body goes back along that motion to the earliest such
-     * time (the paper's rule: never advance past a time of impact) and an inelastic impulse at the
-     * contact point removes its velocity into the surface there (the SDF body counts as infinitely
-     * heavy). A body that starts a step deeper is left to the contacts. Bodies clear of every SDF's
-     * box cost nothing. Default 0.0005. */
+     * than this below an SDF's surface (sdfccd_guard_rigid, then a discrete check of the pose it
+     * keeps), the body goes back along that motion to where it was within half of this (the paper's
+     * rule: never advance past a time of impact). Its velocity: the first time, kept, for the next
+     * step's contacts, which start at the time of impact and respond with every point and friction;
+     * rolled back again in the next step, it loses its velocity into the surface (its centre's, then
+     * an inelastic impulse with Coulomb friction at the contact point; the SDF body counts as
+     * infinitely heavy). A body that starts a step deeper is left to the contacts. Bodies clear of
+     * every SDF's box cost nothing. Off with query.method DCD (the discrete baseline). Default 0.0005. */
     double guard_tolerance = 0.0005;
     /** Handle convex shapes (box, sphere, capsule, hulls...) against SdfShape with the same
      * CCD (box: its 12 triangles; others: their btShapeHull). Off: Bullet's convex-concave
@@ -256,6 +259,8 @@ struct Stats {
     int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
     int64_t guard_queries = 0;         /**< Executed motions checked by the guarantee (one per body part and SDF). */
     int64_t rollbacks = 0;             /**< Bodies the guarantee put back at their time of impact. */
+    int64_t guard_bisections = 0;      /**< Poses the CCD let through that the guarantee's discrete check found
+                                            deeper than its tolerance (put back by bisection). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (Config::face_search_size). */
     int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
                                             they are counted in queries, end_pose_queries and sdf_evaluations too. */
