@@ -3,11 +3,11 @@
 // advances past a time of impact). An action (btActionInterface, run by Bullet after it
 // integrates a step) checks the EXECUTED motion of every dynamic body that can reach an SDF
 // (its start pose of the step to the pose the solver produced) with the CCD; a body that went
-// deeper than Config::guard_tolerance goes back along that motion to its time of impact and
-// loses its velocity into the surface there (an inelastic impulse at the contact point).
-// Whatever moved it (its own contacts' spin, a kick from another body, a compound parent), it
-// does not pass an SDF. Start poses: taken at the step's first narrow-phase call of the bridge
-// (world transforms are the start poses then), otherwise the poses this action left the step before.
+// deeper than Config::guard_tolerance goes back along that motion to its time of impact (its
+// velocity: see Config::guard_tolerance). Whatever moved it (its own contacts' spin, a kick from
+// another body, a compound parent), it does not pass an SDF. Start poses: taken at the step's first
+// narrow-phase call of the bridge (world transforms are the start poses then), otherwise Bullet's
+// integration undone (the end pose moved back by the body's velocities).
 #include "internal.h"
 
 #include <cmath>
@@ -206,12 +206,7 @@ void guardDetach(BridgeImpl* impl)
 void BridgeImpl::snapshotStartPoses(const btCollisionWorld* world)
 {
     if (!guard_world || world != guard_world || snapshot_step == guard_step) return;
-    recordPoses(world);
     snapshot_step = guard_step;
-}
-
-void BridgeImpl::recordPoses(const btCollisionWorld* world)
-{
     const btCollisionObjectArray& objs = world->getCollisionObjectArray();
     start_poses.resize((size_t)objs.size());
     for (int i = 0; i < objs.size(); ++i) start_poses[(size_t)i] = std::make_pair(static_cast<const btCollisionObject*>(objs[i]), objs[i]->getWorldTransform());
@@ -220,10 +215,21 @@ void BridgeImpl::recordPoses(const btCollisionWorld* world)
 void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
 {
     const btCollisionObjectArray& objs = world->getCollisionObjectArray();
+    // The step's start pose of object i: the snapshot of this step's narrow phase, else Bullet's
+    // integration of the step undone (its end pose moved back by its velocities over dt; kinematic
+    // bodies by their interpolation velocities).
+    const bool snapped = snapshot_step == guard_step;
     auto startOf = [&](int i, btTransform& t) {
-        if ((size_t)i >= start_poses.size() || start_poses[(size_t)i].first != objs[i]) return false;
-        t = start_poses[(size_t)i].second;
-        return true;
+        // (Kinematic bodies are already at their end pose in the narrow phase: saveKinematicState.)
+        if (snapped && !objs[i]->isKinematicObject() && (size_t)i < start_poses.size() && start_poses[(size_t)i].first == objs[i]) {
+            t = start_poses[(size_t)i].second;
+            return;
+        }
+        const btCollisionObject* co = objs[i];
+        const btRigidBody* rb = btRigidBody::upcast(co);
+        const bool kin = co->isKinematicObject() || !rb;
+        btTransformUtil::integrateTransform(co->getWorldTransform(), -(kin ? co->getInterpolationLinearVelocity() : rb->getLinearVelocity()),
+                                            -(kin ? co->getInterpolationAngularVelocity() : rb->getAngularVelocity()), (btScalar)dt, t);
     };
     if (dt > 0) {
         if (!workspace && sdfccd_create_workspace(&workspace) != SDFCCD_OK) workspace = nullptr;
@@ -244,7 +250,8 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             o.sdf = shapes.sdfFor(s, cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
             if (!o.sdf.index1) continue;
             o.t1 = objs[i]->getWorldTransform();
-            if (objs[i]->isStaticObject() || !startOf(i, o.t0)) o.t0 = o.t1;
+            if (objs[i]->isStaticObject() && !objs[i]->isKinematicObject()) o.t0 = o.t1;
+            else startOf(i, o.t0);
             sweptBox(s, o.t0, o.t1, o.lo, o.hi);
             sdfs.push_back(o);
         }
@@ -255,7 +262,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             btRigidBody* body = btRigidBody::upcast(objs[i]);
             if (!body || body->isStaticOrKinematicObject()) continue;
             btTransform t0;
-            if (!startOf(i, t0)) continue;
+            startOf(i, t0);
             const btTransform t1 = body->getWorldTransform();
             const btCollisionShape* shape = body->getCollisionShape();
             btVector3 lo, hi;
@@ -348,8 +355,6 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             stats.last_toi_fraction = best.fraction;
         }
     }
-    // The poses this step ends with start the next one, unless its narrow phase sees others.
-    recordPoses(world);
     for (auto it = last_rollback.begin(); it != last_rollback.end();)
         if (it->second < guard_step) it = last_rollback.erase(it);
         else ++it;

@@ -229,9 +229,8 @@ public:
     // guard.cpp
     // After the step: checks every dynamic body's executed motion against the SDFs it can reach.
     void guardStep(btCollisionWorld* world, double dt);
-    // The step's start poses, once per step (the first narrow-phase call), and every object's pose now.
+    // The step's start poses, once per step (the first narrow-phase call).
     void snapshotStartPoses(const btCollisionWorld* world);
-    void recordPoses(const btCollisionWorld* world);
     // One part's executed motion `mm` over [0, dt] against `sdf` (moving with `sm`, NULL: static).
     sdfccd_Status guardRigid(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sm, sdfccd_MeshId mesh, const sdfccd_RigidMotion& mm, double dt,
                              detail::GuardOut& out);

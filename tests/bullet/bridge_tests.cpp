@@ -1173,6 +1173,64 @@ static void test_compound_child()
     sdfccd_destroy_sdf(slab);
 }
 
+// A compound holding a GImpact cube (offset and rotated child) falling at 200 m/s (3.3 m per
+// step) onto the 10 cm slab: Bullet gives a compound child a pair only when its box overlaps the
+// slab's at the START of a step, so the child's own CCD never sees the impact step. The guarantee
+// checks the whole body's executed motion (the child's triangles moved by the child transform).
+// Returns the deepest vertex penetration after any step and the lowest vertex's final height.
+static double runCompoundFast(bool guard, double* lowest_final, int64_t* rollbacks)
+{
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    double worst = 0;
+    {
+        sdfccd_bullet::Config cfg;
+        if (!guard) cfg.guard_tolerance = 0;
+        Bridge bridge(cfg);
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        btCompoundShape compound;
+        btTransform child;
+        child.setIdentity();
+        child.setOrigin(btVector3(0.3, 0.1, -0.2));
+        child.setRotation(btQuaternion(btVector3(0, 0, 1), btScalar(0.4)));
+        compound.addChildShape(child, cube->shape.get());
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(&compound, 1, btVector3(0, 0, 2.0), btVector3(0.5, 0.5, 0.5));
+        body->setLinearVelocity(btVector3(0, 0, -200));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        btTransform id;
+        id.setIdentity();
+        for (int i = 0; i < 60; ++i) {
+            w.step();
+            worst = std::max(worst, vertexPenetration(*cube, body->getWorldTransform() * child, slab, id));
+        }
+        *lowest_final = 1e9;
+        for (size_t i = 0; i + 2 < cube->v.size(); i += 3)
+            *lowest_final = std::min(*lowest_final, (double)(body->getWorldTransform() * child * btVector3(cube->v[i], cube->v[i + 1], cube->v[i + 2])).z());
+        *rollbacks = bridge.stats().rollbacks;
+        checkNoQueryErrors(bridge.stats(), guard ? "fast compound, guarantee on" : "fast compound, guarantee off");
+    }
+    sdfccd_destroy_sdf(slab);
+    return worst;
+}
+
+static void test_compound_fast()
+{
+    double low_on = 0, low_off = 0;
+    int64_t rb_on = 0, rb_off = 0;
+    const double on = runCompoundFast(true, &low_on, &rb_on);
+    const double off = runCompoundFast(false, &low_off, &rb_off);
+    // Issue 19: stops on the slab within 1 cm; without the guarantee it passes through.
+    CHECK(on <= 0.01, "with the guarantee the compound's child went %.5f m into the slab", on);
+    CHECK(low_on > 0.05 - 0.01, "with the guarantee the child's lowest vertex ends at z %.4f (slab top 0.05)", low_on);
+    CHECK(rb_on > 0, "the guarantee never acted");
+    CHECK(low_off < -0.05, "without the guarantee the child ends at z %.4f: the case does not need it", low_off);
+    std::printf("compound at 200 m/s (%s): deepest %.5f m, lowest vertex ends at %.5f (%lld rollbacks); without the guarantee "
+                "it ends at %.3f\n", SDFCCD_BULLET_PRECISION_NAME, on, low_on, (long long)rb_on, low_off);
+}
+
 // Contact callbacks, counted per manifold.
 static int g_started = 0, g_ended = 0, g_processed = 0, g_added = 0, g_unpaired = 0;
 static std::vector<const btPersistentManifold*> g_open;
@@ -1526,6 +1584,7 @@ static const Test kTests[] = {
     { "batch_threads", test_batch_threads },
     { "kicked_into_sdf", test_kicked_into_sdf },
     { "compound_child", test_compound_child },
+    { "compound_fast", test_compound_fast },
     { "face_search", test_face_search },
     { "callbacks", test_callbacks },
     { "convex_box_fast", test_convex_box_fast },
