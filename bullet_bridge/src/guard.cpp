@@ -161,7 +161,12 @@ sdfccd_Status BridgeImpl::guardRigid(sdfccd_SdfId sdf, const sdfccd_RigidMotion*
     };
     sdfccd_Contact c;
     bool found = false;
-    if ((st = deep(out.toi, -tol, &c, &found)) != SDFCCD_OK || !found) return st;
+    if ((st = deep(out.toi, -tol, &c, &found)) != SDFCCD_OK) return st;
+    if (!found) {
+        out.fraction = out.toi / dt;
+        out.pinned = out.rolled_back && !(out.toi > 0);
+        return SDFCCD_OK;
+    }
     stats.guard_bisections++;
     out.rolled_back = true;
     out.point = c.point;
@@ -180,6 +185,10 @@ sdfccd_Status BridgeImpl::guardRigid(sdfccd_SdfId sdf, const sdfccd_RigidMotion*
     }
     out.toi = lo;
     out.fraction = out.toi / dt;
+    // No time after the start passes the discrete check: the body cannot move in this step without
+    // going deeper (a resting body the contacts hold a little deeper than half the tolerance): it
+    // stays at its start, at rest relative to the SDF (see guardStep).
+    out.pinned = !(out.toi > 0);
     return SDFCCD_OK;
 }
 
@@ -282,8 +291,8 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     collected = true;
                 }
                 sdfccd_RigidMotion sm;
-                const bool sdf_moves = !(o.t0 == o.t1);
-                if (sdf_moves && motionFromPoses(o.t0, o.t1, btVector3(0, 0, 0), dt, &sm) != SDFCCD_OK) {
+                // The SDF's motion (a static one still has its pose: NULL would mean the world origin).
+                if (motionFromPoses(o.t0, o.t1, btVector3(0, 0, 0), dt, &sm) != SDFCCD_OK) {
                     stats.query_errors++;
                     continue;
                 }
@@ -300,7 +309,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     }
                     GuardOut r;
                     stats.guard_queries++;
-                    if (guardRigid(o.sdf, sdf_moves ? &sm : nullptr, me->id, mm, dt, r) != SDFCCD_OK) {
+                    if (guardRigid(o.sdf, &sm, me->id, mm, dt, r) != SDFCCD_OK) {
                         stats.query_errors++;
                         continue;
                     }
@@ -323,10 +332,17 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             // approaches (a spin), an inelastic impulse there along the normal makes the approach
             // zero, with Coulomb friction (the pair's combined coefficient) reducing the point's
             // tangential velocity by at most mu times that impulse. The SDF body counts as infinitely heavy.
+            if (best.pinned) {
+                // Held at its start pose for the whole step: at rest relative to the SDF body.
+                const btRigidBody* sb = btRigidBody::upcast(best_sdf->co);
+                body->setLinearVelocity(sb ? sb->getVelocityInLocalPoint(body->getCenterOfMassPosition() - sb->getCenterOfMassPosition())
+                                           : btVector3(0, 0, 0));
+                body->setAngularVelocity(sb ? sb->getAngularVelocity() : btVector3(0, 0, 0));
+            }
             auto last = last_rollback.find(body);
             const bool again = last != last_rollback.end() && last->second == guard_step - 1;
             last_rollback[body] = guard_step;
-            if (again) {
+            if (again && !best.pinned) {
                 const btVector3 p = bt(best.point), n = bt(best.normal);
                 btVector3 vs(0, 0, 0);
                 if (const btRigidBody* sb = btRigidBody::upcast(best_sdf->co)) vs = sb->getVelocityInLocalPoint(p - sb->getCenterOfMassPosition());

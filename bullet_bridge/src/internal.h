@@ -184,6 +184,7 @@ void guardDetach(BridgeImpl* impl);
 // The outcome of the guarantee's check of one part against one SDF.
 struct GuardOut {
     bool rolled_back = false;
+    bool pinned = false; // put back to the very start by the discrete check
     double toi = 0, fraction = 1;
     sdfccd_Vec3 point = { 0, 0, 0 }, normal = { 0, 0, 1 };
 };
