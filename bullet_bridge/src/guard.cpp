@@ -11,8 +11,6 @@
 #include "internal.h"
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
