@@ -608,6 +608,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.query_errors++;
         return false;
     }
+    last_start_margin = P.start_margin;
     Gatherer G;
     G.me = P.me;
     G.sdf = P.sdf;
@@ -892,9 +893,21 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     const double margin = closest ? std::max(0.0, (double)out->m_closestPointDistanceThreshold) : cfg.contact_margin;
     double radius = 0;
     btVector3 w(0, 0, 0);
+    const int64_t errors_before = stats.query_errors, skipped_before = stats.queries_skipped;
     const bool any = gather(mw, sw, dt, margin, scratch, &radius, &w);
     // The guarantee's start poses: the world transforms of this step's first pair are the step's start.
     if (!closest && dt > 0) snapshotStartPoses(guard_world);
+    // ... and the body's smallest gap at the start, for the guarantee's free proof (only when the
+    // queries ran without error and with a continuous method; top-level shapes only).
+    if (!closest && dt > 0 && guard_world && stats.query_errors == errors_before && cfg.query.method != SDFCCD_METHOD_DCD &&
+        mw->getCollisionShape() == mw->getCollisionObject()->getCollisionShape() &&
+        mw->getWorldTransform() == mw->getCollisionObject()->getWorldTransform()) {
+        // No candidate: every feature at least the margin away at the start, or, when the start-pose
+        // query's broad phase culled every triangle, at least that query's margin (margin + travel).
+        double d0 = !any && stats.queries_skipped > skipped_before ? last_start_margin : margin;
+        for (const Candidate& c : scratch) d0 = std::min(d0, c.d);
+        start_gaps[std::make_pair(mw->getCollisionObject(), sw->getCollisionObject())] = std::make_pair(guard_step, d0);
+    }
     const double tol = std::max(1e-6, 1e-3 * radius);
     double depth_scale = cfg.spread_depth_scale;
     if (cfg.spread_depth_fraction > 0) depth_scale = std::min(depth_scale, cfg.spread_depth_fraction * radius);

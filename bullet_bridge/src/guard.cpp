@@ -116,6 +116,7 @@ sdfccd_Status BridgeImpl::guardRigid(sdfccd_SdfId sdf, const sdfccd_RigidMotion*
     const double tol = cfg.guard_tolerance;
     sdfccd_GuardParams gp = sdfccd_default_guard_params();
     gp.tolerance = tol;
+    gp.query.fwgss_restarts = cfg.query.fwgss_restarts; // the bridge's (0): the discrete check below backs it
     sdfccd_GuardResult r;
     sdfccd_Status st = sdfccd_guard_rigid(workspace, sdf, sm, mesh, &mm, 0, dt, &gp, &r);
     if (st != SDFCCD_OK) return st;
@@ -298,6 +299,22 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     if (part.first == o.co->getCollisionShape() || !isMeshLike(part.first)) continue;
                     const MeshEntry* me = shapes.meshFor(part.first);
                     if (!me) continue;
+                    // A check that costs nothing: this step's narrow phase (its start-pose query over the
+                    // step's reach) saw the body (a top-level shape) no deeper than d0 at its start; no
+                    // point moves farther than the centre's displacement plus the turn times the mesh's
+                    // radius, so with a static SDF and d0 - that > -tolerance/2 no point reaches the
+                    // tolerance (phi is 1-Lipschitz; as sure as that query's local search).
+                    if (snapped && parts.size() == 1 && o.t0 == o.t1 && part.first == shape) {
+                        auto g = start_gaps.find(std::make_pair(static_cast<const btCollisionObject*>(body), o.co));
+                        if (g != start_gaps.end() && g->second.first == guard_step) {
+                            const double moved = (double)(t1.getOrigin() - t0.getOrigin()).length() +
+                                                 (double)t0.getRotation().angleShortestPath(t1.getRotation()) * me->radius;
+                            if (g->second.second - moved > -0.5 * tol) {
+                                stats.guard_skipped++;
+                                continue;
+                            }
+                        }
+                    }
                     const btTransform inv = part.second.inverse();
                     sdfccd_RigidMotion mm;
                     if (motionFromPoses(t0 * part.second, t1 * part.second, inv.getOrigin(), dt, &mm) !=
@@ -371,6 +388,9 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
     }
     for (auto it = last_rollback.begin(); it != last_rollback.end();)
         if (it->second < guard_step) it = last_rollback.erase(it);
+        else ++it;
+    for (auto it = start_gaps.begin(); it != start_gaps.end();)
+        if (it->second.first < guard_step) it = start_gaps.erase(it);
         else ++it;
     ++guard_step;
 }

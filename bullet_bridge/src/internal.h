@@ -247,6 +247,16 @@ public:
     std::vector<std::pair<const btCollisionObject*, btTransform>> start_poses;
     int64_t guard_step = 0, snapshot_step = -1;
     std::unordered_map<const btCollisionObject*, int64_t> last_rollback; // the step each body was last put back
+    // Per (mesh object, SDF object): the step and the smallest gap at its start the narrow phase saw
+    // (a top-level pair; the margin when the pair was proven clear).
+    struct PairHash {
+        size_t operator()(const std::pair<const btCollisionObject*, const btCollisionObject*>& k) const
+        {
+            return std::hash<const void*>()(k.first) * 31u + std::hash<const void*>()(k.second);
+        }
+    };
+    std::unordered_map<std::pair<const btCollisionObject*, const btCollisionObject*>, std::pair<int64_t, double>, PairHash> start_gaps;
+    double last_start_margin = 0; // the start-pose query's margin of the last gather()
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
     std::vector<sdfccd_Contact> contacts, start_contacts;

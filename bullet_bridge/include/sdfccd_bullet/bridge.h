@@ -259,6 +259,8 @@ struct Stats {
     int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
     int64_t guard_queries = 0;         /**< Executed motions checked by the guarantee (one per body part and SDF). */
     int64_t rollbacks = 0;             /**< Bodies the guarantee put back at their time of impact. */
+    int64_t guard_skipped = 0;         /**< Checks the guarantee skipped: the step's narrow phase saw the body's
+                                            start clear by more than its executed motion could close. */
     int64_t guard_bisections = 0;      /**< Poses the CCD let through that the guarantee's discrete check found
                                             deeper than its tolerance (put back by bisection). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (Config::face_search_size). */
