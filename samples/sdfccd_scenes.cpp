@@ -4,20 +4,21 @@
 //   sdfccd_scenes --list
 //   sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]
 //                 [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]
-//                 [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]
+//                 [--margin M] [--patch-band B] [--guard T] [--spread-depth-scale D]
 //                 [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]
-//                 [--projection T] [--spread-depth-fraction F] [--face-search S]
+//                 [--spread-depth-fraction F] [--face-search S]
 //                 [--discrete-subdivision-scale S] [--batch-threads N] [--data DIR] [--check KEY=LIMIT,...]
 //                 [--quiet] [--table4] [--inject-nan STEP[,KIND]]
 //
-// --patch-band B / --hard-clamp T / --spread-depth-scale D / --solver-iterations N override the
-// Bullet scenes' set-up (the bridge's Config::patch_band, Bridge::setHardClamp tolerance,
-// Config::spread_depth_scale, btContactSolverInfo::m_numIterations; B < 0 and T <= 0 turn them
-// off, D < 0 is the bridge's default). The paper's rigid scenes default to B = 0.02, T = 0.0005
-// (off with DCD) and D = 0.01, the Bullet re-creations to the bridge's defaults.
+// --patch-band B / --spread-depth-scale D / --solver-iterations N override the Bullet scenes'
+// set-up (the bridge's Config::patch_band, Config::spread_depth_scale,
+// btContactSolverInfo::m_numIterations; B < 0 turns it off, D < 0 is the bridge's default). The
+// paper's rigid scenes default to B = 0.02 and D = 0.01, the Bullet re-creations to the bridge's
+// defaults. --guard T sets the bridge's Config::guard_tolerance (the guarantee; 0: off; default
+// 0.0005, off with --method dcd).
 // B < 0 given also drops the extra manifolds (Bullet's single 4-point manifold). --extra-manifolds N / --kick W / --cover-depth D /
-// --projection T override the bridge's Config::extra_manifolds, kick_angular_speed, cover_depth
-// and projection_tolerance (0: off); by default the bridge's own defaults. --spread-depth-fraction F
+// override the bridge's Config::extra_manifolds, kick_angular_speed and cover_depth; by default
+// the bridge's own defaults. --spread-depth-fraction F
 // overrides Config::spread_depth_fraction (0: off); a depth scale D >= 0 (given or the scene's)
 // turns it off unless F is given, so D is the scale used. --face-search S sets the bridge's
 // Config::face_search_size (0: off; the spikes scene defaults to 0.02, others to off).
@@ -77,9 +78,9 @@ void usage(std::FILE* f)
                  "usage: sdfccd_scenes --list\n"
                  "       sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]\n"
                  "                     [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]\n"
-                 "                     [--margin M] [--patch-band B] [--hard-clamp T] [--spread-depth-scale D]\n"
+                 "                     [--margin M] [--patch-band B] [--guard T] [--spread-depth-scale D]\n"
                  "                     [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]\n"
-                 "                     [--projection T] [--spread-depth-fraction F] [--face-search S]\n"
+                 "                     [--spread-depth-fraction F] [--face-search S]\n"
                  "                     [--discrete-subdivision-scale S] [--batch-threads N] [--data DIR]\n"
                  "                     [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
                  "                     [--inject-nan STEP[,position|velocity|energy|phi|query]]  (test hook)\n"
@@ -157,12 +158,11 @@ int main(int argc, char** argv)
         else if (a == "--face-search") opt.face_search = std::atof(value("metres (0: off)"));
         else if (a == "--batch-threads") opt.batch_threads = std::atoi(value("a thread count"));
         else if (a == "--solver-iterations") opt.solver_iterations = std::atoi(value("a count"));
-        else if (a == "--hard-clamp") opt.hard_clamp = std::atof(value("metres"));
+        else if (a == "--guard") opt.guard = std::atof(value("metres (0: off)"));
         else if (a == "--extra-manifolds") opt.extra_manifolds = std::atoi(value("a count (0-3)"));
         else if (a == "--kick") opt.kick = std::atof(value("rad/s"));
         else if (a == "--cover-depth") opt.cover_depth = std::atof(value("metres"));
         else if (a == "--spread-depth-fraction") opt.spread_depth_fraction = std::atof(value("a fraction of the mesh's radius (0: off)"));
-        else if (a == "--projection") opt.projection = std::atof(value("metres (0: off)"));
         else if (a == "--discrete-subdivision-scale") opt.discrete_subdivision_scale = std::atof(value("a fraction of the mesh radius"));
         else if (a == "--data") opt.data_dir = value("a folder");
         else if (a == "--check") check = value("limits");

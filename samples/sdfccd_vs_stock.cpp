@@ -5,9 +5,10 @@
 // (bridge then stock on even steps, stock then bridge on odd ones), so both see the same machine
 // load. Each repeat builds both worlds afresh; the summary row is the median over repeats.
 //
-//   sdfccd_vs_stock [NAME] [--steps N] [--repeats R] [--quick] [--batch-threads N] [--data DIR]
+//   sdfccd_vs_stock [NAME] [--steps N] [--repeats R] [--quick] [--batch-threads N] [--guard T] [--data DIR]
 //
 // --batch-threads N: the bridge runs each step's queries as batches on N threads (Config::batch_threads).
+// --guard T: the bridge's Config::guard_tolerance (the guarantee; 0: off, to measure what it costs).
 //
 // NAME defaults to landscape (any Bullet scene of `sdfccd_scenes --list` works). Prints CSV:
 //   repeat,bridge_ms,stock_ms,ratio,bridge_contact_ms,stock_contact_ms,contact_ratio,
@@ -92,8 +93,9 @@ int main(int argc, char** argv)
         else if (a == "--quick") opt.quick = true;
         else if (a == "--data") opt.data_dir = value();
         else if (a == "--batch-threads") opt.batch_threads = std::atoi(value());
+        else if (a == "--guard") opt.guard = std::atof(value());
         else if (a == "--help" || a == "-h") {
-            std::printf("usage: sdfccd_vs_stock [NAME] [--steps N] [--repeats R] [--quick] [--batch-threads N] [--data DIR]\n");
+            std::printf("usage: sdfccd_vs_stock [NAME] [--steps N] [--repeats R] [--quick] [--batch-threads N] [--guard T] [--data DIR]\n");
             return 0;
         } else if (!a.empty() && a[0] != '-') name = a;
         else {

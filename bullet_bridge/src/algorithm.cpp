@@ -276,7 +276,6 @@ const char* statusString(Status s)
     case Status::NotRegistered: return "NotRegistered";
     case Status::InvalidArgument: return "InvalidArgument";
     case Status::InvalidShape: return "InvalidShape";
-    case Status::ClampDisplaced: return "ClampDisplaced";
     }
     return "?";
 }
@@ -295,7 +294,6 @@ Bridge::~Bridge()
         std::lock_guard<std::mutex> lock(g_registry_mutex);
         g_registered.erase(m_impl->dispatcher);
     }
-    clampForget(m_impl);
     delete m_impl;
 }
 
@@ -318,7 +316,7 @@ Status Bridge::registerWith(btCollisionWorld* world)
     }
     const Status s = registerWith(d);
     if (s == Status::Ok) {
-        projectionAttach(m_impl, world);
+        guardAttach(m_impl, world);
         m_impl->batch_world = world;
     }
     return s;
@@ -432,11 +430,6 @@ Status Bridge::check(btCollisionWorld* world, std::string* message) const
             return Status::TooLate;
         }
     }
-    if (clampCheck(m_impl, world) != Status::Ok) {
-        say(message, "an internal tick callback installed after Bridge::setHardClamp replaced the clamp's; install "
-                     "yours first (the clamp chains it)");
-        return Status::ClampDisplaced;
-    }
     if (m_impl->stats.query_errors > 0)
         say(message, "ok, but %s%lld queries failed (see sdfccd_last_error)", "", (long long)m_impl->stats.query_errors);
     return Status::Ok;
@@ -451,7 +444,7 @@ void Bridge::unregister()
         d->registerCollisionCreateFunc(s.first, s.second, cc->getCollisionAlgorithmCreateFunc(s.first, s.second));
         d->registerClosestPointsCreateFunc(s.first, s.second, cc->getClosestPointsAlgorithmCreateFunc(s.first, s.second));
     }
-    projectionDetach(m_impl);
+    guardDetach(m_impl);
     m_impl->batch_world = nullptr;
     m_impl->batch_cache.clear();
     std::lock_guard<std::mutex> lock(g_registry_mutex);

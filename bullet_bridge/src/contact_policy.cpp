@@ -608,6 +608,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.query_errors++;
         return false;
     }
+    last_start_margin = P.start_margin;
     Gatherer G;
     G.me = P.me;
     G.sdf = P.sdf;
@@ -888,36 +889,24 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
 void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
                          btManifoldResult* out, btPersistentManifold* const* manifolds, int manifold_count, bool closest)
 {
-    const btCollisionObject* mo = mw->getCollisionObject();
-    const btCollisionObject* so = sw->getCollisionObject();
     const double dt = closest ? 0.0 : (double)info.m_timeStep;
     const double margin = closest ? std::max(0.0, (double)out->m_closestPointDistanceThreshold) : cfg.contact_margin;
     double radius = 0;
     btVector3 w(0, 0, 0);
-    const int64_t errors_before = stats.query_errors;
+    const int64_t errors_before = stats.query_errors, skipped_before = stats.queries_skipped;
     const bool any = gather(mw, sw, dt, margin, scratch, &radius, &w);
-    // The clamp looks at every pair. The projection looks at pairs with candidates, and at the
-    // pairs the queries found clear: a body the queries proved clear for its PREDICTED motion can
-    // still end the step inside the SDF when another contact solved in the same step (a GImpact
-    // mesh-mesh hit) changes its motion; the projection checks those when the body ends the step
-    // farther from its predicted end pose than that proof allows. (Not with the DCD baseline,
-    // whose query does not prove the motion clear.)
-    const btRigidBody* mesh_body = btRigidBody::upcast(mo);
-    const bool clear = !any && dt > 0 && stats.query_errors == errors_before && cfg.query.method != SDFCCD_METHOD_DCD &&
-                       mesh_body && !mesh_body->isStaticOrKinematicObject();
-    if (!closest && (clamp_world || (projection_world && (any || clear)))) {
-        PairRecord r;
-        r.mesh = mo;
-        r.sdf = so;
-        r.start = mo->getWorldTransform();
-        r.child = mo->getWorldTransform().inverseTimes(mw->getWorldTransform());
-        r.shape = mw->getCollisionShape();
-        r.top = mo->getCollisionShape();
-        r.clear = clear;
-        r.predicted = mo->getInterpolationWorldTransform();
-        r.sdf_start = so->getWorldTransform();
-        r.margin = margin;
-        pairs.push_back(r);
+    // The guarantee's start poses: the world transforms of this step's first pair are the step's start.
+    if (!closest && dt > 0) snapshotStartPoses(guard_world);
+    // ... and the body's smallest gap at the start, for the guarantee's free proof (only when the
+    // queries ran without error and with a continuous method; top-level shapes only).
+    if (!closest && dt > 0 && guard_world && stats.query_errors == errors_before && cfg.query.method != SDFCCD_METHOD_DCD &&
+        mw->getCollisionShape() == mw->getCollisionObject()->getCollisionShape() &&
+        mw->getWorldTransform() == mw->getCollisionObject()->getWorldTransform()) {
+        // No candidate: every feature at least the margin away at the start, or, when the start-pose
+        // query's broad phase culled every triangle, at least that query's margin (margin + travel).
+        double d0 = !any && stats.queries_skipped > skipped_before ? last_start_margin : margin;
+        for (const Candidate& c : scratch) d0 = std::min(d0, c.d);
+        start_gaps[std::make_pair(mw->getCollisionObject(), sw->getCollisionObject())] = std::make_pair(guard_step, d0);
     }
     const double tol = std::max(1e-6, 1e-3 * radius);
     double depth_scale = cfg.spread_depth_scale;

@@ -5,8 +5,8 @@
 //   contact_policy.cpp the queries of one pair and step, the contact set, its reduction to the
 //                      manifolds' points, and writing them with Bullet's callbacks
 //   algorithm.cpp      the collision algorithm, its create functions, registration, check()
-//   hard_clamp.cpp     the end-of-step projection (an action) and the optional hard clamp (chained
-//                      internal tick callbacks), one correction
+//   guard.cpp          the guarantee: an action checks each body's executed motion after the step
+//                      and puts a body that went into an SDF back at its time of impact
 #ifndef SDFCCD_BULLET_INTERNAL_H
 #define SDFCCD_BULLET_INTERNAL_H
 
@@ -169,7 +169,6 @@ struct PairStageHash {
 
 class MeshSdfAlgorithm;
 
-Status clampCheck(const BridgeImpl* impl, const btCollisionWorld* world);
 /** Bridge::verify() of `impl`. */
 Status verifyImpl(const BridgeImpl* impl);
 /** True when `callback` is Bullet's GImpact algorithm's triangle callback (btGImpactTriangleCallback). */
@@ -178,11 +177,21 @@ bool isGImpactCallback(const btTriangleCallback* callback);
  * handler unless the diagnosis equals the last one reported for the shape (`last_reported`:
  * 0 = none, else the Status + 1; updated). */
 void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported);
-// The end-of-step projection's action (Config::projection_tolerance): added to a dynamics world
-// at registration, removed by unregister().
-void projectionAttach(BridgeImpl* impl, btCollisionWorld* world);
-void projectionDetach(BridgeImpl* impl);
-void clampForget(BridgeImpl* impl);
+// The guarantee's action (Config::guard_tolerance): added to a dynamics world at registration,
+// removed by unregister().
+void guardAttach(BridgeImpl* impl, btCollisionWorld* world);
+void guardDetach(BridgeImpl* impl);
+// The outcome of the guarantee's check of one part against one SDF.
+struct GuardOut {
+    bool rolled_back = false;
+    bool pinned = false; // put back to the very start by the discrete check
+    double toi = 0, fraction = 1;
+    sdfccd_Vec3 point = { 0, 0, 0 }, normal = { 0, 0, 1 };
+};
+// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
+sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out);
+// The frame of a rigid motion at time t.
+btTransform poseAt(const sdfccd_RigidMotion& m, double t);
 
 } // namespace detail
 
@@ -218,40 +227,36 @@ public:
                  btManifoldResult* out, btPersistentManifold* const* manifolds, int manifold_count, bool closest);
     double timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt);
 
-    // hard_clamp.cpp
-    void clampPre(btDynamicsWorld* world);
-    void clampPost(btDynamicsWorld* world, double dt);
+    // guard.cpp
+    // After the step: checks every dynamic body's executed motion against the SDFs it can reach.
+    void guardStep(btCollisionWorld* world, double dt);
+    // The step's start poses, once per step (the first narrow-phase call).
+    void snapshotStartPoses(const btCollisionWorld* world);
+    // One part's executed motion `mm` over [0, dt] against `sdf` (moving with `sm`, NULL: static).
+    sdfccd_Status guardRigid(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sm, sdfccd_MeshId mesh, const sdfccd_RigidMotion& mm, double dt,
+                             detail::GuardOut& out);
 
     Config cfg;
     Stats stats;
     detail::ShapeCache shapes;
     btCollisionDispatcher* dispatcher = nullptr;
-    btDiscreteDynamicsWorld* clamp_world = nullptr;
-    btInternalTickCallback user_pre = nullptr, user_post = nullptr; // chained by the clamp
-    double clamp_tolerance = 1e-3;
-    // The pairs of the step, for the clamp and the projection: the mesh body's pose at the start
-    // of the step, the wrapper's offset in it (compound child), the shapes. A pair the queries
-    // found clear (`clear`: no feature within `margin` of the surface over the predicted motion)
-    // keeps the predicted end pose and the SDF's pose, so the projection can tell whether the
-    // body ended elsewhere (a kick from another contact solved in the same step).
-    struct PairRecord {
-        const btCollisionObject* mesh;
-        const btCollisionObject* sdf;
-        btTransform start, child;
-        const btCollisionShape* shape;
-        const btCollisionShape* top;
-        bool clear = false;
-        btTransform predicted, sdf_start;
-        double margin = 0;
+    // The guarantee: the world its action is in, the objects' poses at the start of the step
+    // (by world array index), the steps it has checked and the step of the last snapshot.
+    btDynamicsWorld* guard_world = nullptr;
+    std::unique_ptr<btActionInterface> guard;
+    std::vector<std::pair<const btCollisionObject*, btTransform>> start_poses;
+    int64_t guard_step = 0, snapshot_step = -1;
+    std::unordered_map<const btCollisionObject*, int64_t> last_rollback; // the step each body was last put back
+    // Per (mesh object, SDF object): the step and the smallest gap at its start the narrow phase saw
+    // (a top-level pair; the margin when the pair was proven clear).
+    struct PairHash {
+        size_t operator()(const std::pair<const btCollisionObject*, const btCollisionObject*>& k) const
+        {
+            return std::hash<const void*>()(k.first) * 31u + std::hash<const void*>()(k.second);
+        }
     };
-    std::vector<PairRecord> pairs;
-    // Moves bodies of the recorded pairs that end the step deeper than `tolerance` back out; returns
-    // how many it moved. Only objects still in `world` are touched. to_impact (the hard clamp):
-    // back along the step's motion to its time of impact, normal velocity removed; otherwise (the
-    // projection) out along the deepest feature's normal, velocity unchanged.
-    int projectPairs(btCollisionWorld* world, double dt, double tolerance, bool to_impact);
-    btDynamicsWorld* projection_world = nullptr;
-    std::unique_ptr<btActionInterface> projection;
+    std::unordered_map<std::pair<const btCollisionObject*, const btCollisionObject*>, std::pair<int64_t, double>, PairHash> start_gaps;
+    double last_start_margin = 0; // the start-pose query's margin of the last gather()
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
     std::vector<sdfccd_Contact> contacts, start_contacts;

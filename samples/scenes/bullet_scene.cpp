@@ -71,7 +71,7 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     if (opt.extra_manifolds >= 0) cfg.extra_manifolds = opt.extra_manifolds;
     if (opt.kick >= 0) cfg.kick_angular_speed = opt.kick;
     if (opt.cover_depth >= 0) cfg.cover_depth = opt.cover_depth;
-    if (opt.projection >= 0) cfg.projection_tolerance = opt.projection;
+    if (!std::isnan(opt.guard)) cfg.guard_tolerance = opt.guard > 0 ? opt.guard : 0;
     const double face = std::isnan(opt.face_search) ? setup.face_search : opt.face_search;
     cfg.face_search_size = face > 0 ? face : 0;
     if (opt.discrete_subdivision_scale >= 0) cfg.discrete_subdivision_scale = opt.discrete_subdivision_scale;
@@ -83,12 +83,7 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
         std::snprintf(buf, sizeof buf, " [patch manifold, band %g m]", cfg.patch_band);
         m_description += buf;
     }
-    const double clamp = std::isnan(opt.hard_clamp) ? setup.hard_clamp : opt.hard_clamp;
-    if (m_bridge && clamp > 0) {
-        char buf[96];
-        std::snprintf(buf, sizeof buf, " [hard clamp %g m]", clamp);
-        m_description += buf;
-    }
+    if (m_bridge && !(cfg.guard_tolerance > 0)) m_description += " [guarantee off]";
     if (m_bridge && sds >= 0) {
         char buf[96];
         std::snprintf(buf, sizeof buf, " [spread depth scale %g m]", sds);
@@ -105,11 +100,6 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     if (opt.solver_iterations > 0) m_world->getSolverInfo().m_numIterations = opt.solver_iterations;
     if (m_bullet->status != sdfccd_bullet::Status::Ok)
         std::fprintf(stderr, "sdfccd_scenes: bridge registration failed: %s\n", sdfccd_bullet::statusString(m_bullet->status));
-    if (m_bridge && clamp > 0) {
-        sdfccd_bullet::Status s = m_bridge->setHardClamp(m_world, true, clamp);
-        if (s != sdfccd_bullet::Status::Ok)
-            std::fprintf(stderr, "sdfccd_scenes: hard clamp failed: %s\n", sdfccd_bullet::statusString(s));
-    }
 }
 
 BulletScene::~BulletScene()

@@ -40,7 +40,6 @@ struct BulletWorld {
  * bridge's own default / off). */
 struct BridgeSetup {
     double patch_band = -1;         /**< Config::patch_band. */
-    double hard_clamp = -1;         /**< Bridge::setHardClamp tolerance (<= 0: off). */
     double spread_depth_scale = -1; /**< Config::spread_depth_scale. */
     double face_search = -1;        /**< Config::face_search_size (<= 0: off). */
 };

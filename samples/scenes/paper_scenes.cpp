@@ -48,12 +48,9 @@ const double kG = 9.81;
 // and with 4 a body resting or landing on several features pivots about the one it has and lets
 // the others in (hoop: 1.7 mm resting, 0.03 mm with the patch). --patch-band -1 turns it off.
 const double kPatchBand = 0.02;
-// The paper's response rule (Section 4, after Eq. 12: the simulation does not advance past a time of impact):
-// the bridge's hard clamp moves a body that ends a step more than this deep back along its motion
-// to its time of impact and removes its normal velocity (Bridge::setHardClamp). It needs a time
-// of impact, so it is off by default with DCD (whose "toi" is the step's end: with the clamp on,
-// the DCD skateboard gained 95 J in one step). --hard-clamp 0 turns it off, --hard-clamp T on.
-const double kHardClamp = 5e-4;
+// The paper's response rule (Section 4, after Eq. 12: the simulation does not advance past a time
+// of impact) is the bridge's guarantee, on by default (Config::guard_tolerance 0.5 mm; off with
+// the DCD baseline). --guard 0 turns it off, --guard T sets its tolerance.
 // The bridge's reduction to manifold points weighs a point's spread against its gap over this
 // depth scale (Config::spread_depth_scale, default 0.3 m). The paper's bodies are centimetres thick
 // (the shuriken 4 mm): at 0.3 m the blade edges at the shuriken's mid-plane, 2 mm above its lower
@@ -135,11 +132,10 @@ public:
     }
 
 private:
-    static BridgeSetup setup(const Options& opt, double spread_depth_scale, double face_search)
+    static BridgeSetup setup(const Options&, double spread_depth_scale, double face_search)
     {
         BridgeSetup s;
         s.patch_band = kPatchBand;
-        s.hard_clamp = opt.method == SDFCCD_METHOD_DCD ? -1.0 : kHardClamp;
         s.spread_depth_scale = spread_depth_scale;
         s.face_search = face_search;
         return s;

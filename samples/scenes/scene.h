@@ -42,12 +42,10 @@ struct Options {
     double face_search = NAN; /**< Bullet scenes: the bridge's Config::face_search_size (m; <= 0: off; NaN: the scene's
                                    default, 0.02 in the spikes scene, off elsewhere). */
     int solver_iterations = -1; /**< Bullet scenes: btContactSolverInfo::m_numIterations; < 0: the scene's default. */
-    double hard_clamp = NAN; /**< Bullet scenes: Bridge::setHardClamp with this tolerance (m); <= 0: off; NaN: the scene's
-                                  default (0.5 mm in the paper's rigid scenes, off in the Bullet re-creations). */
+    double guard = NAN; /**< Bullet scenes: the bridge's Config::guard_tolerance (m); <= 0: off; NaN: its default. */
     int extra_manifolds = -1;   /**< Bullet scenes: the bridge's Config::extra_manifolds (< 0: its default). */
     double kick = -1;           /**< Bullet scenes: the bridge's Config::kick_angular_speed (< 0: its default). */
     double cover_depth = -1;    /**< Bullet scenes: the bridge's Config::cover_depth (< 0: its default). */
-    double projection = -1;     /**< Bullet scenes: the bridge's Config::projection_tolerance (< 0: its default; 0: off). */
     double spread_depth_fraction = -1; /**< Bullet scenes: the bridge's Config::spread_depth_fraction (< 0: its default, or
                                             0 when a spread depth scale >= 0 is set; 0: off). */
     double discrete_subdivision_scale = -1; /**< Bullet scenes: the bridge's Config::discrete_subdivision_scale (< 0: its

@@ -3,8 +3,9 @@
 // no argument runs every test. Prints one line per failed check and a closing
 // "N passed, N failed"; exits non-zero on any failure.
 // "Measured" beside a limit: the figure at commit 954e223, float / double Bullet (each test prints
-// its figures). A limit of 2 mm on a depth is the bridge's Config::projection_tolerance (no step
-// ends deeper than that unless it started so); positions at rest are held to the same 2 mm.
+// its figures). A limit of 2 mm on a depth was the tolerance of the bridge's former end-of-step
+// projection (now the guarantee, Config::guard_tolerance 0.5 mm, holds every step's whole motion);
+// positions at rest are held to the same 2 mm.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -722,21 +723,22 @@ static void test_closest_points_and_toi()
     sdfccd_destroy_sdf(slab);
 }
 
-// ---- optional hard clamp: a bar tumbling fast onto the torus's tube ----
+// ---- the guarantee: a bar tumbling fast onto the torus's tube ----
 
 // The bar (0.8 m) hits the tube end first while spinning at 25 rad/s: the speculative contacts
-// are linear, so without the clamp it pivots and ends some steps partly inside the tube.
-static double runTumble(bool clamp, int* clamps)
+// are linear, so without the guarantee it pivots and ends some steps partly inside the tube.
+static double runTumble(bool guard, int* rollbacks)
 {
     sdfccd_SdfId torus = { 0, 0 };
     CHECK(sdfccd_create_torus(1.0, 0.25, &torus) == SDFCCD_OK, "torus");
     const btVector3 half(0.4, 0.1, 0.1);
     double worst = 0;
     {
-        Bridge bridge;
+        sdfccd_bullet::Config cfg;
+        if (!guard) cfg.guard_tolerance = 0;
+        Bridge bridge(cfg);
         World w;
         CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
-        if (clamp) CHECK(bridge.setHardClamp(&w.world, true, 1e-3) == Status::Ok, "hard clamp on");
         SdfShape shape(torus);
         std::unique_ptr<TriMesh> bar = makeBox(half);
         w.add(&shape, 0, btVector3(0, 0, 0));
@@ -748,28 +750,29 @@ static double runTumble(bool clamp, int* clamps)
             w.step();
             worst = std::max(worst, barPenetration(torus, body->getWorldTransform(), half));
         }
-        *clamps = (int)bridge.stats().clamps;
-        checkNoQueryErrors(bridge.stats(), clamp ? "tumbling bar, clamp on" : "tumbling bar, clamp off");
-        CHECK(bridge.hardClampEnabled() == clamp, "hardClampEnabled");
-        if (clamp) CHECK(bridge.setHardClamp(&w.world, false) == Status::Ok, "hard clamp off");
+        *rollbacks = (int)bridge.stats().rollbacks;
+        checkNoQueryErrors(bridge.stats(), guard ? "tumbling bar, guarantee on" : "tumbling bar, guarantee off");
     }
     sdfccd_destroy_sdf(torus);
     return worst;
 }
 
-static void test_hard_clamp()
+static void test_guarantee()
 {
-    int clamps_off = 0, clamps_on = 0;
-    double off = runTumble(false, &clamps_off);
-    double on = runTumble(true, &clamps_on);
-    CHECK(clamps_off == 0, "clamp corrections while off: %d", clamps_off);
-    CHECK(clamps_on > 0, "the clamp never acted");
-    // Measured (both precisions): 0.00186 m without the clamp, 0.00021 m with it (3 corrections).
-    // The bar's sample points lie on its triangles, which the clamp holds to its 1 mm tolerance
-    // (the limit was 2 mm, above the clamp-off depth, so it could not tell the clamp mattered).
-    CHECK(on <= 1e-3, "with the hard clamp the deepest end-of-step penetration is %.5f m (tolerance 0.001)", on);
-    CHECK(off > 1e-3, "without the clamp the deepest end-of-step penetration is only %.5f m: the case does not need the clamp", off);
-    std::printf("hard clamp: deepest end-of-step penetration %.5f m without, %.5f m with (%d corrections)\n", off, on, clamps_on);
+    // A bar falling at 60 m/s while tumbling at 25 rad/s onto a torus: its contacts alone end
+    // steps deeper than the guarantee's tolerance; with the guarantee (on by default) no step ends
+    // a sample point of the bar deeper than it (it checks the whole executed motion).
+    int rollbacks_off = 0, rollbacks_on = 0;
+    double off = runTumble(false, &rollbacks_off);
+    double on = runTumble(true, &rollbacks_on);
+    const double tol = sdfccd_bullet::Config().guard_tolerance;
+    CHECK(tol > 0, "the guarantee is off by default");
+    CHECK(rollbacks_off == 0, "rollbacks while off: %d", rollbacks_off);
+    CHECK(rollbacks_on > 0, "the guarantee never acted");
+    // (The hard clamp this replaces held 1 mm here, 0.21 mm measured; 1.86 mm without it.)
+    CHECK(on <= tol, "with the guarantee the deepest end-of-step penetration is %.5f m (tolerance %.4f)", on, tol);
+    CHECK(off > tol, "without the guarantee the deepest end-of-step penetration is only %.5f m: the case does not need it", off);
+    std::printf("guarantee: deepest end-of-step penetration %.5f m without, %.5f m with (%d rollbacks)\n", off, on, rollbacks_on);
 }
 
 
@@ -881,17 +884,16 @@ static void test_kicked_into_sdf()
     // A GImpact cube hovering 3 cm above an SDF slab, hit from above by another GImpact cube at
     // 20 m/s (Bullet's own mesh-mesh algorithm, no CCD): the hit and the push into the slab happen
     // in ONE step. The bridge found the hovering cube's predicted motion clear of the slab, so the
-    // slab has no contact with it in that step; the end-of-step projection must still apply: a
-    // body that ends a step deeper than Config::projection_tolerance, having started it less
-    // deep, is moved out. By induction no step may end with a vertex deeper than the tolerance
-    // (the exact box SDF at the 8 vertices, after every step).
+    // slab has no contact with it in that step; the guarantee must still apply: it checks the
+    // executed motion, whatever moved the body, so no step may end with a vertex deeper than its
+    // tolerance (the exact box SDF at the 8 vertices, after every step).
     sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
     double worst = 0, first = 0;
     double tolerance = 0;
-    int64_t projections = 0;
+    int64_t rollbacks = 0;
     {
         Bridge bridge;
-        tolerance = bridge.config().projection_tolerance;
+        tolerance = bridge.config().guard_tolerance;
         World w;
         CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
         SdfShape shape(slab);
@@ -921,16 +923,16 @@ static void test_kicked_into_sdf()
                 std::printf("  kicked step %d: z %.5f vz %.3f pen %.5f (shot z %.5f vz %.3f)\n", i, body->getCenterOfMassPosition().z(),
                             body->getLinearVelocity().z(), pen, hammer->getCenterOfMassPosition().z(), hammer->getLinearVelocity().z());
         }
-        projections = bridge.stats().projections;
+        rollbacks = bridge.stats().rollbacks;
         checkNoQueryErrors(bridge.stats(), "kicked cube");
     }
-    // Measured: deepest 0.00100 m, first step 0.00100 m (tolerance 0.002); 8 / 10 projections.
-    CHECK(tolerance > 0, "the projection is on by default");
-    CHECK(projections > 0, "no projection happened");
+    // The end-of-step projection this replaces (tolerance 0.002) measured 0.00100 m.
+    CHECK(tolerance > 0, "the guarantee is on by default");
+    CHECK(rollbacks > 0, "the guarantee never acted");
     CHECK(first <= tolerance, "the kicked cube ended its first step %.4f m deep (tolerance %.4f)", first, tolerance);
-    CHECK(worst <= tolerance, "a vertex ended a step %.4f m deep (tolerance %.4f)", worst, tolerance);
-    std::printf("cube kicked into a slab by a 20 m/s GImpact cube (%s): deepest vertex after a step %.5f m (first step %.5f), %lld projections\n",
-                SDFCCD_BULLET_PRECISION_NAME, worst, first, (long long)projections);
+    CHECK(worst <= tolerance, "a vertex ended a step %.5f m deep (tolerance %.4f)", worst, tolerance);
+    std::printf("cube kicked into a slab by a 20 m/s GImpact cube (%s): deepest vertex after a step %.5f m (first step %.5f), %lld rollbacks\n",
+                SDFCCD_BULLET_PRECISION_NAME, worst, first, (long long)rollbacks);
     sdfccd_destroy_sdf(slab);
 }
 
@@ -1171,6 +1173,64 @@ static void test_compound_child()
     sdfccd_destroy_sdf(slab);
 }
 
+// A compound holding a GImpact cube (offset and rotated child) falling at 200 m/s (3.3 m per
+// step) onto the 10 cm slab: Bullet gives a compound child a pair only when its box overlaps the
+// slab's at the START of a step, so the child's own CCD never sees the impact step. The guarantee
+// checks the whole body's executed motion (the child's triangles moved by the child transform).
+// Returns the deepest vertex penetration after any step and the lowest vertex's final height.
+static double runCompoundFast(bool guard, double* lowest_final, int64_t* rollbacks)
+{
+    sdfccd_SdfId slab = makeBoxSdf(5, 5, 0.05);
+    double worst = 0;
+    {
+        sdfccd_bullet::Config cfg;
+        if (!guard) cfg.guard_tolerance = 0;
+        Bridge bridge(cfg);
+        World w;
+        CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
+        SdfShape shape(slab);
+        std::unique_ptr<TriMesh> cube = makeBox(btVector3(0.5, 0.5, 0.5));
+        btCompoundShape compound;
+        btTransform child;
+        child.setIdentity();
+        child.setOrigin(btVector3(0.3, 0.1, -0.2));
+        child.setRotation(btQuaternion(btVector3(0, 0, 1), btScalar(0.4)));
+        compound.addChildShape(child, cube->shape.get());
+        w.add(&shape, 0, btVector3(0, 0, 0));
+        btRigidBody* body = w.add(&compound, 1, btVector3(0, 0, 2.0), btVector3(0.5, 0.5, 0.5));
+        body->setLinearVelocity(btVector3(0, 0, -200));
+        body->setActivationState(DISABLE_DEACTIVATION);
+        btTransform id;
+        id.setIdentity();
+        for (int i = 0; i < 60; ++i) {
+            w.step();
+            worst = std::max(worst, vertexPenetration(*cube, body->getWorldTransform() * child, slab, id));
+        }
+        *lowest_final = 1e9;
+        for (size_t i = 0; i + 2 < cube->v.size(); i += 3)
+            *lowest_final = std::min(*lowest_final, (double)(body->getWorldTransform() * child * btVector3(cube->v[i], cube->v[i + 1], cube->v[i + 2])).z());
+        *rollbacks = bridge.stats().rollbacks;
+        checkNoQueryErrors(bridge.stats(), guard ? "fast compound, guarantee on" : "fast compound, guarantee off");
+    }
+    sdfccd_destroy_sdf(slab);
+    return worst;
+}
+
+static void test_compound_fast()
+{
+    double low_on = 0, low_off = 0;
+    int64_t rb_on = 0, rb_off = 0;
+    const double on = runCompoundFast(true, &low_on, &rb_on);
+    const double off = runCompoundFast(false, &low_off, &rb_off);
+    // Issue 19: stops on the slab within 1 cm; without the guarantee it passes through.
+    CHECK(on <= 0.01, "with the guarantee the compound's child went %.5f m into the slab", on);
+    CHECK(low_on > 0.05 - 0.01, "with the guarantee the child's lowest vertex ends at z %.4f (slab top 0.05)", low_on);
+    CHECK(rb_on > 0, "the guarantee never acted");
+    CHECK(low_off < -0.05, "without the guarantee the child ends at z %.4f: the case does not need it", low_off);
+    std::printf("compound at 200 m/s (%s): deepest %.5f m, lowest vertex ends at %.5f (%lld rollbacks); without the guarantee "
+                "it ends at %.3f\n", SDFCCD_BULLET_PRECISION_NAME, on, low_on, (long long)rb_on, low_off);
+}
+
 // Contact callbacks, counted per manifold.
 static int g_started = 0, g_ended = 0, g_processed = 0, g_added = 0, g_unpaired = 0;
 static std::vector<const btPersistentManifold*> g_open;
@@ -1402,7 +1462,7 @@ static void test_misuse()
         CHECK(bridge.check(&w.world, &msg) == Status::InvalidShape, "destroyed handle: %s", msg.c_str());
     }
     {
-        // The hard clamp chains the user's tick callbacks and keeps the world's user info.
+        // The guarantee (an action) leaves the user's tick callbacks and the world's user info alone.
         g_user_pre = g_user_post = 0;
         int info = 42;
         Bridge bridge;
@@ -1410,21 +1470,10 @@ static void test_misuse()
         CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
         w.world.setInternalTickCallback(userPre, &info, true);
         w.world.setInternalTickCallback(userPost, &info, false);
-        CHECK(bridge.setHardClamp(&w.world, true) == Status::Ok, "clamp on");
         w.step();
         CHECK(g_user_pre == 1 && g_user_post == 1 && g_user_info_seen == &info, "user callbacks %d %d (info %p)", g_user_pre,
               g_user_post, g_user_info_seen);
-        CHECK(bridge.check(&w.world, &msg) == Status::Ok, "clamp chained: %s", msg.c_str());
-        CHECK(bridge.setHardClamp(&w.world, false) == Status::Ok, "clamp off");
-        w.step();
-        CHECK(g_user_pre == 2 && g_user_post == 2, "user callbacks not restored: %d %d", g_user_pre, g_user_post);
-        // A callback installed after the clamp displaces it: reported, and stepping is safe.
-        CHECK(bridge.setHardClamp(&w.world, true) == Status::Ok, "clamp on again");
-        w.world.setInternalTickCallback(userPost, nullptr, false);
-        CHECK(bridge.check(&w.world, &msg) == Status::ClampDisplaced, "displaced clamp: %s", msg.c_str());
-        w.step();
-        CHECK(g_user_post == 3, "user post callback %d", g_user_post);
-        bridge.setHardClamp(&w.world, false);
+        CHECK(bridge.check(&w.world, &msg) == Status::Ok, "user callbacks: %s", msg.c_str());
     }
     setMisuseHandler(nullptr);
     sdfccd_destroy_sdf(slab);
@@ -1529,12 +1578,13 @@ static const Test kTests[] = {
     { "shape_aabb", test_shape_aabb },
     { "registration", test_registration },
     { "closest_points_and_toi", test_closest_points_and_toi },
-    { "hard_clamp", test_hard_clamp },
+    { "guarantee", test_guarantee },
     { "corner_cube", test_corner_cube },
     { "torus_flat", test_torus_flat },
     { "batch_threads", test_batch_threads },
     { "kicked_into_sdf", test_kicked_into_sdf },
     { "compound_child", test_compound_child },
+    { "compound_fast", test_compound_fast },
     { "face_search", test_face_search },
     { "callbacks", test_callbacks },
     { "convex_box_fast", test_convex_box_fast },

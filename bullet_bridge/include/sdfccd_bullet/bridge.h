@@ -36,10 +36,13 @@
  *    A point with gap d > 0 lets the solver close at most d in the step, so the mesh stops on
  *    the surface in its impact step; such speculative points have restitution 0.
  *  - Bridge::check(world) reports misuse (not registered, registered too late, overwritten,
- *    an SdfShape with a dead handle, a displaced hard clamp); while a world steps, Bullet's
+ *    an SdfShape with a dead handle); while a world steps, Bullet's
  *    GImpact algorithm colliding with an SdfShape (the bridge not in charge) goes to the misuse
  *    handler, which asserts in debug builds (setMisuseHandler).
- *  - optional hard clamp (off by default), see setHardClamp().
+ *  - the guarantee (on by default, Config::guard_tolerance): after Bullet integrates a step, every
+ *    dynamic body that can reach an SDF has its executed motion (start pose to the pose the solver
+ *    produced) checked with the CCD; a body that went deeper than the tolerance is put back at its
+ *    time of impact (see Config::guard_tolerance for its velocity).
  *
  * Manifold convention: body A = the mesh (or convex/moving SDF) body, body B = the SDF body; the
  * normal is grad phi (out of the SDF, towards the mesh); the point on B is on the surface;
@@ -81,12 +84,10 @@ enum class Status {
                             algorithm they were created with. Register right after creating the world. */
     Overwritten,       /**< verify(): the dispatcher no longer finds our algorithm for GImpact vs SDF,
                             e.g. btGImpactCollisionAlgorithm::registerAlgorithm was called after us. */
-    NotRegistered,     /**< verify()/setHardClamp() before a successful registerWith(). */
+    NotRegistered,     /**< verify() before a successful registerWith(). */
     InvalidArgument,   /**< NULL world/dispatcher, a dispatcher that is not a btCollisionDispatcher,
-                            a shape type id that is not concave, or setHardClamp() without a
-                            btDiscreteDynamicsWorld. */
-    InvalidShape,      /**< check(): an SdfShape in the world wraps a null or destroyed sdfccd handle. */
-    ClampDisplaced     /**< check(): an internal tick callback set after setHardClamp() replaced the clamp's. */
+                            or a shape type id that is not concave. */
+    InvalidShape       /**< check(): an SdfShape in the world wraps a null or destroyed sdfccd handle. */
 };
 
 /** Constant name of a status, e.g. "TooLate". */
@@ -195,25 +196,20 @@ struct Config {
      * tori are no longer subdivided) with the same penetration; the CCD query keeps the library's
      * subdivision. 0: the library's subdivision_min_area everywhere. Default 0.1. */
     double discrete_subdivision_scale = 0.1;
-    /** End-of-step projection (m; <= 0: off). When the bridge is registered with a dynamics world
-     * (registerWith(btCollisionWorld*)), it adds an action (btActionInterface, run after Bullet
-     * integrates the step) that moves a mesh body ending the step deeper than this in an SDF out
-     * along the normal of its deepest feature until it is half as deep; its velocity is left
-     * unchanged (the contacts deal with it, like a split-impulse position correction). The contacts hold the surface in Bullet's velocity solve, but Bullet's split-impulse
-     * position pass (on by default) only solves contacts deeper than the world's
-     * m_splitImpulsePenetrationThreshold (-0.04 m): a deep contact between two GImpact meshes
-     * there pushes a body into the SDF with nothing resisting (gimpact-demo: 18 mm with
-     * m_splitImpulse on, 8 mm with it off, 5.6 mm with this projection). A body that starts the
-     * step deeper is left to the contacts. Costs one discrete query per pair and step with contact
-     * candidates. It also covers a body whose pair the queries found clear for its predicted
-     * motion but that another contact solved in the same step (a GImpact mesh-mesh hit) carried
-     * farther than that proof allows (margin + this tolerance from its predicted end pose): such a
-     * kicked body, if it ends deeper than this, goes back along its actual motion to where it
-     * first came within half of this of the surface, with no velocity into the surface (a
-     * normal projection could push it out through the far side of a thin part). Clear pairs cost
-     * no query unless the body was kicked (gimpact-shot-50, float: 28.8 -> 2.0 mm; landscape:
-     * 182.7 -> 2.0 mm). Default 0.002. */
-    double projection_tolerance = 0.002;
+    /** The guarantee (m; <= 0: off). When the bridge is registered with a dynamics world
+     * (registerWith(btCollisionWorld*)), an action it adds (run after Bullet integrates each step)
+     * checks the executed motion of every dynamic body whose swept box meets an SDF's: from its
+     * pose at the start of the step to the pose the solver produced (constant velocities, shortest
+     * rotation), every compound child and convex shape as its triangles. If any point went deeper
+     * than this below an SDF's surface (sdfccd_guard_rigid, then a discrete check of the pose it
+     * keeps), the body goes back along that motion to where it was within half of this (the paper's
+     * rule: never advance past a time of impact). Its velocity: the first time, kept, for the next
+     * step's contacts, which start at the time of impact and respond with every point and friction;
+     * rolled back again in the next step, it loses its velocity into the surface (its centre's, then
+     * an inelastic impulse with Coulomb friction at the contact point; the SDF body counts as
+     * infinitely heavy). A body that starts a step deeper is left to the contacts. Bodies clear of
+     * every SDF's box cost nothing. Off with query.method DCD (the discrete baseline). Default 0.0005. */
+    double guard_tolerance = 0.0005;
     /** Handle convex shapes (box, sphere, capsule, hulls...) against SdfShape with the same
      * CCD (box: its 12 triangles; others: their btShapeHull). Off: Bullet's convex-concave
      * algorithm against the shape's triangulation (no CCD). Default on. */
@@ -261,8 +257,12 @@ struct Stats {
     int64_t ordinary_contacts = 0;     /**< Contacts written for features in contact at step start. */
     int64_t query_errors = 0;          /**< Queries that failed or had no mesh/SDF to work with (no contacts written). */
     int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
-    int64_t clamps = 0;                /**< Hard-clamp corrections. */
-    int64_t projections = 0;           /**< End-of-step projections (Config::projection_tolerance). */
+    int64_t guard_queries = 0;         /**< Executed motions checked by the guarantee (one per body part and SDF). */
+    int64_t rollbacks = 0;             /**< Bodies the guarantee put back at their time of impact. */
+    int64_t guard_skipped = 0;         /**< Checks the guarantee skipped: the step's narrow phase saw the body's
+                                            start clear by more than its executed motion could close. */
+    int64_t guard_bisections = 0;      /**< Poses the CCD let through that the guarantee's discrete check found
+                                            deeper than its tolerance (put back by bisection). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (Config::face_search_size). */
     int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
                                             they are counted in queries, end_pose_queries and sdf_evaluations too. */
@@ -316,27 +316,14 @@ public:
      *  Overwritten    something replaced our create functions after registerWith();
      *  InvalidShape   an SdfShape in the world has a null or destroyed sdfccd handle;
      *  TooLate        a mesh-SDF pair still has an algorithm created before registerWith();
-     *  ClampDisplaced the hard clamp's tick callbacks were replaced;
      *  Ok             none of these (the message mentions failed queries, if any). */
     Status check(btCollisionWorld* world, std::string* message = nullptr) const;
 
     /** Restores the dispatcher's slots to the collision configuration's defaults (note: this also
-     * drops GImpact's registration for those pairs), removes the end-of-step projection's action
+     * drops GImpact's registration for those pairs), removes the guarantee's action
      * from the world and forgets the dispatcher. */
     void unregister();
 
-    /** Optional hard clamp (off by default; while it is on it replaces the end-of-step
-     * projection, see Config::projection_tolerance, with its own tolerance). With it on, internal pre- and post-tick callbacks
-     * of `world` save each GImpact body's start pose and, after integration, move a mesh that
-     * ends a step inside an SDF by more than `tolerance` (m) back to its time of impact and
-     * remove its velocity into the surface. Tick callbacks installed before are chained (called
-     * after the clamp's, with the world's user info unchanged) and put back when it is turned
-     * off; install your own callbacks BEFORE turning the clamp on (one installed later replaces
-     * the clamp's: check() reports ClampDisplaced). Costs one extra query per mesh-SDF pair and
-     * step. AlreadyRegistered: another bridge clamps this world. */
-    Status setHardClamp(btDiscreteDynamicsWorld* world, bool on, double tolerance = 1e-3);
-    /** True while setHardClamp() has the clamp on for a world. */
-    bool hardClampEnabled() const;
 
     /** Time of impact of `mesh_body` moving from its world transform to its interpolation
      * transform, against `sdf_body` (likewise) over `dt` seconds, as a fraction in [0, 1]
