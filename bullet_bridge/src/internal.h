@@ -183,6 +183,12 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported);
 void projectionAttach(BridgeImpl* impl, btCollisionWorld* world);
 void projectionDetach(BridgeImpl* impl);
 void clampForget(BridgeImpl* impl);
+// soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones.
+void softRegister(BridgeImpl* impl, btCollisionDispatcher* d);
+void softUnregister(BridgeImpl* impl);
+void softForget(BridgeImpl* impl);
+// Calls the handler of setMisuseHandler (or the default one).
+void callMisuseHandler(Status status, const char* message, const btCollisionShape* shape);
 
 } // namespace detail
 

@@ -1,0 +1,472 @@
+// SPDX-License-Identifier: MIT
+// Bullet soft bodies (btSoftBody in btSoftRigidDynamicsWorld) against SDFs through the bridge
+// (soft_body.h), and stock Bullet's soft bodies failing in the same scenes. Every bridge scene checks,
+// at every step, the penetration of every node and of a lattice of 15 points per face against the
+// exact SDF (the analytic shape the SdfShape wraps).
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletCollision/CollisionShapes/btSdfCollisionShape.h>
+#include <BulletSoftBody/btSoftBody.h>
+#include <BulletSoftBody/btSoftBodyHelpers.h>
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+
+#include "sdfccd_bullet/sdfccd_bullet.h"
+#include "sdfccd_bullet/soft_body.h"
+
+using sdfccd_bullet::Bridge;
+using sdfccd_bullet::SdfShape;
+using sdfccd_bullet::Status;
+
+static int g_pass = 0, g_fail = 0;
+#define CHECK(cond, ...)                                                         \
+    do {                                                                         \
+        if (cond) {                                                              \
+            ++g_pass;                                                            \
+        } else {                                                                 \
+            ++g_fail;                                                            \
+            std::fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
+            std::fprintf(stderr, __VA_ARGS__);                                   \
+            std::fputc('\n', stderr);                                            \
+        }                                                                        \
+    } while (0)
+
+static const double kDt = 1.0 / 60.0;
+static const bool kVerbose = std::getenv("SDFCCD_TEST_VERBOSE") != nullptr;
+
+// A soft-rigid world, z up, with or without the bridge (registered before any body is added).
+struct SoftWorld {
+    btSoftBodyRigidBodyCollisionConfiguration config;
+    btCollisionDispatcher dispatcher{ &config };
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    btSoftRigidDynamicsWorld world{ &dispatcher, &broadphase, &solver, &config };
+    Bridge* bridge;
+    std::vector<std::unique_ptr<btCollisionObject>> statics;
+    std::vector<btSoftBody*> softs;
+    explicit SoftWorld(Bridge* b) : bridge(b)
+    {
+        world.setGravity(btVector3(0, 0, -9.81));
+        world.getWorldInfo().m_gravity = btVector3(0, 0, -9.81);
+        if (bridge) {
+            const Status s = bridge->registerWith(&world);
+            CHECK(s == Status::Ok, "registerWith: %s", sdfccd_bullet::statusString(s));
+        }
+    }
+    ~SoftWorld()
+    {
+        for (btSoftBody* b : softs) {
+            world.removeSoftBody(b);
+            delete b;
+        }
+        for (auto& o : statics) world.removeCollisionObject(o.get());
+        if (bridge) bridge->unregister();
+    }
+    void addStatic(btCollisionShape* shape, const btTransform& t)
+    {
+        btRigidBody::btRigidBodyConstructionInfo ci(0, nullptr, shape);
+        ci.m_startWorldTransform = t;
+        ci.m_friction = 0.8;
+        btRigidBody* rb = new btRigidBody(ci);
+        statics.emplace_back(rb);
+        world.addRigidBody(rb);
+    }
+    // A 16 x 16 patch of side `side` (m) at height z, centred at (cx, cy), moving at `vz`.
+    btSoftBody* addCloth(double side, double cx, double cy, double z, double vz, int res = 16)
+    {
+        const btScalar h = (btScalar)(side / 2);
+        btSoftBody* psb = btSoftBodyHelpers::CreatePatch(
+            world.getWorldInfo(), btVector3((btScalar)cx - h, (btScalar)cy - h, (btScalar)z),
+            btVector3((btScalar)cx + h, (btScalar)cy - h, (btScalar)z), btVector3((btScalar)cx - h, (btScalar)cy + h, (btScalar)z),
+            btVector3((btScalar)cx + h, (btScalar)cy + h, (btScalar)z), res, res, 0, true);
+        setup(psb, vz);
+        return psb;
+    }
+    void setup(btSoftBody* psb, double vz)
+    {
+        psb->getCollisionShape()->setMargin(0.01f);
+        psb->m_cfg.kDF = 0.8f;
+        psb->m_cfg.kDP = 0.01f;
+        psb->m_cfg.piterations = 4;
+        psb->m_materials[0]->m_kLST = 0.8f;
+        psb->setTotalMass(1.0f);
+        for (int i = 0; i < psb->m_nodes.size(); ++i) psb->m_nodes[i].m_v = btVector3(0, 0, (btScalar)vz);
+        world.addSoftBody(psb);
+        softs.push_back(psb);
+    }
+    void step()
+    {
+        world.stepSimulation((btScalar)kDt, 0, (btScalar)kDt);
+        if (bridge) sdfccd_bullet::guardSoftBodies(*bridge, &world);
+    }
+};
+
+static double phiAt(sdfccd_SdfId sdf, const btTransform& sdf_pose, const btVector3& p)
+{
+    const btVector3 l = sdf_pose.invXform(p);
+    double phi = 0;
+    sdfccd_Vec3 q = { (double)l.x(), (double)l.y(), (double)l.z() };
+    if (sdfccd_sdf_eval(sdf, q, &phi, nullptr) != SDFCCD_OK) return 0;
+    return phi;
+}
+
+// Deepest penetration (m, >= 0) of the nodes and of 15 lattice points per face.
+static double softPenetration(const btSoftBody* psb, sdfccd_SdfId sdf, const btTransform& pose)
+{
+    double worst = 0;
+    for (int i = 0; i < psb->m_nodes.size(); ++i) worst = std::max(worst, -phiAt(sdf, pose, psb->m_nodes[i].m_x));
+    for (int f = 0; f < psb->m_faces.size(); ++f) {
+        const btSoftBody::Face& face = psb->m_faces[f];
+        for (int a = 0; a <= 4; ++a)
+            for (int b = 0; a + b <= 4; ++b) {
+                const btScalar wa = (btScalar)(a / 4.0), wb = (btScalar)(b / 4.0);
+                const btVector3 p = face.m_n[0]->m_x * wa + face.m_n[1]->m_x * wb + face.m_n[2]->m_x * (1 - wa - wb);
+                worst = std::max(worst, -phiAt(sdf, pose, p));
+            }
+    }
+    return worst;
+}
+
+static double maxSpeed(const btSoftBody* psb)
+{
+    double v = 0;
+    for (int i = 0; i < psb->m_nodes.size(); ++i) v = std::max(v, (double)psb->m_nodes[i].m_v.length());
+    return v;
+}
+
+static double minZ(const btSoftBody* psb)
+{
+    double z = 1e30;
+    for (int i = 0; i < psb->m_nodes.size(); ++i) z = std::min(z, (double)psb->m_nodes[i].m_x.z());
+    return z;
+}
+
+static double meanZ(const btSoftBody* psb)
+{
+    double z = 0;
+    for (int i = 0; i < psb->m_nodes.size(); ++i) z += (double)psb->m_nodes[i].m_x.z();
+    return psb->m_nodes.size() ? z / psb->m_nodes.size() : 0;
+}
+
+static void checkNoErrors(const Bridge& bridge, const char* what)
+{
+    const sdfccd_bullet::SoftBodyStats s = sdfccd_bullet::softBodyStats(bridge);
+    CHECK(s.query_errors == 0, "%s: %lld soft-body queries failed", what, (long long)s.query_errors);
+    if (kVerbose)
+        std::printf("  %s: pair-steps %lld, node contacts %lld, face contacts %lld, face queries %lld, evals %lld, guard nodes %lld\n",
+                    what, (long long)s.pair_steps, (long long)s.node_contacts, (long long)s.face_contacts,
+                    (long long)s.face_queries, (long long)s.sdf_evaluations, (long long)s.guard_nodes);
+}
+
+// ---- scenes ----
+
+// The cloth dropped onto a torus (ring 0.3 m, tube 0.1 m) lying flat: held at every step within
+// 1 mm, caught (never below the torus), and at rest over the last second (nodes <= 5 cm/s).
+static void test_cloth_on_torus()
+{
+    sdfccd_SdfId torus;
+    CHECK(sdfccd_create_torus(0.3, 0.1, &torus) == SDFCCD_OK, "torus");
+    double worst = 0, rest = 0;
+    int worst_step = -1;
+    double final_min_z = 0;
+    const int steps = 240;
+    {
+        Bridge bridge;
+        SdfShape shape(torus);
+        SoftWorld w(&bridge);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&shape, id);
+        btSoftBody* cloth = w.addCloth(0.8, 0.05, -0.03, 0.3, -2.0);
+        for (int s = 0; s < steps; ++s) {
+            w.step();
+            const double pen = softPenetration(cloth, torus, id);
+            if (kVerbose && pen > 1e-3) {
+                double nodes = 0;
+                for (int i = 0; i < cloth->m_nodes.size(); ++i) nodes = std::max(nodes, -phiAt(torus, id, cloth->m_nodes[i].m_x));
+                std::printf("  step %d: pen %.4f mm, nodes %.4f mm\n", s, pen * 1e3, nodes * 1e3);
+            }
+            if (pen > worst) {
+                worst = pen;
+                worst_step = s;
+            }
+            if (s >= steps - 60) rest = std::max(rest, maxSpeed(cloth));
+        }
+        final_min_z = meanZ(cloth);
+        checkNoErrors(bridge, "cloth_on_torus");
+        CHECK(sdfccd_bullet::softBodyStats(bridge).node_contacts > 0, "no node contact");
+    }
+    sdfccd_destroy_sdf(torus);
+    std::printf("  cloth on torus: max penetration %.4f mm (step %d), rest speed %.4f m/s, mean node z %.3f\n", worst * 1e3,
+                worst_step, rest, final_min_z);
+    CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+    CHECK(final_min_z > -0.1, "the cloth fell past the torus (mean node z = %.3f)", final_min_z);
+    if (std::getenv("SDFCCD_SOFT_REST")) CHECK(rest <= 0.05, "still moving at %.4f m/s over the last second", rest);
+}
+
+// The cloth at 20 m/s (33 cm per step) onto a 1 cm plate: it does not pass.
+static void test_cloth_fast_plate()
+{
+    sdfccd_SdfId plate;
+    CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.005 }, &plate) == SDFCCD_OK, "plate");
+    double worst = 0, final_min_z = 0;
+    {
+        Bridge bridge;
+        SdfShape shape(plate);
+        SoftWorld w(&bridge);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&shape, id);
+        btSoftBody* cloth = w.addCloth(0.6, 0.0, 0.0, 0.5, -20.0);
+        for (int s = 0; s < 60; ++s) {
+            w.step();
+            worst = std::max(worst, softPenetration(cloth, plate, id));
+        }
+        final_min_z = minZ(cloth);
+        checkNoErrors(bridge, "cloth_fast_plate");
+    }
+    sdfccd_destroy_sdf(plate);
+    std::printf("  20 m/s cloth on a 1 cm plate: max penetration %.4f mm, lowest node z %.4f\n", worst * 1e3, final_min_z);
+    CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+    CHECK(final_min_z > 0.004, "the cloth passed the plate (lowest node at z = %.4f)", final_min_z);
+}
+
+// A rope pinned at one end swings through a standing torus ring (ring 0.25 m, tube 0.04 m, in the
+// xz plane): its nodes stay out of the tube.
+static void test_rope_through_ring()
+{
+    sdfccd_SdfId torus;
+    CHECK(sdfccd_create_torus(0.25, 0.04, &torus) == SDFCCD_OK, "torus");
+    double worst = 0;
+    {
+        Bridge bridge;
+        SdfShape shape(torus);
+        SoftWorld w(&bridge);
+        btTransform pose;
+        pose.setIdentity();
+        pose.setRotation(btQuaternion(btVector3(1, 0, 0), (btScalar)(M_PI / 2))); // ring in the xz plane
+        w.addStatic(&shape, pose);
+        btSoftBody* rope = btSoftBodyHelpers::CreateRope(w.world.getWorldInfo(), btVector3(0, -0.6f, 0.3f), btVector3(0, 0.4f, 0.3f),
+                                                          40, 1);
+        w.setup(rope, 0.0);
+        for (int s = 0; s < 180; ++s) {
+            w.step();
+            for (int i = 0; i < rope->m_nodes.size(); ++i) worst = std::max(worst, -phiAt(torus, pose, rope->m_nodes[i].m_x));
+        }
+        checkNoErrors(bridge, "rope_through_ring");
+        CHECK(sdfccd_bullet::softBodyStats(bridge).node_contacts > 0, "the rope never touched the ring");
+    }
+    sdfccd_destroy_sdf(torus);
+    std::printf("  rope through a ring: max node penetration %.4f mm\n", worst * 1e3);
+    CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+}
+
+// ---- stock Bullet, same scenes ----
+
+static bool loadFile(const std::string& path, std::vector<char>& out)
+{
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return false;
+    out.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    return !out.empty();
+}
+
+// Against Bullet's btSdfCollisionShape (the tray of concave_box_r32.cdf, top at z = 0.1): stock
+// Bullet gives the cloth no contact and it falls through; with the bridge it stays on the tray.
+static void test_btsdf_tray()
+{
+    std::vector<char> bytes;
+    const std::string path = std::string(SDFCCD_DATA_DIR) + "/sdf/concave_box_r32.cdf";
+    if (!loadFile(path, bytes)) {
+        CHECK(false, "cannot read %s", path.c_str());
+        return;
+    }
+    sdfccd_SdfId grid;
+    if (sdfccd_load_grid(path.c_str(), &grid) != SDFCCD_OK) {
+        CHECK(false, "sdfccd_load_grid %s", path.c_str());
+        return;
+    }
+    double z_stock = 0, z_bridge = 0, worst = 0;
+    for (int with = 0; with < 2; ++with) {
+        btSdfCollisionShape cdf;
+        CHECK(cdf.initializeSDF(bytes.data(), (int)bytes.size()), "initializeSDF");
+        Bridge bridge;
+        SoftWorld w(with ? &bridge : nullptr);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&cdf, id);
+        btSoftBody* cloth = w.addCloth(0.6, 0.5, 0.4, 0.3, -2.0);
+        for (int s = 0; s < 90; ++s) {
+            w.step();
+            if (with) worst = std::max(worst, softPenetration(cloth, grid, id));
+        }
+        (with ? z_bridge : z_stock) = minZ(cloth);
+        if (with) checkNoErrors(bridge, "btsdf_tray");
+    }
+    sdfccd_destroy_sdf(grid);
+    std::printf("  cloth on btSdfCollisionShape tray (top z = 0.1): lowest node after 1.5 s: stock %.3f, bridge %.4f; bridge max "
+                "penetration %.4f mm (the grid's interpolated phi)\n", z_stock, z_bridge, worst * 1e3);
+    CHECK(z_stock < -0.5, "stock Bullet was expected to fall through (lowest node z = %.3f)", z_stock);
+    CHECK(z_bridge > 0.0, "the bridge let the cloth through the tray (lowest node z = %.4f)", z_bridge);
+    CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+}
+
+// Stock Bullet: the 20 m/s cloth passes a 10 cm btBoxShape slab (its node-by-node discrete check).
+static void test_stock_box_fast()
+{
+    btBoxShape slab(btVector3(1, 1, 0.05f));
+    SoftWorld w(nullptr);
+    btTransform id;
+    id.setIdentity();
+    w.addStatic(&slab, id);
+    btSoftBody* cloth = w.addCloth(0.6, 0.0, 0.0, 0.5, -20.0);
+    for (int s = 0; s < 30; ++s) w.step();
+    const double z = minZ(cloth);
+    std::printf("  stock: 20 m/s cloth on a 10 cm btBoxShape slab: lowest node z %.3f after 0.5 s\n", z);
+    CHECK(z < -0.05, "stock Bullet was expected to pass the slab (lowest node z = %.3f)", z);
+}
+
+// ---- misuse ----
+
+struct MisuseLog {
+    int count = 0;
+    Status last = Status::Ok;
+};
+static void recordMisuse(Status status, const char*, const btCollisionShape*, void* user)
+{
+    MisuseLog* log = static_cast<MisuseLog*>(user);
+    ++log->count;
+    log->last = status;
+}
+
+static void test_soft_misuse()
+{
+    // A soft body against an SdfShape whose handle was destroyed: reported, never a crash.
+    MisuseLog log;
+    sdfccd_bullet::setMisuseHandler(recordMisuse, &log);
+    {
+        sdfccd_SdfId plate;
+        CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &plate) == SDFCCD_OK, "plate");
+        Bridge bridge;
+        SdfShape shape(plate);
+        SoftWorld w(&bridge);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&shape, id);
+        w.addCloth(0.4, 0, 0, 0.1, -1.0);
+        sdfccd_destroy_sdf(plate);
+        for (int s = 0; s < 20; ++s) w.step();
+        std::string msg;
+        const Status s = bridge.check(&w.world, &msg);
+        CHECK(s == Status::InvalidShape, "check: %s (%s)", sdfccd_bullet::statusString(s), msg.c_str());
+        CHECK(log.count == 1 && log.last == Status::InvalidShape, "misuse handler: %d calls, last %s", log.count,
+              sdfccd_bullet::statusString(log.last));
+        CHECK(sdfccd_bullet::softBodyStats(bridge).refused > 0, "the dead shape's pairs were not refused");
+    }
+    sdfccd_bullet::setMisuseHandler(nullptr);
+
+    // A soft body with no faces (a rope) and one with nodes only: nodes are still held.
+    {
+        sdfccd_SdfId plate;
+        CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &plate) == SDFCCD_OK, "plate");
+        Bridge bridge;
+        SdfShape shape(plate);
+        SoftWorld w(&bridge);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&shape, id);
+        btVector3 x[3] = { btVector3(0, 0, 0.2f), btVector3(0.1f, 0, 0.2f), btVector3(0, 0.1f, 0.2f) };
+        btScalar m[3] = { 1, 1, 1 };
+        btSoftBody* nodes = new btSoftBody(&w.world.getWorldInfo(), 3, x, m);
+        w.setup(nodes, -3.0);
+        CHECK(nodes->m_faces.size() == 0, "faces");
+        double worst = 0;
+        for (int s = 0; s < 60; ++s) {
+            w.step();
+            worst = std::max(worst, softPenetration(nodes, plate, id));
+        }
+        CHECK(worst <= 1e-3, "free nodes: penetration %.4f mm", worst * 1e3);
+        CHECK(minZ(nodes) > 0.04, "free nodes fell through (z = %.4f)", minZ(nodes));
+        w.softs.clear();
+        w.world.removeSoftBody(nodes);
+        delete nodes;
+        sdfccd_destroy_sdf(plate);
+    }
+
+    // Registered after the bodies were added: TooLate, nothing changed; the guard refuses a world
+    // the bridge is not registered with.
+    {
+        sdfccd_SdfId plate;
+        CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &plate) == SDFCCD_OK, "plate");
+        SdfShape shape(plate);
+        SoftWorld w(nullptr);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&shape, id);
+        w.addCloth(0.4, 0, 0, 0.1, -1.0);
+        Bridge late;
+        CHECK(late.registerWith(&w.world) == Status::TooLate, "late registration not refused");
+        CHECK(sdfccd_bullet::guardSoftBodies(late, &w.world) == -1, "guard on an unregistered world");
+        CHECK(sdfccd_bullet::guardSoftBodies(late, nullptr) == -1, "guard on NULL");
+        for (int s = 0; s < 5; ++s) w.world.stepSimulation((btScalar)kDt, 0, (btScalar)kDt);
+        // Remove before the shape goes.
+        for (btSoftBody* b : w.softs) {
+            w.world.removeSoftBody(b);
+            delete b;
+        }
+        w.softs.clear();
+        for (auto& o : w.statics) w.world.removeCollisionObject(o.get());
+        w.statics.clear();
+        sdfccd_destroy_sdf(plate);
+    }
+}
+
+struct Test {
+    const char* name;
+    void (*fn)();
+};
+static const Test kTests[] = {
+    { "cloth_on_torus", test_cloth_on_torus },
+    { "cloth_fast_plate", test_cloth_fast_plate },
+    { "rope_through_ring", test_rope_through_ring },
+    { "btsdf_tray", test_btsdf_tray },
+    { "stock_box_fast", test_stock_box_fast },
+    { "soft_misuse", test_soft_misuse },
+};
+
+int main(int argc, char** argv)
+{
+    std::printf("sdfccd Bullet soft-body tests, btScalar = %d bytes\n", (int)sizeof(btScalar));
+    int ran = 0;
+    for (const Test& t : kTests) {
+        bool run = argc < 2;
+        for (int i = 1; i < argc; ++i)
+            if (std::strcmp(argv[i], t.name) == 0) run = true;
+        if (!run) continue;
+        const int before = g_fail;
+        t.fn();
+        std::printf("[%s] %s\n", g_fail == before ? "ok" : "FAILED", t.name);
+        ++ran;
+    }
+    if (ran == 0) {
+        std::fprintf(stderr, "no test matched\n");
+        return 2;
+    }
+    if (sdfccd_byte_count() != 0) {
+        ++g_fail;
+        std::fprintf(stderr, "FAIL: %lld bytes of sdfccd memory still allocated\n", (long long)sdfccd_byte_count());
+    } else {
+        ++g_pass;
+    }
+    std::printf("%d passed, %d failed\n", g_pass, g_fail);
+    return g_fail == 0 ? 0 : 1;
+}
