@@ -312,6 +312,41 @@ static void test_cloth_on_spikes()
     CHECK(face_steps > 0, "no face contact: the scene does not test face interiors");
 }
 
+// A volumetric soft ball (btSoftBodyHelpers::CreateEllipsoid, pressure) dropped at 3 m/s onto the
+// torus, into its ring (ball radius 0.25 m, hole 0.2 m): its surface faces are checked like cloth faces.
+static void test_ball_on_torus()
+{
+    sdfccd_SdfId torus;
+    CHECK(sdfccd_create_torus(0.3, 0.1, &torus) == SDFCCD_OK, "torus");
+    double worst = 0, mean_z = 0;
+    int faces = 0;
+    {
+        Bridge bridge;
+        SdfShape shape(torus);
+        SoftWorld w(&bridge);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&shape, id);
+        btSoftBody* ball = btSoftBodyHelpers::CreateEllipsoid(w.world.getWorldInfo(), btVector3(0.01f, 0.02f, 0.5f),
+                                                               btVector3(0.25f, 0.25f, 0.25f), 128);
+        ball->m_cfg.kPR = 20;
+        w.setup(ball, -3.0);
+        faces = ball->m_faces.size();
+        for (int s = 0; s < 90; ++s) {
+            w.step();
+            worst = std::max(worst, softPenetration(ball, torus, id));
+        }
+        mean_z = meanZ(ball);
+        checkNoErrors(bridge, "ball_on_torus");
+        CHECK(sdfccd_bullet::softBodyStats(bridge).node_contacts + sdfccd_bullet::softBodyStats(bridge).face_contacts > 0, "no contact");
+    }
+    sdfccd_destroy_sdf(torus);
+    std::printf("  soft ball (%d faces) on torus: max penetration %.4f mm, mean node z %.3f\n", faces, worst * 1e3, mean_z);
+    CHECK(faces > 0, "the ellipsoid has no faces");
+    CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+    CHECK(mean_z > 0.0, "the ball fell past the torus (mean node z = %.3f)", mean_z);
+}
+
 // A rope pinned at one end swings through a standing torus ring (ring 0.25 m, tube 0.04 m, in the
 // xz plane): its nodes stay out of the tube.
 static void test_rope_through_ring()
@@ -510,6 +545,7 @@ static const Test kTests[] = {
     { "cloth_on_torus", test_cloth_on_torus },
     { "cloth_fast_plate", test_cloth_fast_plate },
     { "cloth_on_spikes", test_cloth_on_spikes },
+    { "ball_on_torus", test_ball_on_torus },
     { "rope_through_ring", test_rope_through_ring },
     { "btsdf_tray", test_btsdf_tray },
     { "stock_box_fast", test_stock_box_fast },
