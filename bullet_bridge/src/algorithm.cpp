@@ -320,6 +320,7 @@ Status Bridge::registerWith(btCollisionWorld* world)
     const Status s = registerWith(d);
     if (s == Status::Ok) {
         projectionAttach(m_impl, world);
+        softAttach(m_impl, world);
         m_impl->batch_world = world;
     }
     return s;

@@ -185,6 +185,7 @@ void projectionDetach(BridgeImpl* impl);
 void clampForget(BridgeImpl* impl);
 // soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones.
 void softRegister(BridgeImpl* impl, btCollisionDispatcher* d);
+void softAttach(BridgeImpl* impl, btCollisionWorld* world);
 void softUnregister(BridgeImpl* impl);
 void softForget(BridgeImpl* impl);
 // Calls the handler of setMisuseHandler (or the default one).

@@ -13,6 +13,7 @@
 #include <set>
 
 #include <BulletSoftBody/btSoftBody.h>
+#include <BulletSoftBody/btSoftBodySolvers.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 
 #include "sdfccd_bullet/soft_body.h"
@@ -111,6 +112,15 @@ struct SoftState {
     std::map<std::pair<const void*, const void*>, SoftRecord> records;
     std::set<const btCollisionShape*> reported;
     std::vector<sdfccd_Contact> contacts;
+    // The automatic guard (registerWith a btSoftRigidDynamicsWorld): the world, its solver as it was,
+    // and whether the world owned it.
+    btSoftRigidDynamicsWorld* world = nullptr;
+    btSoftBodySolver* inner = nullptr;
+    class GuardingSolver* wrapper = nullptr;
+    bool world_owned_inner = false;
+    bool guarded_this_step = false;
+    bool auto_guard = true;
+    double auto_tolerance = 5e-4;
     // Per node of the pair being processed: the most restrictive plane found (the one the node's
     // start position is closest to), so each node gets one contact and no two planes fight.
     struct Plane {
@@ -473,71 +483,38 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     return count;
 }
 
-} // namespace
+// The world's soft-body solver, private in btSoftRigidDynamicsWorld, reached through an explicit
+// instantiation (where access is not checked), so that the guard runs right after the soft-body solve.
+template <typename Tag, typename Tag::type M>
+struct Reach {
+    friend typename Tag::type reach(Tag) { return M; }
+};
+struct SolverField {
+    typedef btSoftBodySolver* btSoftRigidDynamicsWorld::*type;
+    friend type reach(SolverField);
+};
+struct OwnsField {
+    typedef bool btSoftRigidDynamicsWorld::*type;
+    friend type reach(OwnsField);
+};
+template struct Reach<SolverField, &btSoftRigidDynamicsWorld::m_softBodySolver>;
+template struct Reach<OwnsField, &btSoftRigidDynamicsWorld::m_ownsSolver>;
 
-void softRegister(BridgeImpl* impl, btCollisionDispatcher* d)
+int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
 {
-    std::unique_ptr<SoftState> st(new SoftState);
-    st->impl = impl;
-    st->dispatcher = d;
-    st->fn[0].state = st.get();
-    st->fn[1].state = st.get();
-    st->fn[1].m_swapped = true;
-    st->slots.push_back(std::make_pair((int)SOFTBODY_SHAPE_PROXYTYPE, impl->cfg.sdf_shape_type));
-    if (impl->cfg.handle_bt_sdf_shape) st->slots.push_back(std::make_pair((int)SOFTBODY_SHAPE_PROXYTYPE, (int)SDF_SHAPE_PROXYTYPE));
-    for (const auto& s : st->slots) {
-        d->registerCollisionCreateFunc(s.first, s.second, &st->fn[0]);
-        d->registerCollisionCreateFunc(s.second, s.first, &st->fn[1]);
-    }
-    std::lock_guard<std::mutex> lock(g_soft_mutex);
-    g_soft[impl] = std::move(st);
-}
-
-void softUnregister(BridgeImpl* impl)
-{
-    SoftState* st = softOf(impl);
-    if (!st || !st->dispatcher) return;
-    btCollisionConfiguration* cc = st->dispatcher->getCollisionConfiguration();
-    for (const auto& s : st->slots) {
-        st->dispatcher->registerCollisionCreateFunc(s.first, s.second, cc->getCollisionAlgorithmCreateFunc(s.first, s.second));
-        st->dispatcher->registerCollisionCreateFunc(s.second, s.first, cc->getCollisionAlgorithmCreateFunc(s.second, s.first));
-    }
-    st->dispatcher = nullptr;
-    st->records.clear();
-}
-
-void softForget(BridgeImpl* impl)
-{
-    std::lock_guard<std::mutex> lock(g_soft_mutex);
-    g_soft.erase(impl);
-}
-
-} // namespace detail
-
-SoftBodyStats softBodyStats(const Bridge& bridge)
-{
-    const detail::SoftState* st = detail::softOf(const_cast<Bridge&>(bridge).impl());
-    return st ? st->stats : SoftBodyStats();
-}
-
-int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tolerance)
-{
-    if (!world || !(tolerance > 0) || !std::isfinite(tolerance)) return -1;
-    detail::SoftState* st = detail::softOf(bridge.impl());
-    if (!st || !st->dispatcher || st->dispatcher != world->getDispatcher()) return -1;
     std::set<const void*> live;
     const btCollisionObjectArray& objs = world->getCollisionObjectArray();
     for (int i = 0; i < objs.size(); ++i) live.insert(objs[i]);
-    BridgeImpl* impl = bridge.impl();
+    BridgeImpl* impl = st->impl;
     int moved = 0;
     // Pairs collision detection saw this step: their recorded start positions.
     for (auto it = st->records.begin(); it != st->records.end();) {
-        detail::SoftRecord& rec = it->second;
+        SoftRecord& rec = it->second;
         if (!live.count(rec.soft) || !live.count(rec.sdf_object)) { // removed from the world: forget it
             it = st->records.erase(it);
             continue;
         }
-        if (rec.fresh) moved += detail::guardRecord(st, rec, tolerance);
+        if (rec.fresh) moved += guardRecord(st, rec, tolerance);
         ++it;
     }
     // Pairs it did not see: Bullet's box of a soft body covers its predicted nodes, not their paths, so
@@ -568,19 +545,182 @@ int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tole
             if (bmin.x() > hi.x() + reach || bmin.y() > hi.y() + reach || bmin.z() > hi.z() + reach ||
                 bmax.x() < lo.x() - reach || bmax.y() < lo.y() - reach || bmax.z() < lo.z() - reach)
                 continue;
-            detail::SoftRecord& rec = st->records[key];
+            SoftRecord& rec = st->records[key];
             rec.soft = psb;
             rec.sdf_object = co;
             rec.sdf = sdf;
             rec.sdf_pose = co->getWorldTransform();
             rec.start.resize((size_t)psb->m_nodes.size());
-            for (int k = 0; k < psb->m_nodes.size(); ++k) rec.start[(size_t)k] = detail::d3(psb->m_nodes[k].m_q);
-            moved += detail::guardRecord(st, rec, tolerance);
+            for (int k = 0; k < psb->m_nodes.size(); ++k) rec.start[(size_t)k] = d3(psb->m_nodes[k].m_q);
+            moved += guardRecord(st, rec, tolerance);
         }
     }
     for (auto& r : st->records) r.second.fresh = false;
     st->stats.guard_nodes += moved;
     return moved;
+}
+
+
+// Bullet's solver, with the guard after each solve (the world owns this wrapper; the wrapper owns the
+// solver it wraps when the world did).
+class GuardingSolver : public btSoftBodySolver
+{
+public:
+    GuardingSolver(btSoftBodySolver* inner, bool owns, SoftState* st, btSoftRigidDynamicsWorld* world)
+        : m_inner(inner), m_owns(owns), m_state(st), m_world(world)
+    {
+        m_timeScale = inner->getTimeScale();
+        m_numberOfPositionIterations = inner->getNumberOfPositionIterations();
+        m_numberOfVelocityIterations = inner->getNumberOfVelocityIterations();
+    }
+    ~GuardingSolver() override
+    {
+        if (m_state && m_state->wrapper == this) m_state->wrapper = nullptr; // the world is going away
+        if (m_owns) {
+            m_inner->~btSoftBodySolver();
+            btAlignedFree(m_inner);
+        }
+    }
+    SolverTypes getSolverType() const override { return m_inner->getSolverType(); }
+    bool checkInitialized() override { return m_inner->checkInitialized(); }
+    void optimize(btAlignedObjectArray<btSoftBody*>& bodies, bool force) override { m_inner->optimize(bodies, force); }
+    void copyBackToSoftBodies(bool move) override { m_inner->copyBackToSoftBodies(move); }
+    void predictMotion(btScalar dt) override { m_inner->predictMotion(dt); }
+    void solveConstraints(btScalar dt) override
+    {
+        m_inner->solveConstraints(dt);
+        if (m_state && m_state->dispatcher && m_state->auto_guard) {
+            guardWorld(m_state, m_world, m_state->auto_tolerance);
+            m_state->guarded_this_step = true;
+        }
+    }
+    void updateSoftBodies() override { m_inner->updateSoftBodies(); }
+    void processCollision(btSoftBody* b, const btCollisionObjectWrapper* w) override { m_inner->processCollision(b, w); }
+    void processCollision(btSoftBody* a, btSoftBody* b) override { m_inner->processCollision(a, b); }
+    void setNumberOfPositionIterations(int n) override { m_inner->setNumberOfPositionIterations(n); }
+    int getNumberOfPositionIterations() override { return m_inner->getNumberOfPositionIterations(); }
+    void setNumberOfVelocityIterations(int n) override { m_inner->setNumberOfVelocityIterations(n); }
+    int getNumberOfVelocityIterations() override { return m_inner->getNumberOfVelocityIterations(); }
+
+    btSoftBodySolver* m_inner;
+    bool m_owns;
+    SoftState* m_state;
+    btSoftRigidDynamicsWorld* m_world;
+};
+
+} // namespace
+
+void softRegister(BridgeImpl* impl, btCollisionDispatcher* d)
+{
+    std::unique_ptr<SoftState> st(new SoftState);
+    st->impl = impl;
+    st->dispatcher = d;
+    st->fn[0].state = st.get();
+    st->fn[1].state = st.get();
+    st->fn[1].m_swapped = true;
+    st->slots.push_back(std::make_pair((int)SOFTBODY_SHAPE_PROXYTYPE, impl->cfg.sdf_shape_type));
+    if (impl->cfg.handle_bt_sdf_shape) st->slots.push_back(std::make_pair((int)SOFTBODY_SHAPE_PROXYTYPE, (int)SDF_SHAPE_PROXYTYPE));
+    for (const auto& s : st->slots) {
+        d->registerCollisionCreateFunc(s.first, s.second, &st->fn[0]);
+        d->registerCollisionCreateFunc(s.second, s.first, &st->fn[1]);
+    }
+    std::lock_guard<std::mutex> lock(g_soft_mutex);
+    g_soft[impl] = std::move(st);
+}
+
+
+void softAttach(BridgeImpl* impl, btCollisionWorld* cw)
+{
+    btSoftRigidDynamicsWorld* world = dynamic_cast<btSoftRigidDynamicsWorld*>(cw);
+    SoftState* st = softOf(impl);
+    if (!world || !st || st->wrapper) return;
+    btSoftBodySolver*& slot = world->*reach(SolverField());
+    bool& owns = world->*reach(OwnsField());
+    if (!slot || slot->getSolverType() != btSoftBodySolver::DEFAULT_SOLVER) return; // only Bullet's CPU solver
+    void* mem = btAlignedAlloc(sizeof(GuardingSolver), 16);
+    GuardingSolver* g = new (mem) GuardingSolver(slot, owns, st, world);
+    st->world = world;
+    st->inner = slot;
+    st->world_owned_inner = owns;
+    st->wrapper = g;
+    slot = g;
+    owns = true; // the world frees the wrapper (and the wrapper its solver when the world owned it)
+    btSoftBodyArray& softs = world->getSoftBodyArray();
+    for (int i = 0; i < softs.size(); ++i) softs[i]->setSoftBodySolver(g);
+}
+
+// Puts the world's own solver back (the world must still exist: see Bridge's lifetime note).
+void softDetach(SoftState* st)
+{
+    if (!st->wrapper || !st->world) return;
+    btSoftRigidDynamicsWorld* world = st->world;
+    btSoftBodySolver*& slot = world->*reach(SolverField());
+    bool& owns = world->*reach(OwnsField());
+    if (slot == st->wrapper) {
+        slot = st->inner;
+        owns = st->world_owned_inner;
+        btSoftBodyArray& softs = world->getSoftBodyArray();
+        for (int i = 0; i < softs.size(); ++i) softs[i]->setSoftBodySolver(st->inner);
+        GuardingSolver* g = st->wrapper;
+        g->m_owns = false;
+        g->m_state = nullptr;
+        g->~GuardingSolver();
+        btAlignedFree(g);
+    }
+    st->wrapper = nullptr;
+    st->world = nullptr;
+}
+
+void softUnregister(BridgeImpl* impl)
+{
+    SoftState* st = softOf(impl);
+    if (!st || !st->dispatcher) return;
+    softDetach(st);
+    btCollisionConfiguration* cc = st->dispatcher->getCollisionConfiguration();
+    for (const auto& s : st->slots) {
+        st->dispatcher->registerCollisionCreateFunc(s.first, s.second, cc->getCollisionAlgorithmCreateFunc(s.first, s.second));
+        st->dispatcher->registerCollisionCreateFunc(s.second, s.first, cc->getCollisionAlgorithmCreateFunc(s.second, s.first));
+    }
+    st->dispatcher = nullptr;
+    st->records.clear();
+}
+
+void softForget(BridgeImpl* impl)
+{
+    SoftState* st = softOf(impl);
+    if (st && st->wrapper) st->wrapper->m_state = nullptr; // the world still holds it: make it a plain solver
+    std::lock_guard<std::mutex> lock(g_soft_mutex);
+    g_soft.erase(impl);
+}
+
+} // namespace detail
+
+SoftBodyStats softBodyStats(const Bridge& bridge)
+{
+    const detail::SoftState* st = detail::softOf(const_cast<Bridge&>(bridge).impl());
+    return st ? st->stats : SoftBodyStats();
+}
+
+bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance)
+{
+    detail::SoftState* st = detail::softOf(bridge.impl());
+    if (!st || !(tolerance > 0) || !std::isfinite(tolerance)) return false;
+    st->auto_guard = on;
+    st->auto_tolerance = tolerance;
+    st->guarded_this_step = false;
+    return st->wrapper != nullptr;
+}
+
+int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tolerance)
+{
+    if (!world || !(tolerance > 0) || !std::isfinite(tolerance)) return -1;
+    detail::SoftState* st = detail::softOf(bridge.impl());
+    if (!st || !st->dispatcher || st->dispatcher != world->getDispatcher()) return -1;
+    if (st->world == world && st->guarded_this_step) { // the automatic guard already checked this step
+        st->guarded_this_step = false;
+        return 0;
+    }
+    return detail::guardWorld(st, world, tolerance);
 }
 
 SDFCCD_BULLET_NAMESPACE_END

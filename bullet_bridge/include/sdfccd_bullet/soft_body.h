@@ -16,11 +16,14 @@
  * interiors of rope links (their nodes are checked), an SDF body's own motion during the step (its
  * pose at the start of the step is used).
  *
- * The guarantee (call guardSoftBodies() after each btSoftRigidDynamicsWorld::stepSimulation with
- * at most one internal step): a node or face point that ended the step deeper than the tolerance
- * goes back along its motion to its time of impact, and the nodes lose their velocity into the
- * surface there. Bullet's soft-rigid world solves soft bodies after every callback it offers, so
- * the check cannot run inside stepSimulation.
+ * The guarantee: a node or face point that ended a step deeper than the tolerance goes back along
+ * its motion to its time of impact, and the nodes lose their velocity into the surface there. When
+ * the bridge is registered with a btSoftRigidDynamicsWorld using Bullet's own (CPU) soft-body
+ * solver, it runs by itself right after each soft-body solve, in every internal step: the bridge
+ * wraps the world's solver (Bullet's soft-rigid world offers no callback after that solve; the
+ * wrapper is put back by Bridge::unregister(), and the world frees it otherwise). Other solvers, or
+ * a world registered as a bare dispatcher: call guardSoftBodies() after each stepSimulation with at
+ * most one internal step.
  */
 #ifndef SDFCCD_BULLET_SOFT_BODY_H
 #define SDFCCD_BULLET_SOFT_BODY_H
@@ -48,7 +51,13 @@ struct SoftBodyStats {
 /** The soft-body counters of `bridge`. */
 SoftBodyStats softBodyStats(const Bridge& bridge);
 
-/** The soft-body guarantee for the step just taken by `world` (see the file comment). Checks the
+/** Turns the automatic guard (see the file comment) on or off and sets its tolerance (m, > 0;
+ * default on, 5e-4). Returns true when the automatic guard is installed in a world (false: bad
+ * tolerance, bridge never registered, or no btSoftRigidDynamicsWorld with Bullet's solver). */
+bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance = 5e-4);
+
+/** The soft-body guarantee for the step just taken by `world` (see the file comment). Returns 0
+ * at once when the automatic guard already checked that step. Checks the
  * motion of every soft body the bridge collided with an SDF in that step, from its nodes'
  * positions at the start of the step to their positions now: a node whose path went deeper than
  * `tolerance` (m, > 0) below the surface, or a face whose motion took a point of it that deep, is
