@@ -513,6 +513,26 @@ static void test_soft_misuse()
         sdfccd_destroy_sdf(plate);
     }
 
+    // The world destroyed before the bridge, without unregister(): the world frees the guard's
+    // wrapper of its solver (and the solver); nothing leaks or is freed twice (ASan, valgrind).
+    {
+        sdfccd_SdfId plate;
+        CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &plate) == SDFCCD_OK, "plate");
+        Bridge bridge;
+        SdfShape shape(plate);
+        std::unique_ptr<SoftWorld> w(new SoftWorld(&bridge));
+        w->bridge = nullptr; // its destructor must not unregister
+        btTransform id;
+        id.setIdentity();
+        w->addStatic(&shape, id);
+        w->addCloth(0.4, 0, 0, 0.1, -1.0);
+        for (int s = 0; s < 5; ++s) w->world.stepSimulation((btScalar)kDt, 0, (btScalar)kDt);
+        CHECK(sdfccd_bullet::softBodyStats(bridge).pair_steps > 0, "no soft-body pair");
+        w.reset();
+        CHECK(!sdfccd_bullet::setSoftBodyGuard(bridge, true), "the guard still counts as installed in a destroyed world");
+        sdfccd_destroy_sdf(plate);
+    }
+
     // Registered after the bodies were added: TooLate, nothing changed; the guard refuses a world
     // the bridge is not registered with.
     {
