@@ -294,6 +294,7 @@ Bridge::~Bridge()
         std::lock_guard<std::mutex> lock(g_registry_mutex);
         g_registered.erase(m_impl->dispatcher);
     }
+    softForget(m_impl);
     delete m_impl;
 }
 
@@ -317,6 +318,7 @@ Status Bridge::registerWith(btCollisionWorld* world)
     const Status s = registerWith(d);
     if (s == Status::Ok) {
         guardAttach(m_impl, world);
+        softAttach(m_impl, world);
         m_impl->batch_world = world;
     }
     return s;
@@ -342,6 +344,7 @@ Status Bridge::registerWith(btCollisionDispatcher* d)
         d->registerCollisionCreateFunc(s.first, s.second, m_impl->fn[0].get());
         if (cfg.closest_points) d->registerClosestPointsCreateFunc(s.first, s.second, m_impl->fn[1].get());
     }
+    softRegister(m_impl, d);
     m_impl->dispatcher = d;
     return verify();
 }
@@ -445,6 +448,7 @@ void Bridge::unregister()
         d->registerClosestPointsCreateFunc(s.first, s.second, cc->getClosestPointsAlgorithmCreateFunc(s.first, s.second));
     }
     guardDetach(m_impl);
+    softUnregister(m_impl);
     m_impl->batch_world = nullptr;
     m_impl->batch_cache.clear();
     std::lock_guard<std::mutex> lock(g_registry_mutex);
@@ -489,6 +493,18 @@ MisuseHandler setMisuseHandler(MisuseHandler handler, void* user)
     g_misuse_handler = handler;
     g_misuse_user = handler ? user : nullptr;
     return old;
+}
+
+void detail::callMisuseHandler(Status status, const char* message, const btCollisionShape* shape)
+{
+    MisuseHandler h;
+    void* user;
+    {
+        std::lock_guard<std::mutex> lock(g_misuse_mutex);
+        h = g_misuse_handler ? g_misuse_handler : defaultMisuseHandler;
+        user = g_misuse_user;
+    }
+    h(status, message, shape, user);
 }
 
 namespace {

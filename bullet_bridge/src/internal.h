@@ -192,6 +192,13 @@ struct GuardOut {
 sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out);
 // The frame of a rigid motion at time t.
 btTransform poseAt(const sdfccd_RigidMotion& m, double t);
+// soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones.
+void softRegister(BridgeImpl* impl, btCollisionDispatcher* d);
+void softAttach(BridgeImpl* impl, btCollisionWorld* world);
+void softUnregister(BridgeImpl* impl);
+void softForget(BridgeImpl* impl);
+// Calls the handler of setMisuseHandler (or the default one).
+void callMisuseHandler(Status status, const char* message, const btCollisionShape* shape);
 
 } // namespace detail
 

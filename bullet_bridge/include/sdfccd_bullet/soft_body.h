@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+/** @file soft_body.h  Bullet soft bodies (btSoftBody: cloth, ropes, volumetric bodies) against SDFs.
+ *
+ * Bridge::registerWith() also registers the bridge for (btSoftBody, SdfShape) and (btSoftBody,
+ * btSdfCollisionShape) in both body orders (world: btSoftRigidDynamicsWorld with
+ * btSoftBodyRigidBodyCollisionConfiguration). Each step, in Bullet's collision detection, the soft
+ * body's nodes move linearly from their positions at the start of the step (btSoftBody::Node::m_q)
+ * to the positions the solver predicts (m_x): every node's path and every face's per-vertex linear
+ * motion (sdfccd_query_triangle_linear) is checked with the CCD against the SDF within
+ * Config::contact_margin, and each contact found becomes a btSoftBody::RContact on the nodes
+ * (a face point's contact on each of its face's nodes, the plane shifted by the node's offset from
+ * the point along the normal, so that the face point cannot pass the plane while the nodes hold
+ * theirs). The normal is the SDF gradient at the contact; friction (kDF x the SDF body's friction)
+ * and hardness (kKHR against static/kinematic SDF bodies, kCHR against dynamic ones) are the soft
+ * body's own. Not covered: btDeformableMultiBodyDynamicsWorld (its deformable contacts), the
+ * interiors of rope links (their nodes are checked), an SDF body's own motion during the step (its
+ * pose at the start of the step is used).
+ *
+ * The guarantee: a node or face point that ended a step deeper than the tolerance goes back along
+ * its motion to its time of impact, and the nodes lose their velocity into the surface there. When
+ * the bridge is registered with a btSoftRigidDynamicsWorld using Bullet's own (CPU) soft-body
+ * solver, it runs by itself right after each soft-body solve, in every internal step: the bridge
+ * wraps the world's solver (Bullet's soft-rigid world offers no callback after that solve; the
+ * wrapper is put back by Bridge::unregister(), and the world frees it otherwise). Other solvers, or
+ * a world registered as a bare dispatcher: call guardSoftBodies() after each stepSimulation with at
+ * most one internal step.
+ */
+#ifndef SDFCCD_BULLET_SOFT_BODY_H
+#define SDFCCD_BULLET_SOFT_BODY_H
+
+#include <cstdint>
+
+#include "bridge.h"
+
+class btSoftRigidDynamicsWorld;
+
+SDFCCD_BULLET_NAMESPACE_BEGIN
+
+/** Counters of the soft-body side of a bridge (since its construction). */
+struct SoftBodyStats {
+    int64_t pair_steps = 0;     /**< (soft body, SDF) pairs processed in collision detection. */
+    int64_t node_contacts = 0;  /**< RContacts written for nodes whose own path meets the SDF. */
+    int64_t face_contacts = 0;  /**< RContacts written for face points (one per node of the face). */
+    int64_t face_queries = 0;   /**< sdfccd_query_triangle_linear calls (contacts and guard). */
+    int64_t sdf_evaluations = 0;/**< SDF evaluations of all those queries and of the node checks. */
+    int64_t guard_nodes = 0;    /**< Nodes the guard moved back to a time of impact. */
+    int64_t query_errors = 0;   /**< Queries that failed (no contact written for that face). */
+    int64_t refused = 0;        /**< Pairs refused: an SdfShape with a dead handle (reported as misuse). */
+};
+
+/** The soft-body counters of `bridge`. */
+SoftBodyStats softBodyStats(const Bridge& bridge);
+
+/** Turns the automatic guard (see the file comment) on or off and sets its tolerance (m, > 0;
+ * default on, 5e-4). Returns true when the automatic guard is installed in a world (false: bad
+ * tolerance, bridge never registered, or no btSoftRigidDynamicsWorld with Bullet's solver). */
+bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance = 5e-4);
+
+/** The soft-body guarantee for the step just taken by `world` (see the file comment). Returns 0
+ * at once when the automatic guard already checked that step. Checks the
+ * motion of every soft body the bridge collided with an SDF in that step, from its nodes'
+ * positions at the start of the step to their positions now: a node whose path went deeper than
+ * `tolerance` (m, > 0) below the surface, or a face whose motion took a point of it that deep, is
+ * put back at the first time it reached that depth (a face: its three nodes), and its nodes'
+ * velocity into the surface is removed. Repeats over the faces whose nodes moved until no face
+ * crosses (at most a few passes; then the nodes of a face still crossing go back to their start
+ * positions, where the last check left them). Nodes already deeper at the start are held to their
+ * start depth plus the tolerance. Returns the number of nodes moved, or -1 on bad input (NULL
+ * world, tolerance not > 0, bridge not registered with the world's dispatcher). */
+int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tolerance = 5e-4);
+
+SDFCCD_BULLET_NAMESPACE_END
+
+#endif
