@@ -172,7 +172,7 @@ static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 
      * superlinearly, it runs to a twentieth of the tolerance for about 2 evaluations more per
      * query (test_sweep, golden section / this / this at the full tolerance: mean |dTOI| 3.08e-8 /
      * 3.04e-8 / 3.09e-8 s, mean distance from the certified bracket 2.53e-9 / 2.17e-9 / 2.65e-9 s). */
-    if (p->fwgss_deriv_spatial && coarse <= fine &&
+    if (p->fwgss_deriv_spatial && !s->kinked && coarse <= fine &&
         scc_deriv_minimize(f0, scc_dot(gn, scc_sub(end, xn)), 0.05 * tol, p->max_ls_iter, phi_slope_on_segment, &k, &sp, &f1)) {
         /* done */
     } else if (p->fwgss_brent_spatial) {
@@ -436,10 +436,22 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
     return 1;
 }
 
+/* Whether phi may have gradient jumps outside the surface: box edges and faces, CSG seams, cone
+ * tips, grid cells, or unknown (transformed and user fields). The sphere, torus, capsule, rounded
+ * box and half-space are smooth there. */
+static int field_has_kinks(const scc_sdf* sdf)
+{
+    switch (sdf->kind) {
+    case SCC_SDF_SPHERE: case SCC_SDF_TORUS: case SCC_SDF_CAPSULE: case SCC_SDF_ROUNDED_BOX: case SCC_SDF_HALF_SPACE: return 0;
+    default: return 1;
+    }
+}
+
 void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out)
 {
     scc_fw_state s;
     scc_fw_begin(&s, sdf, m, p, ta, tb);
+    s.kinked = p->fwgss_kink_guard && field_has_kinks(sdf);
     double speed = scc_tri_speed_bound(m);
     /* A spatial error of speed x time_tol moves the entry time by about time_tol. */
     if (p->fwgss_speed_tol && speed > 0.0) s.dist_tol = speed * p->time_tol;
@@ -474,6 +486,21 @@ void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb
         const double t_start = k > 0 && s.hit && p->fwgss_restart_at_witness ? s.te : s.ts;
         if (!descend(&s, t_start, &it)) converged = 0;
         if (s.hit && s.hit_t <= s.ts) break; /* in contact at the start: nothing is earlier */
+    }
+    /* Where the gradient jumps (ours, issue 20), a sharp feature (a knife edge, a spike tip, a grid
+     * cell's kink) can touch an edge or the inside of the triangle while the gradient at every
+     * vertex's descent leads elsewhere: the descents stop at a later local minimum (a cube minus a
+     * ball: 11 of 64 cases late or missed with the three vertex starts and golden-section spatial
+     * searches). Four more descents start from the edge midpoints and the centroid, at the earliest
+     * witness like the restarts. A convex field (box, cylinder) has no such later minimum at a
+     * given time: there only the spatial searches change. */
+    if (s.kinked && !sdf->convex && p->fwgss_restarts > 0 && !(s.hit && s.hit_t <= s.ts)) {
+        static const double extra[4][3] = { { 0.5, 0.5, 0.0 }, { 0.0, 0.5, 0.5 }, { 0.5, 0.0, 0.5 }, { 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0 } };
+        for (int k = 0; k < 4; ++k) {
+            for (int j = 0; j < 3; ++j) s.b[j] = extra[k][j];
+            if (!descend(&s, s.hit && p->fwgss_restart_at_witness ? s.te : s.ts, &it)) converged = 0;
+            if (s.hit && s.hit_t <= s.ts) break;
+        }
     }
     scc_fw_finish(&s, converged, it, out);
 }

@@ -74,6 +74,7 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     if (in->fwgss_clear_proof < 0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_clear_proof must be >= 0 (got %d)", fn, in->fwgss_clear_proof);
     out->fwgss_clear_budget = in->fwgss_clear_proof;
+    out->fwgss_kink_guard = in->fwgss_kink_guard != 0;
     return SDFCCD_OK;
 }
 

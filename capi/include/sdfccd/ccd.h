@@ -125,6 +125,15 @@ typedef struct sdfccd_QueryParams {
                                         in contact there and it searches back for that part's entry, without first
                                         searching the whole interval along the vertex's path. 0 = restarts begin at t0.
                                         Default 1. */
+    int32_t fwgss_kink_guard;      /**< FWGSS on fields whose gradient may jump (box, cylinder, spike grid, CSG, grids,
+                                        transformed and callback SDFs), where the slope of phi is not trusted: the
+                                        spatial line searches use golden section (fwgss_derivative_spatial is ignored),
+                                        and on non-convex ones (CSG, spike grid, grids, transformed, callback), after the
+                                        vertex descents four more start from the edge midpoints and the centroid (when
+                                        fwgss_restarts > 0), which find a sharp feature (knife edge, spike
+                                        tip, grid cell's kink) touching an edge or the inside of the triangle. Smooth
+                                        fields (sphere, torus, capsule, rounded box, half-space) are unaffected. 0 = off.
+                                        Default 1. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
