@@ -212,6 +212,15 @@ static const char* k_kinds[8] = { "torus", "box", "plate", "csg-difference", "cs
 static void section_kinds(FILE* md, const char* dir, const table* t, const table* front)
 {
     fprintf(md, "## 2b. Accuracy per SDF kind (issue 20)\n\n");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/kinds_machine.txt", dir);
+    FILE* mf = fopen(path, "r"); /* written when this section was run on its own */
+    if (mf) {
+        char line[512];
+        while (fgets(line, sizeof line, mf)) fprintf(md, "- This section's run: %s", line);
+        fclose(mf);
+        fprintf(md, "\n");
+    }
     fprintf(md, "The data set per kind (`samples/report/dataset_kinds`, `sdfccd_bench kinds`): the data set's triangle (10 cm) against "
                 "the torus, a box (20 x 14 x 10 cm), an 8 mm plate (30 x 30 cm), a 20 cm cube minus a ball of radius 12.5 cm (knife-edged "
                 "rims), the cube intersected with a ball of radius 13 cm (sharp seams), a rounded box, bullet3's concave box as a 32³ grid "
