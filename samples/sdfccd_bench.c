@@ -517,15 +517,17 @@ static void exp_kinds(const options* o)
 {
     kinds_set ks;
     build_kinds(kinds_dir(o), &ks, o->quick);
-    struct { const char* name; sdfccd_QueryParams p; } m[5] = {
+    struct { const char* name; sdfccd_QueryParams p; } m[6] = {
         { "FWGSS", config_params(CFG_NEW, 0) },
         { "FWGSS-guard-off", config_params(CFG_NEW, 0) },
+        { "FWGSS-guard-2", config_params(CFG_NEW, 0) },
         { "FW", method_params(SDFCCD_METHOD_FW, 0) },
         { "FWGSS-baseline", config_params(CFG_BASELINE, 0) },
         { "FWGSS-paper", config_params(CFG_PAPER, 0) },
     };
     m[1].p.fwgss_kink_guard = 0; /* FWGSS before issue 20 */
-    int nm = o->baseline ? 5 : 3;
+    m[2].p.fwgss_kink_guard = 2; /* the guard on every grid query too */
+    int nm = o->baseline ? 6 : 4;
     run_result* rr = calloc((size_t)ks.n_per_kind, sizeof *rr);
     printf("method,id,kind,hit,state,toi,gt_hit,gt_state,gt_lower,gt_toi,micros,sdf_evals,gt_regions\n");
     for (int j = 0; j < nm; ++j)
@@ -562,11 +564,13 @@ static void exp_kinds_front(const options* o)
             snprintf(sw[n].setting, sizeof sw[n].setting, "restarts=%d trace=%d", r, trace[i]);
             ++n;
         }
-    sw[n].method = "FWGSS-guard-off";
-    sw[n].p = config_params(CFG_NEW, 0);
-    sw[n].p.fwgss_kink_guard = 0;
-    snprintf(sw[n].setting, sizeof sw[n].setting, "defaults");
-    ++n;
+    for (int g = 0; g <= 2; g += 2) {
+        sw[n].method = g ? "FWGSS-guard-2" : "FWGSS-guard-off";
+        sw[n].p = config_params(CFG_NEW, 0);
+        sw[n].p.fwgss_kink_guard = g;
+        snprintf(sw[n].setting, sizeof sw[n].setting, "defaults");
+        ++n;
+    }
     const int caps[3] = { 4, 16, 64 };
     for (int i = 0; i < 3; ++i) {
         sw[n].method = "FWGSS-paper";
@@ -634,7 +638,7 @@ static const experiment k_experiments[] = {
     { "targets", exp_targets, "issue 9's targets: triangle, shuriken, triangle vs 32^3 grid; --baseline interleaves the previous defaults" },
     { "scaling", exp_scaling, "the armadillo falling on the spike grid at 1K/10K/100K (Table 3) with the certified TOI" },
     { "batch", exp_batch, "the data set as one sdfccd_query_batch on 1 and --threads N threads" },
-    { "kinds", exp_kinds, "the data set per SDF kind (issue 20): FWGSS with and without the kink guard and FW on every case; --baseline adds the previous and the paper's FWGSS" },
+    { "kinds", exp_kinds, "the data set per SDF kind (issue 20): FWGSS with the kink guard at levels 1 (default), 0 and 2, and FW on every case; --baseline adds the previous and the paper's FWGSS" },
     { "kinds_front", exp_kinds_front, "speed versus accuracy per SDF kind: FWGSS restarts and trace, the paper's caps, FW, DCD, certified" },
     { "cost", exp_cost, "cost per SDF evaluation in a query: the field and the rest (motion, solver, dispatch), measured differentially" },
 };
