@@ -39,6 +39,7 @@ typedef struct scc_params {
     int fwgss_clear_budget; /* FWGSS: evaluations of the no-contact proof tried before the descents (0: off) */
     double fwgss_gap_tol;   /* FWGSS: line searches far from the surface stop early by this fraction of the gap */
     int fwgss_deriv_spatial; /* FWGSS: spatial line searches at full precision use the gradient (scc_deriv_minimize) */
+    int fwgss_kink_guard;   /* FWGSS on fields with gradient jumps (0 off, 1 grids after a check, 2 grids always): golden section, more starts, the 1 us probe */
     int fwgss_restart_at_witness; /* FWGSS: restarts begin at the earliest witness's time (else at ts) */
     int64_t max_evals;      /* SDF evaluation budget of this call (> 0); solvers stop at it (NOT_CONVERGED) */
 } scc_params;

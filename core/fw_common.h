@@ -25,6 +25,7 @@ typedef struct scc_fw_state {
      * cosine cached for the last time evaluated (spatial searches evaluate many points at one
      * time). Same Eq. 14 as motion.c, without a quaternion product per point. */
     int fast;
+    int kinked; /* FWGSS: the field's gradient may jump and fwgss_kink_guard is on */
     scc_vec3 g0, v, w, axis, r0[3];
     double t0, wlen;
     double cache_t, cache_c, cache_s;

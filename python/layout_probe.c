@@ -55,6 +55,7 @@ int main(void)
     OFF(sdfccd_QueryParams, certified_max_bytes);
     OFF(sdfccd_QueryParams, fwgss_derivative_spatial);
     OFF(sdfccd_QueryParams, fwgss_restart_at_witness);
+    OFF(sdfccd_QueryParams, fwgss_kink_guard);
     SIZE(sdfccd_RigidMotion);
     OFF(sdfccd_RigidMotion, pose.position);
     OFF(sdfccd_RigidMotion, pose.orientation);

@@ -12,6 +12,7 @@
  * machine and its load (the machine this runs on is shared, so compare configurations measured in
  * the same run, and prefer SDF-evaluation counts). */
 #include "bench/bench_common.h"
+#include "bench/bench_kinds.h"
 
 /* ------------------------------------------------------------------ configurations */
 
@@ -502,6 +503,129 @@ static void exp_cost(const options* o)
     free_dataset(&ds);
 }
 
+/* ---- the data set per SDF kind (issue 20) ---- */
+
+static const char* kinds_dir(const options* o)
+{
+    static char dir[1024];
+    snprintf(dir, sizeof dir, "%s_kinds", o->dataset_dir);
+    return dir;
+}
+
+/* Every case of every kind, one row per case and method (the per-kind accuracy table). */
+static void exp_kinds(const options* o)
+{
+    kinds_set ks;
+    build_kinds(kinds_dir(o), &ks, o->quick);
+    struct { const char* name; sdfccd_QueryParams p; } m[6] = {
+        { "FWGSS", config_params(CFG_NEW, 0) },
+        { "FWGSS-guard-off", config_params(CFG_NEW, 0) },
+        { "FWGSS-guard-2", config_params(CFG_NEW, 0) },
+        { "FW", method_params(SDFCCD_METHOD_FW, 0) },
+        { "FWGSS-baseline", config_params(CFG_BASELINE, 0) },
+        { "FWGSS-paper", config_params(CFG_PAPER, 0) },
+    };
+    m[1].p.fwgss_kink_guard = 0; /* FWGSS before issue 20 */
+    m[2].p.fwgss_kink_guard = 2; /* the guard on every grid query too */
+    int nm = o->baseline ? 6 : 4;
+    run_result* rr = calloc((size_t)ks.n_per_kind, sizeof *rr);
+    printf("method,id,kind,hit,state,toi,gt_hit,gt_state,gt_lower,gt_toi,micros,sdf_evals,gt_regions\n");
+    for (int j = 0; j < nm; ++j)
+        for (int k = 0; k < KINDS_COUNT; ++k) {
+            progress("kinds: %s on %s", m[j].name, k_kind_name[k]);
+            kinds_run(&ks, k, &m[j].p, ks.n_per_kind, rr);
+            for (int i = 0; i < ks.n_per_kind; ++i) {
+                const bcase* c = &ks.c[k * ks.n_per_kind + i];
+                const run_result* r = &rr[i];
+                printf("%s,%s,%s,%d,%d,%.17g,%d,%d,%.17g,%.17g,%.2f,%lld,%lld\n", m[j].name, c->id, k_kind_name[k], r->hit, r->state, r->toi, c->gt_hit,
+                       c->gt_state, c->gt_lower, c->gt_toi, r->us, r->evals, c->gt_regions);
+            }
+        }
+    free(rr);
+    free_kinds(&ks);
+}
+
+/* Speed versus accuracy per kind: FWGSS's restarts and vertex trace swept, FWGSS without the kink
+ * guard (before issue 20), the paper's FWGSS with its caps swept, FW, DCD, and the certified method
+ * at two bracket widths. */
+static void exp_kinds_front(const options* o)
+{
+    kinds_set ks;
+    build_kinds(kinds_dir(o), &ks, o->quick);
+    struct sweep { const char* method; char setting[64]; sdfccd_QueryParams p; } sw[32];
+    int n = 0;
+    const int trace[3] = { 0, 16, 64 };
+    for (int r = 0; r <= 2; ++r)
+        for (int i = 0; i < 3; ++i) {
+            sw[n].method = "FWGSS";
+            sw[n].p = config_params(CFG_NEW, 0);
+            sw[n].p.fwgss_restarts = r;
+            sw[n].p.fwgss_vertex_trace = trace[i];
+            snprintf(sw[n].setting, sizeof sw[n].setting, "restarts=%d trace=%d", r, trace[i]);
+            ++n;
+        }
+    for (int g = 0; g <= 2; g += 2) {
+        sw[n].method = g ? "FWGSS-guard-2" : "FWGSS-guard-off";
+        sw[n].p = config_params(CFG_NEW, 0);
+        sw[n].p.fwgss_kink_guard = g;
+        snprintf(sw[n].setting, sizeof sw[n].setting, "defaults");
+        ++n;
+    }
+    const int caps[3] = { 4, 16, 64 };
+    for (int i = 0; i < 3; ++i) {
+        sw[n].method = "FWGSS-paper";
+        sw[n].p = config_params(CFG_PAPER, 0);
+        sw[n].p.max_iterations = caps[i];
+        sw[n].p.max_line_search_iterations = 2 * caps[i];
+        snprintf(sw[n].setting, sizeof sw[n].setting, "iter=%d ls=%d", caps[i], 2 * caps[i]);
+        ++n;
+    }
+    sw[n].method = "FW";
+    sw[n].p = method_params(SDFCCD_METHOD_FW, 0);
+    snprintf(sw[n].setting, sizeof sw[n].setting, "defaults");
+    ++n;
+    sw[n].method = "DCD";
+    sw[n].p = method_params(SDFCCD_METHOD_DCD, 0);
+    snprintf(sw[n].setting, sizeof sw[n].setting, "defaults");
+    ++n;
+    const double ctol[2] = { 1e-4, 1e-6 };
+    for (int i = 0; i < 2; ++i) {
+        sw[n].method = "Certified";
+        sw[n].p = certified_params();
+        sw[n].p.certified_time_tolerance = ctol[i];
+        snprintf(sw[n].setting, sizeof sw[n].setting, "tol=%.0e", ctol[i]);
+        ++n;
+    }
+    int ns = o->quick >= 2 ? 2 : (o->quick ? 32 : 256);
+    if (ns > ks.n_per_kind) ns = ks.n_per_kind;
+    run_result* rr = calloc((size_t)ns, sizeof *rr);
+    printf("kind,method,setting,cases,mean_us,fn_rate,fp_rate,mean_abs_dtoi,sdf_evals\n");
+    for (int k = 0; k < KINDS_COUNT; ++k)
+        for (int s = 0; s < n; ++s) {
+            progress("kinds_front: %s %s %s", k_kind_name[k], sw[s].method, sw[s].setting);
+            kinds_run(&ks, k, &sw[s].p, ns, rr);
+            int fn = 0, fp = 0, cmp = 0;
+            double us = 0, ev = 0, dt = 0;
+            for (int i = 0; i < ns; ++i) {
+                const bcase* c = &ks.c[k * ks.n_per_kind + i];
+                const run_result* r = &rr[i];
+                us += r->us;
+                ev += (double)r->evals;
+                if (c->gt_hit && (!r->hit || r->toi > c->gt_toi + TOI_TOL)) fn++;
+                if (r->hit && (!c->gt_hit || r->toi < c->gt_lower - TOI_TOL)) fp++;
+                if (c->gt_hit && r->hit) {
+                    double d = r->toi > c->gt_toi ? r->toi - c->gt_toi : (r->toi < c->gt_lower ? c->gt_lower - r->toi : 0.0);
+                    dt += d;
+                    ++cmp;
+                }
+            }
+            printf("%s,%s,%s,%d,%.4g,%.6g,%.6g,%.6g,%.1f\n", k_kind_name[k], sw[s].method, sw[s].setting, ns, us / ns, (double)fn / ns, (double)fp / ns,
+                   cmp ? dt / cmp : 0.0, ev / ns);
+        }
+    free(rr);
+    free_kinds(&ks);
+}
+
 /* ------------------------------------------------------------------ the table */
 
 typedef struct experiment { const char* name; void (*run)(const options*); const char* what; } experiment;
@@ -514,6 +638,8 @@ static const experiment k_experiments[] = {
     { "targets", exp_targets, "issue 9's targets: triangle, shuriken, triangle vs 32^3 grid; --baseline interleaves the previous defaults" },
     { "scaling", exp_scaling, "the armadillo falling on the spike grid at 1K/10K/100K (Table 3) with the certified TOI" },
     { "batch", exp_batch, "the data set as one sdfccd_query_batch on 1 and --threads N threads" },
+    { "kinds", exp_kinds, "the data set per SDF kind (issue 20): FWGSS with the kink guard at levels 1 (default), 0 and 2, and FW on every case; --baseline adds the previous and the paper's FWGSS" },
+    { "kinds_front", exp_kinds_front, "speed versus accuracy per SDF kind: FWGSS restarts and trace, the paper's caps, FW, DCD, certified" },
     { "cost", exp_cost, "cost per SDF evaluation in a query: the field and the rest (motion, solver, dispatch), measured differentially" },
 };
 #define N_EXPERIMENTS ((int)(sizeof k_experiments / sizeof k_experiments[0]))

@@ -3,14 +3,16 @@
 # sdfccd_bench_report OUTDIR writes OUTDIR/report.md (and the chart, with gnuplot).
 #   scripts/bench_report.sh OUTDIR [--quick|--smoke] [--build BUILDDIR] [--only "name ..."]
 # The data set and its certified ground truth are read from OUTDIR/dataset when present (copy
-# samples/report/dataset there to skip the ~4 minutes of ground truth), else computed there.
+# samples/report/dataset there to skip the ~4 minutes of ground truth), else computed there; the data
+# set per SDF kind likewise from OUTDIR/dataset_kinds (samples/report/dataset_kinds; ~6 minutes of
+# ground truth, most of it on the two grids).
 # Every experiment interleaves the previous FWGSS defaults (--baseline) so ratios come from one run.
 set -euo pipefail
 out=${1:?usage: bench_report.sh OUTDIR [--quick|--smoke] [--build BUILDDIR] [--only "names"]}
 shift
 mode=""
 build="$(cd "$(dirname "$0")/.." && pwd)/build"
-only="dataset brute accuracy front targets scaling batch cost"
+only="dataset brute accuracy kinds kinds_front front targets scaling batch cost"
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick|--smoke) mode="$1" ;;

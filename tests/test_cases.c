@@ -106,7 +106,7 @@ START_TEST(test_errors)
         { "sdf ball sphere 1\n", SDFCCD_FORMAT_ERROR, "t.cases:4: duplicate sdf name: ball" },
         { "sdf s sphere 1e999\n", SDFCCD_FORMAT_ERROR, "t.cases:4: expected: sdf NAME sphere R" },
         { "sdf s sphere -1\n", SDFCCD_INVALID_ARGUMENT, "t.cases:4: SDFCCD_INVALID_ARGUMENT: " },
-        { "sdf s cone 1\n", SDFCCD_FORMAT_ERROR, "t.cases:4: unknown sdf kind (sphere, box, torus, grid): cone" },
+        { "sdf s cone 1\n", SDFCCD_FORMAT_ERROR, "t.cases:4: unknown sdf kind (sphere, box, rounded_box, torus, csg, grid): cone" },
         { "case c nope tri 0.1 0 0 1 1 0 0 0 0 0 0 0 0 0\n", SDFCCD_FORMAT_ERROR, "t.cases:4: unknown sdf: nope" },
         { "case c ball tri -1 0 0 1 1 0 0 0 0 0 0 0 0 0\n", SDFCCD_FORMAT_ERROR, "t.cases:4: DT must be >= 0: -1" },
         { "case c ball tri 0.1 0 0 1 0 0 0 0 0 0 0 0 0 0\n", SDFCCD_INVALID_ARGUMENT, "t.cases:4: SDFCCD_INVALID_ARGUMENT: " },

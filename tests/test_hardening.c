@@ -115,6 +115,13 @@ START_TEST(test_budget_shared_by_segments)
     p = sdfccd_default_query_params();
     p.max_line_search_iterations = 5000;
     ck_assert_int_eq(sdfccd_query_triangle(s, NULL, k_tri, &m, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
+    const int32_t bad_guard[2] = { -1, 3 }; /* fwgss_kink_guard is 0, 1 or 2 */
+    for (int k = 0; k < 2; ++k) {
+        p = sdfccd_default_query_params();
+        p.fwgss_kink_guard = bad_guard[k];
+        ck_assert_int_eq(sdfccd_query_triangle(s, NULL, k_tri, &m, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
+        ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "fwgss_kink_guard"));
+    }
     sdfccd_destroy_sdf(s);
 }
 END_TEST

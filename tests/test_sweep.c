@@ -203,6 +203,153 @@ START_TEST(test_random_sweep)
 }
 END_TEST
 
+/* ---- the non-smooth kinds (issue 20) ----
+ * The same triangles against fields whose gradient jumps or bends sharply: an 8 mm plate, a cube
+ * minus a ball and a cube intersected with a ball (sharp seams), and a rounded box, with the data
+ * set's harder motions: a target point on the surface, a third of the paths grazing it (along the
+ * tangent plane, dipping by up to 0.1 rad, the centre passing 0-4 cm above it), the others coming
+ * in within 60 degrees of the normal; a travel of 0.5-2.5 triangle sizes (5 cm) per step; spins up
+ * to 300 rad/s. The certified method is the reference (it is checked against brute force above);
+ * per kind, FWGSS reports no false positive, misses no more with the kink guard than without it,
+ * and either meets issue 20's target (at most 0.1 % of the certified hits missed, mean distance from
+ * the certified bracket within 1e-8 s) or stays at the misses measured with the guard (the target is
+ * not met on the plate and the CSG kinds yet). FWGSS with the guard off (today's before issue 20)
+ * fails that bound on all three. */
+#define KINDS 4
+#define CASES_PER_KIND 250
+
+static void surface_point(sdfccd_SdfId sdf, double box, test_rng* rng, sdfccd_Vec3* x, sdfccd_Vec3* n)
+{
+    for (;;) {
+        sdfccd_Vec3 p = { test_rng_uniform(rng, -box, box), test_rng_uniform(rng, -box, box), test_rng_uniform(rng, -box, box) };
+        double phi = 1.0;
+        sdfccd_Vec3 g = { 0, 0, 0 };
+        for (int it = 0; it < 40 && fabs(phi) > 1e-9; ++it) {
+            sdfccd_sdf_eval(sdf, p, &phi, &g);
+            double gl = g.x * g.x + g.y * g.y + g.z * g.z;
+            if (!(gl > 0.25)) break;
+            p.x -= phi * g.x / gl; p.y -= phi * g.y / gl; p.z -= phi * g.z / gl;
+        }
+        sdfccd_sdf_eval(sdf, p, &phi, &g);
+        double gl = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
+        if (fabs(phi) < 1e-7 && gl > 0.5) {
+            *x = p;
+            *n = (sdfccd_Vec3){ g.x / gl, g.y / gl, g.z / gl };
+            return;
+        }
+    }
+}
+
+static void kind_case(sdfccd_SdfId sdf, double box, test_rng* rng, sdfccd_RigidMotion* m)
+{
+    sdfccd_Vec3 x, n, d;
+    surface_point(sdf, box, rng, &x, &n);
+    double h;
+    if (test_rng_uniform(rng, 0, 3) < 1.0) {
+        sdfccd_Vec3 u = test_rng_unit_vector(rng);
+        double un = u.x * n.x + u.y * n.y + u.z * n.z;
+        d = (sdfccd_Vec3){ u.x - un * n.x, u.y - un * n.y, u.z - un * n.z };
+        double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+        if (dl < 1e-6) d = (sdfccd_Vec3){ 1, 0, 0 }, dl = 1.0;
+        double dip = test_rng_uniform(rng, 0.0, 0.1);
+        d = (sdfccd_Vec3){ d.x / dl * cos(dip) - n.x * sin(dip), d.y / dl * cos(dip) - n.y * sin(dip), d.z / dl * cos(dip) - n.z * sin(dip) };
+        h = test_rng_uniform(rng, 0.0, 0.04);
+    } else {
+        for (;;) {
+            sdfccd_Vec3 u = test_rng_unit_vector(rng);
+            double s = test_rng_uniform(rng, 0.0, 0.9);
+            d = (sdfccd_Vec3){ -n.x + s * u.x, -n.y + s * u.y, -n.z + s * u.z };
+            double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+            d = (sdfccd_Vec3){ d.x / dl, d.y / dl, d.z / dl };
+            if (d.x * n.x + d.y * n.y + d.z * n.z < -0.5) break;
+        }
+        h = test_rng_uniform(rng, 0.0, 0.03);
+    }
+    const double travel = test_rng_uniform(rng, 0.5, 2.5) * 0.1, f = test_rng_uniform(rng, 0.15, 0.95);
+    *m = sdfccd_default_rigid_motion();
+    m->linear_velocity = (sdfccd_Vec3){ d.x * travel / DT, d.y * travel / DT, d.z * travel / DT };
+    m->pose.position = (sdfccd_Vec3){ x.x + h * n.x - m->linear_velocity.x * f * DT, x.y + h * n.y - m->linear_velocity.y * f * DT,
+                                      x.z + h * n.z - m->linear_velocity.z * f * DT };
+    sdfccd_Vec3 axis = test_rng_unit_vector(rng);
+    double ang = test_rng_uniform(rng, 0.0, M_PI);
+    m->pose.orientation = (sdfccd_Quat){ cos(ang / 2), axis.x * sin(ang / 2), axis.y * sin(ang / 2), axis.z * sin(ang / 2) };
+    sdfccd_Vec3 w = test_rng_unit_vector(rng);
+    double wm = test_rng_uniform(rng, 0.0, 300.0);
+    m->angular_velocity = (sdfccd_Vec3){ w.x * wm, w.y * wm, w.z * wm };
+}
+
+START_TEST(test_kinds_sweep)
+{
+    sdfccd_SdfId sdfs[KINDS], cube, b1, b2;
+    const char* names[KINDS] = { "plate", "csg-difference", "csg-intersection", "rounded-box" };
+    const double box[KINDS] = { 0.16, 0.11, 0.11, 0.11 };
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.15, 0.15, 0.004 }, &sdfs[0]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.1, 0.1, 0.1 }, &cube), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_sphere(0.125, &b1), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_sphere(0.13, &b2), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_DIFFERENCE, cube, b1, &sdfs[1]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_INTERSECTION, cube, b2, &sdfs[2]), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_rounded_box((sdfccd_Vec3){ 0.08, 0.06, 0.04 }, 0.02, &sdfs[3]), SDFCCD_OK);
+    sdfccd_destroy_sdf(cube);
+    sdfccd_destroy_sdf(b1);
+    sdfccd_destroy_sdf(b2);
+    const sdfccd_Vec3 tri[3] = { { 0.0, 0.055, 0.0 }, { -0.047631397208144133, -0.0275, 0.0 }, { 0.047631397208144133, -0.0275, 0.0 } };
+    test_rng rng = { 20251126u };
+    int not_met = 0;
+    const int max_misses[KINDS] = { 1, 3, 2, 0 }; /* measured with the kink guard (fwgss_kink_guard 1) */
+    for (int k = 0; k < KINDS; ++k) {
+        method_stats st = { 0 }, off = { 0 };
+        int start_in_contact = 0, unresolved = 0;
+        for (int c = 0; c < CASES_PER_KIND; ++c) {
+            sdfccd_RigidMotion m;
+            kind_case(sdfs[k], box[k], &rng, &m);
+            sdfccd_QueryParams p = sdfccd_default_query_params();
+            p.subdivision = 0;
+            sdfccd_QueryResult ref, r;
+            p.method = SDFCCD_METHOD_CERTIFIED;
+            p.max_sdf_evaluations = 5000000;
+            ck_assert_int_eq(sdfccd_query_triangle(sdfs[k], NULL, tri, &m, 0.0, DT, &p, NULL, 0, &ref), SDFCCD_OK);
+            if (ref.state == SDFCCD_STATE_NOT_CONVERGED) { unresolved++; continue; } /* no reference (the data set rejects these too) */
+            if (ref.state == SDFCCD_STATE_PENETRATING) { start_in_contact++; continue; }
+            p = sdfccd_default_query_params();
+            p.subdivision = 0;
+            ck_assert_int_eq(sdfccd_query_triangle(sdfs[k], NULL, tri, &m, 0.0, DT, &p, NULL, 0, &r), SDFCCD_OK);
+            int before = st.misses;
+            compare(&st, &ref, &r);
+            p.fwgss_kink_guard = 0; /* FWGSS before issue 20 */
+            ck_assert_int_eq(sdfccd_query_triangle(sdfs[k], NULL, tri, &m, 0.0, DT, &p, NULL, 0, &r), SDFCCD_OK);
+            compare(&off, &ref, &r);
+            if (st.misses > before)
+                fprintf(stderr, "%s case %d: FWGSS hit %d toi %.9g, certified [%.9g, %.9g]\n", names[k], c, r.hit, r.toi, ref.toi_lower, ref.toi);
+        }
+        const double mean_out = st.compared ? st.sum_outside / st.compared : 0.0;
+        printf("kinds: %-16s %d cases (%d in contact at the start, %d certified unresolved), %d certified hits: FWGSS misses %d (%.2f%%), "
+               "false positives %d, mean |dTOI| %.3g s, mean distance from the certified bracket %.3g s\n",
+               names[k], CASES_PER_KIND, start_in_contact, unresolved, st.hits, st.misses, 100.0 * st.misses / (st.hits ? st.hits : 1), st.false_positives,
+               st.compared ? st.sum_dtoi / st.compared : 0.0, mean_out);
+        printf("kinds: %-16s without the kink guard: misses %d, false positives %d, mean distance from the certified bracket %.3g s\n", names[k],
+               off.misses, off.false_positives, off.compared ? off.sum_outside / off.compared : 0.0);
+        fflush(stdout);
+        ck_assert_int_gt(st.hits, CASES_PER_KIND / 2);
+        ck_assert_int_le(unresolved, CASES_PER_KIND / 50);
+        ck_assert_msg(st.false_positives == 0, "%s: FWGSS reported %d false positives", names[k], st.false_positives);
+        ck_assert_msg(st.misses <= off.misses, "%s: the kink guard misses %d, more than without it (%d)", names[k], st.misses, off.misses);
+        if (st.misses * 1000 > st.hits || mean_out > 1e-8) {
+            /* Issue 20's target (<= 0.1 % misses, mean <= 1e-8 s) is not met on these kinds yet: they are held at
+             * the figures measured with the guard at its introduction (the guard off: plate 5, csg-difference 32,
+             * csg-intersection 3 misses of these cases; the rounded box, a smooth field, meets it either way). */
+            ++not_met;
+            ck_assert_msg(st.misses <= max_misses[k], "%s: FWGSS missed %d of %d certified hits (at most %d measured with the kink guard)",
+                          names[k], st.misses, st.hits, max_misses[k]);
+        }
+    }
+    printf("kinds: issue 20's target (<= 0.1 %% misses, mean distance <= 1e-8 s) met on %d of %d kinds\n", KINDS - not_met, KINDS);
+    fflush(stdout);
+    ck_assert_msg(not_met < KINDS, "the target is met on no kind");
+    for (int k = 0; k < KINDS; ++k) sdfccd_destroy_sdf(sdfs[k]);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("sweep");
@@ -210,6 +357,7 @@ int main(void)
     tcase_set_timeout(tc, 1200);
     test_add_memory_fixture(tc);
     tcase_add_test(tc, test_random_sweep);
+    tcase_add_test(tc, test_kinds_sweep);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

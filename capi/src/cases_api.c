@@ -131,13 +131,28 @@ static int record_sdf(cases_runner* r, int line, char** t, int n)
     } else if (!strcmp(t[2], "torus")) {
         if (n != 5 || !parse_doubles(t + 3, 2, v)) return fail_line(r, F, line, "expected: sdf NAME torus R r", NULL);
         st = sdfccd_create_torus(v[0], v[1], &id);
+    } else if (!strcmp(t[2], "rounded_box")) {
+        double w[4];
+        if (n != 7 || !parse_doubles(t + 3, 4, w)) return fail_line(r, F, line, "expected: sdf NAME rounded_box HX HY HZ R", NULL);
+        st = sdfccd_create_rounded_box((sdfccd_Vec3){ w[0], w[1], w[2] }, w[3], &id);
+    } else if (!strcmp(t[2], "csg")) {
+        /* a combination of two earlier records (issue 20: CSG with sharp seams in the data set) */
+        static const char* ops[3] = { "union", "intersection", "difference" };
+        int op = -1;
+        for (int k = 0; n == 6 && k < 3; ++k)
+            if (!strcmp(t[3], ops[k])) op = k;
+        if (op < 0) return fail_line(r, F, line, "expected: sdf NAME csg union|intersection|difference A B", NULL);
+        const sdfccd_SdfId* a = find_sdf(r, t[4]);
+        const sdfccd_SdfId* b = find_sdf(r, t[5]);
+        if (!a || !b) return fail_line(r, F, line, "unknown sdf", a ? t[5] : t[4]);
+        st = sdfccd_create_csg((sdfccd_CsgOp)op, *a, *b, &id);
     } else if (!strcmp(t[2], "grid")) {
         if (n != 4) return fail_line(r, F, line, "expected: sdf NAME grid PATH", NULL);
         char path[8192];
         resolve(r, t[3], path, sizeof path);
         st = sdfccd_load_grid(path, &id);
     } else {
-        return fail_line(r, F, line, "unknown sdf kind (sphere, box, torus, grid)", t[2]);
+        return fail_line(r, F, line, "unknown sdf kind (sphere, box, rounded_box, torus, csg, grid)", t[2]);
     }
     if (st != SDFCCD_OK) return fail_call(r, line, st);
     snprintf(r->sdfs[r->sdf_count].name, sizeof r->sdfs[0].name, "%s", t[1]);

@@ -74,6 +74,9 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     if (in->fwgss_clear_proof < 0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_clear_proof must be >= 0 (got %d)", fn, in->fwgss_clear_proof);
     out->fwgss_clear_budget = in->fwgss_clear_proof;
+    if (in->fwgss_kink_guard < 0 || in->fwgss_kink_guard > 2)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_kink_guard must be 0, 1 or 2 (got %d)", fn, in->fwgss_kink_guard);
+    out->fwgss_kink_guard = in->fwgss_kink_guard;
     return SDFCCD_OK;
 }
 

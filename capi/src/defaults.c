@@ -35,6 +35,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.certified_max_bytes = SDFCCD_DEFAULT_CERTIFIED_MAX_BYTES;
     p.fwgss_derivative_spatial = 1;
     p.fwgss_restart_at_witness = 1;
+    p.fwgss_kink_guard = 1;
     return p;
 }
 

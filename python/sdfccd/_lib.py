@@ -61,6 +61,7 @@ class QueryParams(C.Structure):
         ("certified_max_bytes", C.c_int64),
         ("fwgss_derivative_spatial", C.c_int32),
         ("fwgss_restart_at_witness", C.c_int32),
+        ("fwgss_kink_guard", C.c_int32),
     ]
 
 

@@ -238,6 +238,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     if (flips & 4) p.fwgss_brent_spatial = !p.fwgss_brent_spatial;
     if (flips & 8) p.fwgss_derivative_spatial = !p.fwgss_derivative_spatial;
     if (flips & 16) p.fwgss_restart_at_witness = !p.fwgss_restart_at_witness;
+    if (flips & 32) p.fwgss_kink_guard = !p.fwgss_kink_guard;
     if (flips & 128) {
         p.fwgss_clear_proof = fz_int(&in, -1, 300);
         p.fwgss_gap_tolerance = fz_double(&in);

@@ -125,6 +125,22 @@ typedef struct sdfccd_QueryParams {
                                         in contact there and it searches back for that part's entry, without first
                                         searching the whole interval along the vertex's path. 0 = restarts begin at t0.
                                         Default 1. */
+    int32_t fwgss_kink_guard;      /**< FWGSS on fields whose gradient may jump, where the slope of phi is not trusted
+                                        (ours, issue 20). On the analytic ones (box, cylinder, spike grid, CSG,
+                                        transformed and callback SDFs): the spatial line searches use golden section
+                                        (fwgss_derivative_spatial is ignored); on non-convex ones, after the vertex
+                                        descents four more start from the edge midpoints and the centroid (when
+                                        fwgss_restarts > 0); and the earliest contact found is checked 1 us earlier by
+                                        spatial steps from its weights and from each vertex; when the triangle touches
+                                        there too, the time is moved back and bisected to the time tolerance. This
+                                        finds contacts where a sharp feature (box edge or corner, knife edge, spike tip)
+                                        crosses an edge or the inside of the triangle, which the alternating temporal and
+                                        spatial searches approach in micrometre steps and answer late. Grids may sample
+                                        smooth shapes: at 1 a grid query gets the extra starts and the check only when
+                                        the gradient turns by more than 0.2 rad within 1 mm of the earliest contact; at 2
+                                        every grid query gets the whole guard. Smooth analytic fields (sphere, torus,
+                                        capsule, rounded box, half-space) are unaffected. Per-kind data set
+                                        (samples/report, section 2b) and costs: README. 0 = off, 1 (default) or 2. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
