@@ -62,8 +62,16 @@ struct Frame {
     D3 toWorld(D3 p) const { return dirToWorld(p) + o; }
 };
 
+// A lower bound `c` of phi over a triangle (or a point: a[0]) with corners a[] in the SDF's frame:
+// any triangle whose corners stay within d of a[] has phi >= c - L d (L-Lipschitz field). Kept from
+// step to step, so resting nodes and faces cost no SDF evaluation.
+struct Cert {
+    D3 a[3];
+    double c = -HUGE_VAL;
+};
+
 // The step of one (soft body, SDF body) pair, kept for the guard: the nodes' start positions and the
-// SDF body's pose.
+// SDF body's pose; the certificates of its nodes and faces.
 struct SoftRecord {
     const btSoftBody* soft = nullptr;
     const btCollisionObject* sdf_object = nullptr;
@@ -71,7 +79,22 @@ struct SoftRecord {
     btTransform sdf_pose;
     std::vector<D3> start;
     bool fresh = false;
+    std::vector<Cert> node_certs, face_certs;
+    void sizeCerts(int nodes, int faces)
+    {
+        if (node_certs.size() != (size_t)nodes) node_certs.assign((size_t)nodes, Cert());
+        if (face_certs.size() != (size_t)faces) face_certs.assign((size_t)faces, Cert());
+    }
 };
+
+// The certificate's bound over the motion of n corners from x0[] to x1[] (linear: their distance to
+// a[] is largest at an end).
+double certBound(const Cert& cert, const D3* x0, const D3* x1, int n, double L)
+{
+    double d = 0;
+    for (int k = 0; k < n; ++k) d = std::max(d, std::max(len(x0[k] - cert.a[k]), len(x1[k] - cert.a[k])));
+    return cert.c - L * d;
+}
 
 struct SoftState;
 
@@ -153,8 +176,10 @@ double lipschitzOf(sdfccd_SdfId sdf)
 // advancement (phi is `L`-Lipschitz, so a step of (phi - level) / (L |b - a|) cannot jump over the
 // level). Returns false when the segment stays above. Iteration cap: the point reached counts as a
 // hit (early, never late).
-bool pointHit(sdfccd_SdfId sdf, D3 a, D3 b, double level, double L, double* out_f, double* out_phi, D3* out_grad, int64_t* evals)
+bool pointHit(sdfccd_SdfId sdf, D3 a, D3 b, double level, double L, double* out_f, double* out_phi, D3* out_grad, int64_t* evals,
+              double* phi_a = nullptr)
 {
+    if (phi_a) *phi_a = -HUGE_VAL;
     const D3 d = b - a;
     const double length = len(d);
     double t = 0;
@@ -163,6 +188,7 @@ bool pointHit(sdfccd_SdfId sdf, D3 a, D3 b, double level, double L, double* out_
         double phi;
         if (sdfccd_sdf_eval(sdf, sv(a + d * t), &phi, &g) != SDFCCD_OK) return false;
         ++*evals;
+        if (it == 0 && phi_a) *phi_a = phi;
         const double gap = phi - level;
         if (gap <= 1e-6 || it == 199) {
             *out_f = t;
@@ -235,17 +261,39 @@ sdfccd_QueryParams faceParams(const BridgeImpl* impl, double level)
     return p;
 }
 
-// Can the triangle with corners s[] at t0 and e[] at t1 come within `level` of the surface? One SDF
-// evaluation at the start centroid, the Lipschitz bound and the farthest the corners get from it.
-bool faceInReach(sdfccd_SdfId sdf, const D3 s[3], const D3 e[3], double level, double L, int64_t* evals)
+// A lower bound of phi over the triangle p0 p1 p2: phi at the centroid minus L times the farthest
+// corner, split into four up to `depth` times where that is below `need`; -HUGE_VAL when a piece
+// stays below it (the face is near the surface: the CCD checks it).
+double certify(sdfccd_SdfId sdf, D3 p0, D3 p1, D3 p2, double need, double L, int depth, int64_t* evals)
 {
-    const D3 c = (s[0] + s[1] + s[2]) * (1.0 / 3);
-    double r = 0;
-    for (int k = 0; k < 3; ++k) r = std::max(r, std::max(len(s[k] - c), len(e[k] - c)));
+    const D3 c = (p0 + p1 + p2) * (1.0 / 3);
+    const double r = std::max(len(p0 - c), std::max(len(p1 - c), len(p2 - c)));
     double phi;
-    if (sdfccd_sdf_eval(sdf, sv(c), &phi, nullptr) != SDFCCD_OK) return true;
+    if (sdfccd_sdf_eval(sdf, sv(c), &phi, nullptr) != SDFCCD_OK) return -HUGE_VAL;
     ++*evals;
-    return phi - L * r <= level;
+    if (phi - L * r >= need) return phi - L * r;
+    if (depth == 0 || phi < need) return -HUGE_VAL;
+    const D3 m01 = (p0 + p1) * 0.5, m12 = (p1 + p2) * 0.5, m20 = (p2 + p0) * 0.5;
+    const D3 kids[4][3] = { { p0, m01, m20 }, { m01, p1, m12 }, { m20, m12, p2 }, { m01, m12, m20 } };
+    double b = HUGE_VAL;
+    for (const auto& t : kids) {
+        b = std::min(b, certify(sdf, t[0], t[1], t[2], need, L, depth - 1, evals));
+        if (b == -HUGE_VAL) break;
+    }
+    return b;
+}
+
+// Is the face moving from s[] to e[] certified above `need` (an old certificate, or a new one at s[])?
+bool faceClear(sdfccd_SdfId sdf, Cert& cert, const D3 s[3], const D3 e[3], double need, double L, int64_t* evals)
+{
+    if (certBound(cert, s, e, 3, L) >= need) return true;
+    double move = 0;
+    for (int k = 0; k < 3; ++k) move = std::max(move, len(e[k] - s[k]));
+    const double b = certify(sdf, s[0], s[1], s[2], need + L * move, L, 3, evals);
+    if (b == -HUGE_VAL) return false;
+    for (int k = 0; k < 3; ++k) cert.a[k] = s[k];
+    cert.c = b;
+    return true;
 }
 
 void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
@@ -280,6 +328,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     rec.sdf_pose = sw->getWorldTransform();
     rec.fresh = true;
     const int nn = psb->m_nodes.size();
+    rec.sizeCerts(nn, psb->m_faces.size());
     rec.start.resize((size_t)nn);
     for (int i = 0; i < nn; ++i) rec.start[(size_t)i] = d3(psb->m_nodes[i].m_q);
 
@@ -295,16 +344,24 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
         if (n.m_battach) continue;
         double f, phi;
         D3 g;
-        if (!pointHit(sdf, F.toLocal(d3(n.m_q)), F.toLocal(d3(n.m_x)), margin, L, &f, &phi, &g, &evals)) continue;
+        const D3 a = F.toLocal(d3(n.m_q)), b = F.toLocal(d3(n.m_x));
+        Cert& cert = rec.node_certs[(size_t)i];
+        if (certBound(cert, &a, &b, 1, L) >= margin) continue;
+        const bool hit = pointHit(sdf, a, b, margin, L, &f, &phi, &g, &evals, &cert.c);
+        cert.a[0] = a;
+        if (!hit) continue;
         const D3 p = F.toLocal(d3(n.m_q)) + (F.toLocal(d3(n.m_x)) - F.toLocal(d3(n.m_q))) * f;
         const D3 nl = unit(g);
         const D3 nw = F.dirToWorld(nl);
         offer(i, nw, -dot(nw, F.toWorld(p - nl * (phi - soft_margin))), false);
     }
 
-    // Faces: per-vertex linear motion; a contact inside a face holds each of its nodes.
+    // Faces: per-vertex linear motion; a contact inside a face holds each of its nodes. A face point
+    // counts when it comes halfway into the soft margin (the nodes hold the rest; a face lying on the
+    // surface at the margin then needs no query).
     const double dt = psb->m_sst.sdt;
-    const sdfccd_QueryParams qp = faceParams(impl, margin);
+    const double face_level = soft_margin > 0 ? 0.5 * soft_margin : margin;
+    const sdfccd_QueryParams qp = faceParams(impl, face_level);
     if (st->contacts.size() < 8) st->contacts.resize(8);
     for (int fi = 0; fi < psb->m_faces.size(); ++fi) {
         btSoftBody::Face& face = psb->m_faces[fi];
@@ -313,7 +370,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
             s[k] = F.toLocal(d3(face.m_n[k]->m_q));
             e[k] = F.toLocal(d3(face.m_n[k]->m_x));
         }
-        if (!faceInReach(sdf, s, e, margin, L, &evals)) continue;
+        if (faceClear(sdf, rec.face_certs[(size_t)fi], s, e, face_level, L, &evals)) continue;
         sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
         sdfccd_QueryResult res;
         const sdfccd_Status status =
@@ -381,8 +438,16 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     std::vector<char> moved((size_t)nn, 0);
     std::vector<double> level((size_t)nn, -tol);
     std::vector<D3> S((size_t)nn);
+    rec.sizeCerts(nn, psb->m_faces.size());
+    std::vector<char> clear((size_t)nn, 0);
     for (int i = 0; i < nn; ++i) {
         S[(size_t)i] = F.toLocal(rec.start[(size_t)i]);
+        const D3 e = F.toLocal(d3(psb->m_nodes[i].m_x));
+        Cert& cert = rec.node_certs[(size_t)i];
+        if (certBound(cert, &S[(size_t)i], &e, 1, L) >= -tol) {
+            clear[(size_t)i] = 1; // its whole path stays above -tol
+            continue;
+        }
         double phi;
         if (sdfccd_sdf_eval(rec.sdf, sv(S[(size_t)i]), &phi, nullptr) == SDFCCD_OK && phi < -tol) level[(size_t)i] = phi - tol;
         ++evals;
@@ -401,6 +466,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     };
     // Nodes.
     for (int i = 0; i < nn; ++i) {
+        if (clear[(size_t)i]) continue;
         double f, phi;
         D3 g;
         const D3 e = endOf(i);
@@ -433,7 +499,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
                 lev = std::min(lev, level[(size_t)idx[k]]);
             }
             if (pass > 0 && !touched[(size_t)idx[0]] && !touched[(size_t)idx[1]] && !touched[(size_t)idx[2]]) continue;
-            if (!faceInReach(rec.sdf, s, e, lev, L, &evals)) continue;
+            if (faceClear(rec.sdf, rec.face_certs[(size_t)fi], s, e, lev, L, &evals)) continue;
             sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
             sdfccd_QueryResult res;
             sdfccd_Status status = SDFCCD_OK;

@@ -62,6 +62,10 @@ struct SoftWorld {
         if (bridge) {
             const Status s = bridge->registerWith(&world);
             CHECK(s == Status::Ok, "registerWith: %s", sdfccd_bullet::statusString(s));
+            if (std::getenv("SDFCCD_SOFT_NO_GUARD")) { // contacts only (to show what the guard adds)
+                guard = false;
+                sdfccd_bullet::setSoftBodyGuard(*bridge, false);
+            }
         }
     }
     ~SoftWorld()
@@ -585,7 +589,9 @@ static void bench()
             const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / 60;
             const int64_t e1 = with ? sdfccd_bullet::softBodyStats(bridge).sdf_evaluations : 0;
             std::printf("  24x24 cloth lying on a slab, %s: %.3f ms per step, %.0f SDF evaluations per step, lowest node z %.4f\n",
-                        with ? "SdfShape + bridge + guard" : "btBoxShape, stock", ms, (double)(e1 - e0) / 60, minZ(cloth));
+                        with ? (w.guard ? "SdfShape + bridge + guard" : "SdfShape + bridge, no guard") : "btBoxShape, stock", ms,
+                        (double)(e1 - e0) / 60, minZ(cloth));
+            if (with) checkNoErrors(bridge, "bench");
         }
         sdfccd_destroy_sdf(slab);
     }
