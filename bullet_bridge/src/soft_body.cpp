@@ -328,7 +328,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     rec.sdf_pose = sw->getWorldTransform();
     rec.fresh = true;
     const int nn = psb->m_nodes.size();
-    rec.sizeCerts(nn, psb->m_faces.size());
+    rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
     rec.start.resize((size_t)nn);
     for (int i = 0; i < nn; ++i) rec.start[(size_t)i] = d3(psb->m_nodes[i].m_q);
 
@@ -438,7 +438,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     std::vector<char> moved((size_t)nn, 0);
     std::vector<double> level((size_t)nn, -tol);
     std::vector<D3> S((size_t)nn);
-    rec.sizeCerts(nn, psb->m_faces.size());
+    rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
     std::vector<char> clear((size_t)nn, 0);
     for (int i = 0; i < nn; ++i) {
         S[(size_t)i] = F.toLocal(rec.start[(size_t)i]);
@@ -487,6 +487,36 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     const int passes = 4;
     for (int pass = 0; pass <= passes + nn; ++pass) {
         bool changed = false;
+        // Links of a body without faces (ropes): points along each link every h at most (tol / 2), each
+        // path held to its level + L h / 2, so no point between them goes below the level either.
+        for (int li = 0; psb->m_faces.size() == 0 && li < psb->m_links.size(); ++li) {
+            const btSoftBody::Link& link = psb->m_links[li];
+            const int a = (int)(link.m_n[0] - &psb->m_nodes[0]), b = (int)(link.m_n[1] - &psb->m_nodes[0]);
+            if (pass > 0 && !touched[(size_t)a] && !touched[(size_t)b]) continue;
+            const D3 s[3] = { S[(size_t)a], S[(size_t)b], S[(size_t)b] }, e[3] = { endOf(a), endOf(b), endOf(b) };
+            const double lev = std::min(level[(size_t)a], level[(size_t)b]);
+            if (faceClear(rec.sdf, rec.face_certs[(size_t)(psb->m_faces.size() + li)], s, e, lev, L, &evals)) continue;
+            const int n = 1 + (int)std::ceil(std::max(len(s[1] - s[0]), len(e[1] - e[0])) / (0.5 * tol));
+            double first = 2;
+            D3 grad{ 0, 0, 1 };
+            for (int k = 1; k < n; ++k) {
+                const double w = (double)k / n, h = std::max(len(s[1] - s[0]), len(e[1] - e[0])) / n;
+                double f, phi;
+                D3 g;
+                if (pointHit(rec.sdf, s[0] * (1 - w) + s[1] * w, e[0] * (1 - w) + e[1] * w, lev + 0.5 * L * h, L, &f, &phi, &g, &evals) &&
+                    f < first) {
+                    first = f;
+                    grad = g;
+                }
+            }
+            if (first > 1) continue;
+            const double f = pass >= passes ? 0.0 : first;
+            for (int k = 0; k < 2; ++k) {
+                setEnd(k ? b : a, s[k] + (e[k] - s[k]) * f);
+                stopInto(psb->m_nodes[k ? b : a], F.dirToWorld(unit(grad)));
+            }
+            changed = true;
+        }
         for (int fi = 0; fi < psb->m_faces.size(); ++fi) {
             btSoftBody::Face& face = psb->m_faces[fi];
             int idx[3];
