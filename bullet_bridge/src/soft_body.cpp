@@ -296,6 +296,17 @@ bool faceClear(sdfccd_SdfId sdf, Cert& cert, const D3 s[3], const D3 e[3], doubl
     return true;
 }
 
+// The SDF body's pose at the start of the step: a kinematic body (or, after the rigid step, any
+// moving one) is already at its end pose, so its velocity is integrated back over dt.
+btTransform startPose(const btCollisionObject* co, double dt)
+{
+    const btRigidBody* rb = btRigidBody::upcast(co);
+    if (!rb || (rb->isStaticObject() && !rb->isKinematicObject()) || !(dt > 0)) return co->getWorldTransform(); // (mass 0: both flags)
+    btTransform x;
+    btTransformUtil::integrateTransform(co->getWorldTransform(), -rb->getLinearVelocity(), -rb->getAngularVelocity(), (btScalar)dt, x);
+    return x;
+}
+
 void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
 {
     BridgeImpl* impl = st->impl;
@@ -325,7 +336,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     rec.soft = psb;
     rec.sdf_object = co;
     rec.sdf = sdf;
-    rec.sdf_pose = sw->getWorldTransform();
+    rec.sdf_pose = co->isKinematicObject() ? startPose(co, psb->m_sst.sdt) : sw->getWorldTransform();
     rec.fresh = true;
     const int nn = psb->m_nodes.size();
     rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
@@ -432,7 +443,9 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     btSoftBody* psb = const_cast<btSoftBody*>(rec.soft);
     const int nn = psb->m_nodes.size();
     if ((size_t)nn != rec.start.size()) return 0;
-    const Frame F(rec.sdf_pose);
+    // Start positions in the SDF's frame at the start of the step, end positions in its frame now (a
+    // moving SDF body: the relative motion, linear in its frame).
+    const Frame F0(rec.sdf_pose), F(rec.sdf_object->getWorldTransform());
     const double L = lipschitzOf(rec.sdf);
     int64_t evals = 0;
     std::vector<char> moved((size_t)nn, 0);
@@ -441,7 +454,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
     std::vector<char> clear((size_t)nn, 0);
     for (int i = 0; i < nn; ++i) {
-        S[(size_t)i] = F.toLocal(rec.start[(size_t)i]);
+        S[(size_t)i] = F0.toLocal(rec.start[(size_t)i]);
         const D3 e = F.toLocal(d3(psb->m_nodes[i].m_x));
         Cert& cert = rec.node_certs[(size_t)i];
         if (certBound(cert, &S[(size_t)i], &e, 1, L) >= -tol) {
@@ -635,8 +648,11 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
             if (found != st->records.end() && found->second.fresh) continue;
             const sdfccd_SdfId sdf = impl->shapes.sdfFor(co->getCollisionShape(), impl->cfg.sdf_shape_type, impl->cfg.handle_bt_sdf_shape);
             if (sdf.index1 == 0) continue;
-            btVector3 bmin, bmax;
+            btVector3 bmin, bmax, smin, smax; // the SDF body's box at the start and at the end of the step
             co->getCollisionShape()->getAabb(co->getWorldTransform(), bmin, bmax);
+            co->getCollisionShape()->getAabb(startPose(co, psb->m_sst.sdt), smin, smax);
+            bmin.setMin(smin);
+            bmax.setMax(smax);
             const btScalar reach = (btScalar)tolerance;
             if (bmin.x() > hi.x() + reach || bmin.y() > hi.y() + reach || bmin.z() > hi.z() + reach ||
                 bmax.x() < lo.x() - reach || bmax.y() < lo.y() - reach || bmax.z() < lo.z() - reach)
@@ -645,7 +661,7 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
             rec.soft = psb;
             rec.sdf_object = co;
             rec.sdf = sdf;
-            rec.sdf_pose = co->getWorldTransform();
+            rec.sdf_pose = startPose(co, psb->m_sst.sdt);
             rec.start.resize((size_t)psb->m_nodes.size());
             for (int k = 0; k < psb->m_nodes.size(); ++k) rec.start[(size_t)k] = d3(psb->m_nodes[k].m_q);
             moved += guardRecord(st, rec, tolerance);

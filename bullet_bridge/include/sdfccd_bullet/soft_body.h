@@ -12,8 +12,10 @@
  * the point along the normal, so that the face point cannot pass the plane while the nodes hold
  * theirs). The normal is the SDF gradient at the contact; friction (kDF x the SDF body's friction)
  * and hardness (kKHR against static/kinematic SDF bodies, kCHR against dynamic ones) are the soft
- * body's own. Not covered: btDeformableMultiBodyDynamicsWorld (its deformable contacts), an SDF
- * body's own motion during the step (its pose at the start of the step is used).
+ * body's own. A moving SDF body (dynamic or kinematic): the guard checks the nodes' motion
+ * relative to it, from their positions in its frame at the start of the step (a kinematic body's
+ * pose there from its velocity) to their positions in its frame at the end, linearly in its frame.
+ * Not covered: btDeformableMultiBodyDynamicsWorld (its deformable contacts).
  *
  * Cost: a node or face whose SDF distance is certified (a lower bound by the Lipschitz bound over
  * the face, split into pieces) beyond what its motion can close skips the CCD; the certificate is
