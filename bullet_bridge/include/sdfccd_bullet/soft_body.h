@@ -15,11 +15,10 @@
  * body's own. A moving SDF body (dynamic or kinematic): the guard checks the nodes' motion
  * relative to it, from their positions in its frame at the start of the step (a kinematic body's
  * pose there from its velocity) to their positions in its frame at the end, linearly in its frame.
- * Not covered: btDeformableMultiBodyDynamicsWorld. Its solver builds its node and face contacts
- * in its own collision pass (btSoftBody::defaultCollisionHandler into m_nodeRigidContacts and
- * m_faceRigidContacts, not through the dispatcher's algorithms) and solves positions and
- * velocities together, so neither these contacts nor the guard's correction has a place there;
- * not attempted.
+ * Not covered: btDeformableMultiBodyDynamicsWorld. Its solver takes node and face contacts of
+ * another kind (btSoftBody::m_nodeRigidContacts and m_faceRigidContacts, with their own Jacobians,
+ * solved in its implicit velocity solve) and ignores the RContacts the bridge writes; the guard
+ * wraps the soft-rigid world's btSoftBodySolver, which that world does not use. Not attempted.
  *
  * Cost: a node or face whose SDF distance is certified (a lower bound by the Lipschitz bound over
  * the face, split into pieces) beyond what its motion can close skips the CCD; the certificate is
