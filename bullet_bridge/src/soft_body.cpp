@@ -400,7 +400,9 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
             if (wmax > 0.99) continue; // at a node: that node's own path gives its contact
             const double f = dt > 0 ? c.toi / dt : 0;
             const D3 p = fromSv(c.point), nl = unit(fromSv(c.normal));
-            const D3 surface = p - nl * (c.distance - soft_margin); // on the margin's plane
+            // Held at the level it was found at: a plane higher up would lift the face off that level, the
+            // next step would find no contact, and the face would fall back (an oscillation).
+            const D3 surface = p - nl * (c.distance - face_level);
             const D3 nw = F.dirToWorld(nl);
             for (int k = 0; k < 3; ++k) {
                 if (c.barycentric[k] < 0.01 || face.m_n[k]->m_battach) continue;
