@@ -80,6 +80,11 @@ struct SoftRecord {
     std::vector<D3> start;
     bool fresh = false;
     std::vector<Cert> node_certs, face_certs;
+    void setSdf(sdfccd_SdfId id) // another field: the certificates say nothing about it
+    {
+        if (id.index1 != sdf.index1 || id.generation != sdf.generation) node_certs.clear(), face_certs.clear();
+        sdf = id;
+    }
     void sizeCerts(int nodes, int faces)
     {
         if (node_certs.size() != (size_t)nodes) node_certs.assign((size_t)nodes, Cert());
@@ -335,7 +340,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     SoftRecord& rec = st->records[std::make_pair((const void*)psb, (const void*)co)];
     rec.soft = psb;
     rec.sdf_object = co;
-    rec.sdf = sdf;
+    rec.setSdf(sdf);
     rec.sdf_pose = co->isKinematicObject() ? startPose(co, psb->m_sst.sdt) : sw->getWorldTransform();
     rec.fresh = true;
     const int nn = psb->m_nodes.size();
@@ -662,7 +667,7 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
             SoftRecord& rec = st->records[key];
             rec.soft = psb;
             rec.sdf_object = co;
-            rec.sdf = sdf;
+            rec.setSdf(sdf);
             rec.sdf_pose = startPose(co, psb->m_sst.sdt);
             rec.start.resize((size_t)psb->m_nodes.size());
             for (int k = 0; k < psb->m_nodes.size(); ++k) rec.start[(size_t)k] = d3(psb->m_nodes[k].m_q);
