@@ -688,12 +688,20 @@ static void test_soft_misuse()
     }
 }
 
-// Not a ctest (timings are noisy): `soft_body_tests_f32 bench` prints the cost per step of a 24 x 24
+// Not a ctest (timings are noisy): `soft_body_tests_f32 bench [sdf|box]` prints the cost per step of a 24 x 24
 // cloth lying on a 10 cm slab, as an SdfShape through the bridge (with the guard) and as a btBoxShape
 // with stock Bullet, over the last second of a 3 s run.
-static void bench()
+// The measured steps, a function of their own so that callgrind can count only them:
+// valgrind --tool=callgrind --toggle-collect='benchSteps*' soft_body_tests_f32 bench sdf (or box).
+__attribute__((noinline)) void benchSteps(SoftWorld& w, int steps)
+{
+    for (int s = 0; s < steps; ++s) w.step();
+}
+
+static void bench(const char* only)
 {
     for (int with = 1; with >= 0; --with) {
+        if (only && std::strcmp(only, with ? "sdf" : "box") != 0) continue;
         sdfccd_SdfId slab;
         CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &slab) == SDFCCD_OK, "slab");
         {
@@ -708,7 +716,7 @@ static void bench()
             for (int s = 0; s < 120; ++s) w.step();
             const int64_t e0 = with ? sdfccd_bullet::softBodyStats(bridge).sdf_evaluations : 0;
             const auto t0 = std::chrono::steady_clock::now();
-            for (int s = 0; s < 60; ++s) w.step();
+            benchSteps(w, 60);
             const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / 60;
             const int64_t e1 = with ? sdfccd_bullet::softBodyStats(bridge).sdf_evaluations : 0;
             std::printf("  24x24 cloth lying on a slab, %s: %.3f ms per step, %.0f SDF evaluations per step, lowest node z %.4f\n",
@@ -741,8 +749,8 @@ int main(int argc, char** argv)
 {
     std::printf("sdfccd Bullet soft-body tests, btScalar = %d bytes\n", (int)sizeof(btScalar));
     int ran = 0;
-    if (argc == 2 && std::strcmp(argv[1], "bench") == 0) {
-        bench();
+    if (argc >= 2 && std::strcmp(argv[1], "bench") == 0) {
+        bench(argc >= 3 ? argv[2] : nullptr);
         return g_fail == 0 ? 0 : 1;
     }
     for (const Test& t : kTests) {
