@@ -474,7 +474,8 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     }
     auto endOf = [&](int i) { return F.toLocal(d3(psb->m_nodes[i].m_x)); };
     std::vector<char> touched((size_t)nn, 0), touched_next((size_t)nn, 0);
-    const double inv_dt = psb->m_sst.sdt > 0 ? 1.0 / psb->m_sst.sdt : 0.0;
+    // Bullet's own rule after its position solve: v = (x - q) / dt, damped by kDP.
+    const double inv_dt = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
     auto setEnd = [&](int i, D3 local) {
         // The node's executed motion is now start -> here: its velocity says so (then loses its part
         // into the surface, stopInto).
