@@ -5,12 +5,13 @@
  * btSdfCollisionShape) in both body orders (world: btSoftRigidDynamicsWorld with
  * btSoftBodyRigidBodyCollisionConfiguration). Each step, in Bullet's collision detection, the soft
  * body's nodes move linearly from their positions at the start of the step (btSoftBody::Node::m_q)
- * to the positions the solver predicts (m_x): every node's path and every face's per-vertex linear
- * motion (sdfccd_query_triangle_linear) is checked with the CCD against the SDF within
- * Config::contact_margin, and each contact found becomes a btSoftBody::RContact on the nodes
- * (a face point's contact on each of its face's nodes, the plane shifted by the node's offset from
- * the point along the normal, so that the face point cannot pass the plane while the nodes hold
- * theirs). The normal is the SDF gradient at the contact; friction (kDF x the SDF body's friction)
+ * to the positions the solver predicts (m_x): every node's path is checked with the CCD against
+ * the SDF within the soft body's collision margin plus Config::contact_margin (its contact plane at
+ * that margin), every face's per-vertex linear motion (sdfccd_query_triangle_linear) for a point
+ * coming halfway into that margin (held there: the nodes hold the rest of it), and each contact
+ * found becomes a btSoftBody::RContact on the nodes (a face point's contact on each of its face's
+ * nodes, the plane shifted by the node's offset from the point along the normal, so that the face
+ * point cannot pass the plane while the nodes hold theirs). The normal is the SDF gradient at the contact; friction (kDF x the SDF body's friction)
  * and hardness (kKHR against static/kinematic SDF bodies, kCHR against dynamic ones) are the soft
  * body's own. A moving SDF body (dynamic or kinematic): the guard checks the nodes' motion
  * relative to it, from their positions in its frame at the start of the step (a kinematic body's
