@@ -62,8 +62,16 @@ struct Frame {
     D3 toWorld(D3 p) const { return dirToWorld(p) + o; }
 };
 
+// A lower bound `c` of phi over a triangle (or a point: a[0]) with corners a[] in the SDF's frame:
+// any triangle whose corners stay within d of a[] has phi >= c - L d (L-Lipschitz field). Kept from
+// step to step, so resting nodes and faces cost no SDF evaluation.
+struct Cert {
+    D3 a[3];
+    double c = -HUGE_VAL;
+};
+
 // The step of one (soft body, SDF body) pair, kept for the guard: the nodes' start positions and the
-// SDF body's pose.
+// SDF body's pose; the certificates of its nodes and faces.
 struct SoftRecord {
     const btSoftBody* soft = nullptr;
     const btCollisionObject* sdf_object = nullptr;
@@ -71,7 +79,27 @@ struct SoftRecord {
     btTransform sdf_pose;
     std::vector<D3> start;
     bool fresh = false;
+    std::vector<Cert> node_certs, face_certs;
+    void setSdf(sdfccd_SdfId id) // another field: the certificates say nothing about it
+    {
+        if (id.index1 != sdf.index1 || id.generation != sdf.generation) node_certs.clear(), face_certs.clear();
+        sdf = id;
+    }
+    void sizeCerts(int nodes, int faces)
+    {
+        if (node_certs.size() != (size_t)nodes) node_certs.assign((size_t)nodes, Cert());
+        if (face_certs.size() != (size_t)faces) face_certs.assign((size_t)faces, Cert());
+    }
 };
+
+// The certificate's bound over the motion of n corners from x0[] to x1[] (linear: their distance to
+// a[] is largest at an end).
+double certBound(const Cert& cert, const D3* x0, const D3* x1, int n, double L)
+{
+    double d = 0;
+    for (int k = 0; k < n; ++k) d = std::max(d, std::max(len(x0[k] - cert.a[k]), len(x1[k] - cert.a[k])));
+    return cert.c - L * d;
+}
 
 struct SoftState;
 
@@ -153,8 +181,10 @@ double lipschitzOf(sdfccd_SdfId sdf)
 // advancement (phi is `L`-Lipschitz, so a step of (phi - level) / (L |b - a|) cannot jump over the
 // level). Returns false when the segment stays above. Iteration cap: the point reached counts as a
 // hit (early, never late).
-bool pointHit(sdfccd_SdfId sdf, D3 a, D3 b, double level, double L, double* out_f, double* out_phi, D3* out_grad, int64_t* evals)
+bool pointHit(sdfccd_SdfId sdf, D3 a, D3 b, double level, double L, double* out_f, double* out_phi, D3* out_grad, int64_t* evals,
+              double* phi_a = nullptr)
 {
+    if (phi_a) *phi_a = -HUGE_VAL;
     const D3 d = b - a;
     const double length = len(d);
     double t = 0;
@@ -163,6 +193,7 @@ bool pointHit(sdfccd_SdfId sdf, D3 a, D3 b, double level, double L, double* out_
         double phi;
         if (sdfccd_sdf_eval(sdf, sv(a + d * t), &phi, &g) != SDFCCD_OK) return false;
         ++*evals;
+        if (it == 0 && phi_a) *phi_a = phi;
         const double gap = phi - level;
         if (gap <= 1e-6 || it == 199) {
             *out_f = t;
@@ -235,17 +266,50 @@ sdfccd_QueryParams faceParams(const BridgeImpl* impl, double level)
     return p;
 }
 
-// Can the triangle with corners s[] at t0 and e[] at t1 come within `level` of the surface? One SDF
-// evaluation at the start centroid, the Lipschitz bound and the farthest the corners get from it.
-bool faceInReach(sdfccd_SdfId sdf, const D3 s[3], const D3 e[3], double level, double L, int64_t* evals)
+// A lower bound of phi over the triangle p0 p1 p2: phi at the centroid minus L times the farthest
+// corner, split into four up to `depth` times where that is below `need`; -HUGE_VAL when a piece
+// stays below it (the face is near the surface: the CCD checks it).
+double certify(sdfccd_SdfId sdf, D3 p0, D3 p1, D3 p2, double need, double L, int depth, int64_t* evals)
 {
-    const D3 c = (s[0] + s[1] + s[2]) * (1.0 / 3);
-    double r = 0;
-    for (int k = 0; k < 3; ++k) r = std::max(r, std::max(len(s[k] - c), len(e[k] - c)));
+    const D3 c = (p0 + p1 + p2) * (1.0 / 3);
+    const double r = std::max(len(p0 - c), std::max(len(p1 - c), len(p2 - c)));
     double phi;
-    if (sdfccd_sdf_eval(sdf, sv(c), &phi, nullptr) != SDFCCD_OK) return true;
+    if (sdfccd_sdf_eval(sdf, sv(c), &phi, nullptr) != SDFCCD_OK) return -HUGE_VAL;
     ++*evals;
-    return phi - L * r <= level;
+    if (phi - L * r >= need) return phi - L * r;
+    if (depth == 0 || phi < need) return -HUGE_VAL;
+    const D3 m01 = (p0 + p1) * 0.5, m12 = (p1 + p2) * 0.5, m20 = (p2 + p0) * 0.5;
+    const D3 kids[4][3] = { { p0, m01, m20 }, { m01, p1, m12 }, { m20, m12, p2 }, { m01, m12, m20 } };
+    double b = HUGE_VAL;
+    for (const auto& t : kids) {
+        b = std::min(b, certify(sdf, t[0], t[1], t[2], need, L, depth - 1, evals));
+        if (b == -HUGE_VAL) break;
+    }
+    return b;
+}
+
+// Is the face moving from s[] to e[] certified above `need` (an old certificate, or a new one at s[])?
+bool faceClear(sdfccd_SdfId sdf, Cert& cert, const D3 s[3], const D3 e[3], double need, double L, int64_t* evals)
+{
+    if (certBound(cert, s, e, 3, L) >= need) return true;
+    double move = 0;
+    for (int k = 0; k < 3; ++k) move = std::max(move, len(e[k] - s[k]));
+    const double b = certify(sdf, s[0], s[1], s[2], need + L * move, L, 3, evals);
+    if (b == -HUGE_VAL) return false;
+    for (int k = 0; k < 3; ++k) cert.a[k] = s[k];
+    cert.c = b;
+    return true;
+}
+
+// The SDF body's pose at the start of the step: a kinematic body (or, after the rigid step, any
+// moving one) is already at its end pose, so its velocity is integrated back over dt.
+btTransform startPose(const btCollisionObject* co, double dt)
+{
+    const btRigidBody* rb = btRigidBody::upcast(co);
+    if (!rb || (rb->isStaticObject() && !rb->isKinematicObject()) || !(dt > 0)) return co->getWorldTransform(); // (mass 0: both flags)
+    btTransform x;
+    btTransformUtil::integrateTransform(co->getWorldTransform(), -rb->getLinearVelocity(), -rb->getAngularVelocity(), (btScalar)dt, x);
+    return x;
 }
 
 void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
@@ -276,10 +340,11 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     SoftRecord& rec = st->records[std::make_pair((const void*)psb, (const void*)co)];
     rec.soft = psb;
     rec.sdf_object = co;
-    rec.sdf = sdf;
-    rec.sdf_pose = sw->getWorldTransform();
+    rec.setSdf(sdf);
+    rec.sdf_pose = co->isKinematicObject() ? startPose(co, psb->m_sst.sdt) : sw->getWorldTransform();
     rec.fresh = true;
     const int nn = psb->m_nodes.size();
+    rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
     rec.start.resize((size_t)nn);
     for (int i = 0; i < nn; ++i) rec.start[(size_t)i] = d3(psb->m_nodes[i].m_q);
 
@@ -295,16 +360,24 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
         if (n.m_battach) continue;
         double f, phi;
         D3 g;
-        if (!pointHit(sdf, F.toLocal(d3(n.m_q)), F.toLocal(d3(n.m_x)), margin, L, &f, &phi, &g, &evals)) continue;
+        const D3 a = F.toLocal(d3(n.m_q)), b = F.toLocal(d3(n.m_x));
+        Cert& cert = rec.node_certs[(size_t)i];
+        if (certBound(cert, &a, &b, 1, L) >= margin) continue;
+        const bool hit = pointHit(sdf, a, b, margin, L, &f, &phi, &g, &evals, &cert.c);
+        cert.a[0] = a;
+        if (!hit) continue;
         const D3 p = F.toLocal(d3(n.m_q)) + (F.toLocal(d3(n.m_x)) - F.toLocal(d3(n.m_q))) * f;
         const D3 nl = unit(g);
         const D3 nw = F.dirToWorld(nl);
         offer(i, nw, -dot(nw, F.toWorld(p - nl * (phi - soft_margin))), false);
     }
 
-    // Faces: per-vertex linear motion; a contact inside a face holds each of its nodes.
+    // Faces: per-vertex linear motion; a contact inside a face holds each of its nodes. A face point
+    // counts when it comes halfway into the soft margin (the nodes hold the rest; a face lying on the
+    // surface at the margin then needs no query).
     const double dt = psb->m_sst.sdt;
-    const sdfccd_QueryParams qp = faceParams(impl, margin);
+    const double face_level = soft_margin > 0 ? 0.5 * soft_margin : margin;
+    const sdfccd_QueryParams qp = faceParams(impl, face_level);
     if (st->contacts.size() < 8) st->contacts.resize(8);
     for (int fi = 0; fi < psb->m_faces.size(); ++fi) {
         btSoftBody::Face& face = psb->m_faces[fi];
@@ -313,7 +386,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
             s[k] = F.toLocal(d3(face.m_n[k]->m_q));
             e[k] = F.toLocal(d3(face.m_n[k]->m_x));
         }
-        if (!faceInReach(sdf, s, e, margin, L, &evals)) continue;
+        if (faceClear(sdf, rec.face_certs[(size_t)fi], s, e, face_level, L, &evals)) continue;
         sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
         sdfccd_QueryResult res;
         const sdfccd_Status status =
@@ -332,7 +405,9 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
             if (wmax > 0.99) continue; // at a node: that node's own path gives its contact
             const double f = dt > 0 ? c.toi / dt : 0;
             const D3 p = fromSv(c.point), nl = unit(fromSv(c.normal));
-            const D3 surface = p - nl * (c.distance - soft_margin); // on the margin's plane
+            // Held at the level it was found at: a plane higher up would lift the face off that level, the
+            // next step would find no contact, and the face would fall back (an oscillation).
+            const D3 surface = p - nl * (c.distance - face_level);
             const D3 nw = F.dirToWorld(nl);
             for (int k = 0; k < 3; ++k) {
                 if (c.barycentric[k] < 0.01 || face.m_n[k]->m_battach) continue;
@@ -375,21 +450,32 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     btSoftBody* psb = const_cast<btSoftBody*>(rec.soft);
     const int nn = psb->m_nodes.size();
     if ((size_t)nn != rec.start.size()) return 0;
-    const Frame F(rec.sdf_pose);
+    // Start positions in the SDF's frame at the start of the step, end positions in its frame now (a
+    // moving SDF body: the relative motion, linear in its frame).
+    const Frame F0(rec.sdf_pose), F(rec.sdf_object->getWorldTransform());
     const double L = lipschitzOf(rec.sdf);
     int64_t evals = 0;
     std::vector<char> moved((size_t)nn, 0);
     std::vector<double> level((size_t)nn, -tol);
     std::vector<D3> S((size_t)nn);
+    rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
+    std::vector<char> clear((size_t)nn, 0);
     for (int i = 0; i < nn; ++i) {
-        S[(size_t)i] = F.toLocal(rec.start[(size_t)i]);
+        S[(size_t)i] = F0.toLocal(rec.start[(size_t)i]);
+        const D3 e = F.toLocal(d3(psb->m_nodes[i].m_x));
+        Cert& cert = rec.node_certs[(size_t)i];
+        if (certBound(cert, &S[(size_t)i], &e, 1, L) >= -tol) {
+            clear[(size_t)i] = 1; // its whole path stays above -tol
+            continue;
+        }
         double phi;
         if (sdfccd_sdf_eval(rec.sdf, sv(S[(size_t)i]), &phi, nullptr) == SDFCCD_OK && phi < -tol) level[(size_t)i] = phi - tol;
         ++evals;
     }
     auto endOf = [&](int i) { return F.toLocal(d3(psb->m_nodes[i].m_x)); };
     std::vector<char> touched((size_t)nn, 0), touched_next((size_t)nn, 0);
-    const double inv_dt = psb->m_sst.sdt > 0 ? 1.0 / psb->m_sst.sdt : 0.0;
+    // Bullet's own rule after its position solve: v = (x - q) / dt, damped by kDP.
+    const double inv_dt = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
     auto setEnd = [&](int i, D3 local) {
         // The node's executed motion is now start -> here: its velocity says so (then loses its part
         // into the surface, stopInto).
@@ -401,6 +487,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     };
     // Nodes.
     for (int i = 0; i < nn; ++i) {
+        if (clear[(size_t)i]) continue;
         double f, phi;
         D3 g;
         const D3 e = endOf(i);
@@ -421,6 +508,36 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     const int passes = 4;
     for (int pass = 0; pass <= passes + nn; ++pass) {
         bool changed = false;
+        // Links of a body without faces (ropes): points along each link every h at most (tol / 2), each
+        // path held to its level + L h / 2, so no point between them goes below the level either.
+        for (int li = 0; psb->m_faces.size() == 0 && li < psb->m_links.size(); ++li) {
+            const btSoftBody::Link& link = psb->m_links[li];
+            const int a = (int)(link.m_n[0] - &psb->m_nodes[0]), b = (int)(link.m_n[1] - &psb->m_nodes[0]);
+            if (pass > 0 && !touched[(size_t)a] && !touched[(size_t)b]) continue;
+            const D3 s[3] = { S[(size_t)a], S[(size_t)b], S[(size_t)b] }, e[3] = { endOf(a), endOf(b), endOf(b) };
+            const double lev = std::min(level[(size_t)a], level[(size_t)b]);
+            if (faceClear(rec.sdf, rec.face_certs[(size_t)(psb->m_faces.size() + li)], s, e, lev, L, &evals)) continue;
+            const int n = 1 + (int)std::ceil(std::max(len(s[1] - s[0]), len(e[1] - e[0])) / (0.5 * tol));
+            double first = 2;
+            D3 grad{ 0, 0, 1 };
+            for (int k = 1; k < n; ++k) {
+                const double w = (double)k / n, h = std::max(len(s[1] - s[0]), len(e[1] - e[0])) / n;
+                double f, phi;
+                D3 g;
+                if (pointHit(rec.sdf, s[0] * (1 - w) + s[1] * w, e[0] * (1 - w) + e[1] * w, lev + 0.5 * L * h, L, &f, &phi, &g, &evals) &&
+                    f < first) {
+                    first = f;
+                    grad = g;
+                }
+            }
+            if (first > 1) continue;
+            const double f = pass >= passes ? 0.0 : first;
+            for (int k = 0; k < 2; ++k) {
+                setEnd(k ? b : a, s[k] + (e[k] - s[k]) * f);
+                stopInto(psb->m_nodes[k ? b : a], F.dirToWorld(unit(grad)));
+            }
+            changed = true;
+        }
         for (int fi = 0; fi < psb->m_faces.size(); ++fi) {
             btSoftBody::Face& face = psb->m_faces[fi];
             int idx[3];
@@ -433,7 +550,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
                 lev = std::min(lev, level[(size_t)idx[k]]);
             }
             if (pass > 0 && !touched[(size_t)idx[0]] && !touched[(size_t)idx[1]] && !touched[(size_t)idx[2]]) continue;
-            if (!faceInReach(rec.sdf, s, e, lev, L, &evals)) continue;
+            if (faceClear(rec.sdf, rec.face_certs[(size_t)fi], s, e, lev, L, &evals)) continue;
             sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
             sdfccd_QueryResult res;
             sdfccd_Status status = SDFCCD_OK;
@@ -539,8 +656,11 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
             if (found != st->records.end() && found->second.fresh) continue;
             const sdfccd_SdfId sdf = impl->shapes.sdfFor(co->getCollisionShape(), impl->cfg.sdf_shape_type, impl->cfg.handle_bt_sdf_shape);
             if (sdf.index1 == 0) continue;
-            btVector3 bmin, bmax;
+            btVector3 bmin, bmax, smin, smax; // the SDF body's box at the start and at the end of the step
             co->getCollisionShape()->getAabb(co->getWorldTransform(), bmin, bmax);
+            co->getCollisionShape()->getAabb(startPose(co, psb->m_sst.sdt), smin, smax);
+            bmin.setMin(smin);
+            bmax.setMax(smax);
             const btScalar reach = (btScalar)tolerance;
             if (bmin.x() > hi.x() + reach || bmin.y() > hi.y() + reach || bmin.z() > hi.z() + reach ||
                 bmax.x() < lo.x() - reach || bmax.y() < lo.y() - reach || bmax.z() < lo.z() - reach)
@@ -548,8 +668,8 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
             SoftRecord& rec = st->records[key];
             rec.soft = psb;
             rec.sdf_object = co;
-            rec.sdf = sdf;
-            rec.sdf_pose = co->getWorldTransform();
+            rec.setSdf(sdf);
+            rec.sdf_pose = startPose(co, psb->m_sst.sdt);
             rec.start.resize((size_t)psb->m_nodes.size());
             for (int k = 0; k < psb->m_nodes.size(); ++k) rec.start[(size_t)k] = d3(psb->m_nodes[k].m_q);
             moved += guardRecord(st, rec, tolerance);

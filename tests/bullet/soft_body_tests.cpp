@@ -62,6 +62,10 @@ struct SoftWorld {
         if (bridge) {
             const Status s = bridge->registerWith(&world);
             CHECK(s == Status::Ok, "registerWith: %s", sdfccd_bullet::statusString(s));
+            if (std::getenv("SDFCCD_SOFT_NO_GUARD")) { // contacts only (to show what the guard adds)
+                guard = false;
+                sdfccd_bullet::setSoftBodyGuard(*bridge, false);
+            }
         }
     }
     ~SoftWorld()
@@ -226,7 +230,9 @@ static void test_cloth_on_torus()
                 worst_step, rest, final_min_z);
     CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
     CHECK(final_min_z > -0.1, "the cloth fell past the torus (mean node z = %.3f)", final_min_z);
-    // Not asserted yet: the rest limit (0.05 m/s over the last second) is not met (see the report).
+    // Not asserted yet: the rest limit (0.05 m/s over the last second) is not met: 0.061 m/s (float and
+    // double), at nodes on the edge of the contact band and where the guard keeps putting back nodes that
+    // Bullet's soft contacts (kKHR 0.1) let sink under the skirt's weight; the mean node speed is 3 mm/s.
 }
 
 // The cloth at 20 m/s (33 cm per step) onto a 1 cm plate: it does not pass. Without the guard
@@ -352,12 +358,13 @@ static void test_ball_on_torus()
 }
 
 // A rope pinned at one end swings through a standing torus ring (ring 0.25 m, tube 0.04 m, in the
-// xz plane): its nodes stay out of the tube.
+// xz plane): its nodes and 7 points inside each link stay out of the tube (with the nodes alone
+// checked, the link interiors went 7.14 mm deep).
 static void test_rope_through_ring()
 {
     sdfccd_SdfId torus;
     CHECK(sdfccd_create_torus(0.25, 0.04, &torus) == SDFCCD_OK, "torus");
-    double worst = 0;
+    double worst = 0, worst_links = 0;
     {
         Bridge bridge;
         SdfShape shape(torus);
@@ -372,13 +379,71 @@ static void test_rope_through_ring()
         for (int s = 0; s < 180; ++s) {
             w.step();
             for (int i = 0; i < rope->m_nodes.size(); ++i) worst = std::max(worst, -phiAt(torus, pose, rope->m_nodes[i].m_x));
+            for (int l = 0; l < rope->m_links.size(); ++l)
+                for (int k = 1; k < 8; ++k) {
+                    const btVector3 p = rope->m_links[l].m_n[0]->m_x.lerp(rope->m_links[l].m_n[1]->m_x, (btScalar)(k / 8.0));
+                    worst_links = std::max(worst_links, -phiAt(torus, pose, p));
+                }
         }
         checkNoErrors(bridge, "rope_through_ring");
         CHECK(sdfccd_bullet::softBodyStats(bridge).node_contacts > 0, "the rope never touched the ring");
     }
     sdfccd_destroy_sdf(torus);
-    std::printf("  rope through a ring: max node penetration %.4f mm\n", worst * 1e3);
+    std::printf("  rope through a ring: max penetration %.4f mm at nodes, %.4f mm at 7 points inside each link\n", worst * 1e3,
+                worst_links * 1e3);
     CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+    CHECK(worst_links <= 1e-3, "link interiors: penetration %.4f mm > 1 mm", worst_links * 1e3);
+}
+
+// A moving SDF body: a kinematic plate (a 1 cm thick 1.2 m square) rising at 3 m/s (5 cm per step)
+// and turning about z at 1 rad/s under a cloth; the cloth is checked against the plate at its pose
+// of each step. With the guard in the plate's frame at collision time only (before the moving-body
+// fix), the plate passed the cloth (lowest node 7.3 m under it after 1.5 s, float).
+struct KinematicPath : btMotionState {
+    double t = 0, rise = 3.0;
+    btTransform at(double time) const
+    {
+        btTransform x;
+        x.setIdentity();
+        x.setRotation(btQuaternion(btVector3(0, 0, 1), (btScalar)time));
+        x.setOrigin(btVector3(0, 0, (btScalar)(rise * time)));
+        return x;
+    }
+    void getWorldTransform(btTransform& x) const override { x = at(t); }
+    void setWorldTransform(const btTransform&) override {}
+};
+
+static void test_moving_sdf()
+{
+    sdfccd_SdfId plate;
+    CHECK(sdfccd_create_box(sdfccd_Vec3{ 0.6, 0.6, 0.005 }, &plate) == SDFCCD_OK, "plate");
+    double worst = 0, lowest_gap = 1e30;
+    {
+        Bridge bridge;
+        SdfShape shape(plate);
+        SoftWorld w(&bridge);
+        KinematicPath path;
+        btRigidBody::btRigidBodyConstructionInfo ci(0, &path, &shape);
+        btRigidBody body(ci);
+        body.setCollisionFlags(body.getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+        body.setActivationState(DISABLE_DEACTIVATION);
+        w.world.addRigidBody(&body);
+        btSoftBody* cloth = w.addCloth(0.6, 0.0, 0.0, 0.15, -1.0);
+        for (int s = 0; s < 90; ++s) {
+            path.t = (s + 1) * kDt;
+            w.step();
+            const btTransform pose = body.getWorldTransform();
+            worst = std::max(worst, softPenetration(cloth, plate, pose));
+            lowest_gap = std::min(lowest_gap, minZ(cloth) - (double)pose.getOrigin().z());
+        }
+        checkNoErrors(bridge, "moving_sdf");
+        w.world.removeRigidBody(&body);
+    }
+    sdfccd_destroy_sdf(plate);
+    std::printf("  cloth on a rising, turning SDF plate: max penetration %.4f mm, lowest node above the plate's centre %.4f m\n",
+                worst * 1e3, lowest_gap);
+    CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+    CHECK(lowest_gap > 0.0, "the cloth passed the moving plate (lowest node %.4f m from its centre)", lowest_gap);
 }
 
 // ---- stock Bullet, same scenes ----
@@ -429,6 +494,68 @@ static void test_btsdf_tray()
     CHECK(z_stock < -0.5, "stock Bullet was expected to fall through (lowest node z = %.3f)", z_stock);
     CHECK(z_bridge > 0.0, "the bridge let the cloth through the tray (lowest node z = %.4f)", z_bridge);
     CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+}
+
+// Stock Bullet against the SDF's isosurface (sdfccd_extract_isosurface) as a btBvhTriangleMeshShape,
+// in the scenes above: the cloth dropped at 2 m/s onto the torus (a coarse 16-cell mesh and 15 steps:
+// Bullet's soft-concave path costs seconds per step on finer ones), and at 20 m/s onto the 1 cm plate.
+// Measured against the exact SDF like the bridge's rows.
+static void runStockMesh(sdfccd_SdfId sdf, sdfccd_Aabb box, int res, double side, double z, double vz, int steps, double* worst,
+                         double* min_z)
+{
+    sdfccd_MeshId mesh;
+    *worst = 0;
+    *min_z = 0;
+    if (sdfccd_extract_isosurface(sdf, box, res, &mesh) != SDFCCD_OK) {
+        CHECK(false, "extract: %s", sdfccd_last_error());
+        return;
+    }
+    sdfccd_MeshInfo info;
+    sdfccd_mesh_get_info(mesh, &info);
+    std::vector<double> v(3 * (size_t)info.vertex_count);
+    std::vector<uint32_t> idx(3 * (size_t)info.triangle_count);
+    sdfccd_mesh_get_data(mesh, v.data(), idx.data());
+    sdfccd_destroy_mesh(mesh);
+    btTriangleMesh tm;
+    for (size_t t = 0; t < idx.size(); t += 3) {
+        btVector3 c[3];
+        for (int k = 0; k < 3; ++k)
+            c[k] = btVector3((btScalar)v[3 * idx[t + k]], (btScalar)v[3 * idx[t + k] + 1], (btScalar)v[3 * idx[t + k] + 2]);
+        tm.addTriangle(c[0], c[1], c[2]);
+    }
+    btBvhTriangleMeshShape shape(&tm, true);
+    SoftWorld w(nullptr);
+    btTransform id;
+    id.setIdentity();
+    w.addStatic(&shape, id);
+    btSoftBody* cloth = w.addCloth(side, 0.05, -0.03, z, vz);
+    for (int s = 0; s < steps; ++s) {
+        w.step();
+        *worst = std::max(*worst, softPenetration(cloth, sdf, id));
+    }
+    *min_z = minZ(cloth);
+}
+
+static void test_stock_isosurface()
+{
+    sdfccd_SdfId torus, plate;
+    CHECK(sdfccd_create_torus(0.3, 0.1, &torus) == SDFCCD_OK, "torus");
+    CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.005 }, &plate) == SDFCCD_OK, "plate");
+    double torus_pen, torus_z, plate_pen, plate_z;
+    const auto t1 = std::chrono::steady_clock::now();
+    runStockMesh(torus, sdfccd_Aabb{ { -0.45, -0.45, -0.15 }, { 0.45, 0.45, 0.15 } }, 16, 0.8, 0.3, -2.0, 15, &torus_pen, &torus_z);
+    if (kVerbose) std::printf("  torus: %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+    const auto t0 = std::chrono::steady_clock::now();
+    runStockMesh(plate, sdfccd_Aabb{ { -0.4, -0.4, -0.02 }, { 0.4, 0.4, 0.02 } }, 160, 0.6, 0.5, -20.0, 60, &plate_pen, &plate_z);
+    if (kVerbose) std::printf("  plate: %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    sdfccd_destroy_sdf(torus);
+    sdfccd_destroy_sdf(plate);
+    std::printf("  stock, SDF isosurface as btBvhTriangleMeshShape: cloth on torus max penetration %.3f mm (lowest node z %.3f); "
+                "20 m/s cloth on the 1 cm plate: max penetration %.3f mm, lowest node z %.3f\n",
+                torus_pen * 1e3, torus_z, plate_pen * 1e3, plate_z);
+    CHECK(torus_pen > 1e-3 && torus_z < -0.1, "stock Bullet was expected to sink into the torus mesh and fall through it (%.3f mm, "
+          "lowest node z %.3f)", torus_pen * 1e3, torus_z);
+    CHECK(plate_z < -0.005, "stock Bullet was expected to pass the plate mesh (lowest node z = %.3f)", plate_z);
 }
 
 // Stock Bullet: the 20 m/s cloth passes a 10 cm btBoxShape slab (its node-by-node discrete check).
@@ -561,12 +688,20 @@ static void test_soft_misuse()
     }
 }
 
-// Not a ctest (timings are noisy): `soft_body_tests_f32 bench` prints the cost per step of a 24 x 24
+// Not a ctest (timings are noisy): `soft_body_tests_f32 bench [sdf|box]` prints the cost per step of a 24 x 24
 // cloth lying on a 10 cm slab, as an SdfShape through the bridge (with the guard) and as a btBoxShape
 // with stock Bullet, over the last second of a 3 s run.
-static void bench()
+// The measured steps, a function of their own so that callgrind can count only them:
+// valgrind --tool=callgrind --toggle-collect='benchSteps*' soft_body_tests_f32 bench sdf (or box).
+__attribute__((noinline)) void benchSteps(SoftWorld& w, int steps)
+{
+    for (int s = 0; s < steps; ++s) w.step();
+}
+
+static void bench(const char* only)
 {
     for (int with = 1; with >= 0; --with) {
+        if (only && std::strcmp(only, with ? "sdf" : "box") != 0) continue;
         sdfccd_SdfId slab;
         CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &slab) == SDFCCD_OK, "slab");
         {
@@ -581,11 +716,13 @@ static void bench()
             for (int s = 0; s < 120; ++s) w.step();
             const int64_t e0 = with ? sdfccd_bullet::softBodyStats(bridge).sdf_evaluations : 0;
             const auto t0 = std::chrono::steady_clock::now();
-            for (int s = 0; s < 60; ++s) w.step();
+            benchSteps(w, 60);
             const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / 60;
             const int64_t e1 = with ? sdfccd_bullet::softBodyStats(bridge).sdf_evaluations : 0;
             std::printf("  24x24 cloth lying on a slab, %s: %.3f ms per step, %.0f SDF evaluations per step, lowest node z %.4f\n",
-                        with ? "SdfShape + bridge + guard" : "btBoxShape, stock", ms, (double)(e1 - e0) / 60, minZ(cloth));
+                        with ? (w.guard ? "SdfShape + bridge + guard" : "SdfShape + bridge, no guard") : "btBoxShape, stock", ms,
+                        (double)(e1 - e0) / 60, minZ(cloth));
+            if (with) checkNoErrors(bridge, "bench");
         }
         sdfccd_destroy_sdf(slab);
     }
@@ -601,8 +738,10 @@ static const Test kTests[] = {
     { "cloth_on_spikes", test_cloth_on_spikes },
     { "ball_on_torus", test_ball_on_torus },
     { "rope_through_ring", test_rope_through_ring },
+    { "moving_sdf", test_moving_sdf },
     { "btsdf_tray", test_btsdf_tray },
     { "stock_box_fast", test_stock_box_fast },
+    { "stock_isosurface", test_stock_isosurface },
     { "soft_misuse", test_soft_misuse },
 };
 
@@ -610,8 +749,8 @@ int main(int argc, char** argv)
 {
     std::printf("sdfccd Bullet soft-body tests, btScalar = %d bytes\n", (int)sizeof(btScalar));
     int ran = 0;
-    if (argc == 2 && std::strcmp(argv[1], "bench") == 0) {
-        bench();
+    if (argc >= 2 && std::strcmp(argv[1], "bench") == 0) {
+        bench(argc >= 3 ? argv[2] : nullptr);
         return g_fail == 0 ? 0 : 1;
     }
     for (const Test& t : kTests) {
