@@ -36,6 +36,18 @@ namespace detail {
 
 // Among points giving at least this share of the best spread, the one with the smallest gap wins.
 static const double kSpreadShare = 0.95;
+// The reduction's depth scale: a tenth of the mesh's radius, at most 0.3 m (a body's far features
+// count less than those about to touch, in proportion to its size).
+static const double kSpreadDepthFraction = 0.1, kSpreadDepthMax = 0.3;
+// The vertices of a triangle in contact within this distance of the surface at its TOI are
+// candidates too (a face landing flat gives its corners).
+static const double kVertexDistance = 0.02;
+// The discrete queries do not split subdivision regions smaller than (this x the mesh's radius)^2:
+// their points lie that close to the triangle's vertices, which are candidates already.
+static const double kDiscreteSubdivisionScale = 0.1;
+// The face search splits faces down to regions with edges at most this share of the SDF's feature
+// size (SdfShape::setFeatureSize).
+static const double kFaceRegionShare = 0.4;
 // The face search keeps the field's normal at a point of a face inside the SDF when it is
 // within about 25 degrees of the face's inward direction (a face on a smooth surface).
 static const double kFaceNormalAgreement = 0.9;
@@ -247,7 +259,7 @@ struct Gatherer {
             addFromStart(local, (int)vt[i].second);
         }
     }
-    // The face search (Config::face_search_size): the mesh's triangles with an edge longer than
+    // The face search (SdfShape::setFeatureSize): the mesh's triangles with an edge longer than
     // `size` at pose (Mx, Sx), split into 4 at their edge midpoints down to regions with no edge
     // longer than `size`; a region whose centroid is farther from the surface than `lipschitz`
     // times its radius plus `accept` has no point within `accept` and is dropped; each remaining
@@ -440,18 +452,21 @@ bool BridgeImpl::plan(const btCollisionObjectWrapper* mw, const btCollisionObjec
     // query was moved first).
     P.continuous = P.params.method != SDFCCD_METHOD_DCD;
     P.start_margin = margin;
-    P.travel = P.kick = 0;
+    P.travel = 0;
     if (dt > 0) {
         const double reach = P.me->radius + (double)(P.M.t0.getOrigin() - P.S.t0.getOrigin()).length();
         P.travel = dt * ((double)(P.M.v - P.S.v).length() + (double)P.M.w.length() * P.me->radius + (double)P.S.w.length() * reach);
-        // A kick (a velocity change from another contact solved in the same step, e.g. a body
-        // landing on this one) is not in the predicted motion: the start-pose query also reaches
-        // as far as kick_angular_speed about the body's centre carries its farthest point in the
-        // step, and its features count even when the predicted motion has no contact.
-        P.kick = dt * cfg.kick_angular_speed * P.me->radius;
-        P.start_margin = margin + P.travel + P.kick;
+        P.start_margin = margin + P.travel;
     }
+    // The face search's region size comes from the SDF shape's smallest feature.
+    const SdfShape* shape = dynamic_cast<const SdfShape*>(sw->getCollisionShape());
+    P.feature_size = shape ? shape->getFeatureSize() : 0.0;
     return true;
+}
+
+bool BridgeImpl::faceSearch(const PairPlan& P) const
+{
+    return P.params.subdivision && P.feature_size > 0;
 }
 
 sdfccd_QueryParams BridgeImpl::discreteParams(const PairPlan& P, double dcd_margin) const
@@ -460,10 +475,10 @@ sdfccd_QueryParams BridgeImpl::discreteParams(const PairPlan& P, double dcd_marg
     std::memcpy(&dcd, &P.params, sizeof dcd);
     dcd.method = SDFCCD_METHOD_DCD;
     dcd.margin = dcd_margin;
-    // Subdivision regions below (discrete_subdivision_scale x the mesh radius)^2 are not split:
+    // Subdivision regions below (kDiscreteSubdivisionScale x the mesh radius)^2 are not split:
     // their points lie that close to the triangle's vertices, which are candidates already.
     // (Not for the DCD baseline, which keeps the library's subdivision.)
-    const double sub = cfg.discrete_subdivision_scale * P.me->radius;
+    const double sub = kDiscreteSubdivisionScale * P.me->radius;
     if (P.continuous && sub > 0) dcd.subdivision_min_area = std::max(dcd.subdivision_min_area, sub * sub);
     return dcd;
 }
@@ -582,7 +597,7 @@ void BridgeImpl::prefetch(double dt, double margin)
         const CachedQuery& c = batch_cache[PairStageKey{ items[k].mo, items[k].so, kStageStart }];
         if (c.status != SDFCCD_OK) continue;
         if (c.result.triangles_tested == 0 && c.result.state == SDFCCD_STATE_NO_HIT) continue;
-        if (cfg.face_search_size > 0 && items[k].P.params.subdivision) continue;
+        if (faceSearch(items[k].P)) continue;
         bool touching = false;
         if (c.result.hit)
             for (int i = 0; i < std::min(c.result.contact_count, kBatchCapacity) && !touching; ++i)
@@ -704,7 +719,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // together on a resting body). Otherwise (2) the CCD query over the step; no hit, no contact.
     sdfccd_QueryResult r0{};
     bool start_ran = false, start_ok = false, starts_touching = false;
-    const double start_margin = P.start_margin, travel = P.travel, kick = P.kick;
+    const double start_margin = P.start_margin, travel = P.travel;
     if (dt > 0 && continuous) {
         start_ran = true;
         start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0, kStageStart);
@@ -717,16 +732,17 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         if (start_ok && r0.hit)
             for (int i = 0; i < r0.contact_count && !starts_touching; ++i) starts_touching = start_contacts[(size_t)i].distance <= margin;
     }
-    // The face search (Config::face_search_size; part of the subdivision, so off without it): at
+    // The face search (SdfShape::setFeatureSize; part of the subdivision, so off without it): at
     // the start pose over the step's reach (DCD, the discrete baseline: at the end pose within
     // the margin, as its own query). Its features count like the start-pose query's, even when
     // the CCD query misses them (a face landing flat on tips between its FW points).
     size_t face_found = 0;
-    if (dt > 0 && cfg.face_search_size > 0 && params.subdivision) {
+    if (dt > 0 && faceSearch(P)) {
         sdfccd_SdfInfo info;
         const double lip = sdfccd_sdf_get_info(G.sdf, &info) == SDFCCD_OK && info.lipschitz > 0 ? info.lipschitz : 1.0;
-        stats.face_regions += continuous ? G.searchFaces(cfg.face_search_size, G.M.t0, G.S.t0, start_margin, lip, params)
-                                         : G.searchFaces(cfg.face_search_size, G.M.t1, G.S.t1, margin, lip, params);
+        const double fs = kFaceRegionShare * P.feature_size;
+        stats.face_regions += continuous ? G.searchFaces(fs, G.M.t0, G.S.t0, start_margin, lip, params)
+                                         : G.searchFaces(fs, G.M.t1, G.S.t1, margin, lip, params);
         face_found = cands.size();
         for (size_t i = 0; i < face_found && continuous && !starts_touching; ++i) starts_touching = cands[i].d <= margin;
     }
@@ -746,15 +762,15 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.last_state = (int)res.state;
         if (!res.hit) {
             stats.last_toi_fraction = 1;
-            // The predicted motion is clear: only a kick can bring the start pose's features in,
-            // or the face search found features the CCD query missed.
-            if ((kick > 0 || face_found > 0) && start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, start_margin);
+            // The predicted motion is clear: only the face search can have found features the
+            // CCD query missed; the start pose's features then count too.
+            if (face_found > 0 && start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, start_margin);
             return cands.empty() ? false : finish();
         }
         stats.hits++;
         stats.last_toi_fraction = res.fraction;
-        G.addContacts(contacts.data(), res.contact_count, margin + std::max(cfg.vertex_distance, params.contact_slop));
-        if (dt > 0 && !start_ran && (res.toi > 0 || travel + kick > margin)) {
+        G.addContacts(contacts.data(), res.contact_count, margin + std::max(kVertexDistance, params.contact_slop));
+        if (dt > 0 && !start_ran && (res.toi > 0 || travel > margin)) {
             start_ran = true;
             start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0, kStageStart);
         }
@@ -769,7 +785,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // the vertex distance count too, as they would have with the CCD's contacts (a face resting
     // flat gives its corners).
     if (dt > 0) {
-        const double accept = starts_touching ? std::max(start_margin, margin + std::max(cfg.vertex_distance, params.contact_slop))
+        const double accept = starts_touching ? std::max(start_margin, margin + std::max(kVertexDistance, params.contact_slop))
                                               : start_margin;
         if (start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, accept);
         sdfccd_QueryResult r1;
@@ -787,7 +803,7 @@ namespace {
 // the first manifold gains its first point and ended when it empties (the first manifold speaks
 // for the pair: the others never fire started or ended).
 void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, const std::vector<Candidate>& cands,
-                    const std::vector<int>& pick, int first, bool own_manifold_only, const btCollisionObjectWrapper* mw,
+                    const std::vector<int>& pick, int first, const btCollisionObjectWrapper* mw,
                     const btCollisionObjectWrapper* sw, Stats& stats)
 {
     const int per = (int)MANIFOLD_CACHE_SIZE;
@@ -798,11 +814,9 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
     // The last step's points of every manifold of the pair.
     std::vector<btManifoldPoint> old;
     std::vector<char> matched;
-    std::vector<int> old_m;
     for (int m = 0; m < manifold_count; ++m)
         for (int i = 0; i < manifolds[m]->getNumContacts(); ++i) {
             old.push_back(manifolds[m]->getContactPoint(i));
-            old_m.push_back(m);
         }
     matched.assign(old.size(), 0);
     const int primary_old = manifolds[0]->getNumContacts();
@@ -834,9 +848,7 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
         // (btPersistentManifold::getCacheEntry / replaceContactPoint).
         int best = -1;
         btScalar best_d2 = match * match;
-        const int target = k < first ? 0 : 1 + (k - first) / per;
         for (size_t j = 0; j < old.size(); ++j) {
-            if (own_manifold_only && old_m[j] != target) continue; // the patch rule: per manifold
             const btScalar d2 = (old[j].m_localPointA - pt.m_localPointA).length2();
             if (!matched[j] && d2 < best_d2) {
                 best_d2 = d2;
@@ -909,8 +921,7 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         start_gaps[std::make_pair(mw->getCollisionObject(), sw->getCollisionObject())] = std::make_pair(guard_step, d0);
     }
     const double tol = std::max(1e-6, 1e-3 * radius);
-    double depth_scale = cfg.spread_depth_scale;
-    if (cfg.spread_depth_fraction > 0) depth_scale = std::min(depth_scale, cfg.spread_depth_fraction * radius);
+    const double depth_scale = std::min(kSpreadDepthMax, kSpreadDepthFraction * radius);
     std::vector<int> pick;
     if (any) pick = reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, -1);
     if (closest) {
@@ -919,32 +930,16 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     }
     const int first = (int)pick.size();
     // More points where the first ones leave the body free to sink: every candidate that could end
-    // deeper than cover_depth while the points held so far stay out, for any rotation of the body
-    // (relative to the SDF) about an axis in the contact plane up to its angular speed plus
-    // kick_angular_speed during the step (a kick from another contact solved in the same step).
+    // deeper than the guarantee's tolerance while the points held so far stay out, for any rotation
+    // of the body (relative to the SDF) about an axis in the contact plane up to its angular speed.
     const int extra_limit = (manifold_count - 1) * (int)MANIFOLD_CACHE_SIZE;
-    if (any && !pick.empty() && extra_limit > 0 && cfg.patch_band >= 0) {
-        // The older rule (Config::patch_band): up to 4 points spread over the candidates within
-        // the band of the deepest gap that are not within tol of a point already picked.
-        const double d0 = scratch[pick[0]].d;
-        std::vector<Candidate> sub;
-        std::vector<int> from;
-        for (int i = 0; i < (int)scratch.size(); ++i) {
-            if (!(scratch[i].d <= d0 + cfg.patch_band)) continue;
-            bool near = false;
-            for (int j : pick) near |= (double)(scratch[i].pB0 - scratch[j].pB0).length() <= tol;
-            if (near) continue;
-            sub.push_back(scratch[i]);
-            from.push_back(i);
-        }
-        for (int i : reduceContacts(sub, (int)MANIFOLD_CACHE_SIZE, tol, depth_scale, -1)) pick.push_back(from[i]);
-    } else if (any && !pick.empty() && extra_limit > 0) {
+    if (any && !pick.empty() && extra_limit > 0) {
         const btVector3& n = scratch[pick[0]].n0;
-        const double w_tilt = (double)(w - n * n.dot(w)).length();
-        const double slope = dt * (w_tilt + cfg.kick_angular_speed);
-        for (int i : coverContacts(scratch, pick, extra_limit, slope, cfg.cover_depth, tol)) pick.push_back(i);
+        const double slope = dt * (double)(w - n * n.dot(w)).length();
+        const double cover = cfg.guard_tolerance > 0 ? cfg.guard_tolerance : Config().guard_tolerance;
+        for (int i : coverContacts(scratch, pick, extra_limit, slope, cover, tol)) pick.push_back(i);
     }
-    writeManifolds(manifolds, manifold_count, scratch, pick, first, cfg.patch_band >= 0, mw, sw, stats);
+    writeManifolds(manifolds, manifold_count, scratch, pick, first, mw, sw, stats);
 }
 
 double BridgeImpl::timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt)

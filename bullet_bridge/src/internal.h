@@ -54,6 +54,7 @@ struct MeshEntry {
     btScalar margin = 0;
     int source_count = 0;
     double radius = 0; // largest vertex distance from the local origin
+    double max_area = 0; // largest triangle area (the face search's trigger)
     std::vector<double> vertices;
     std::vector<uint32_t> indices;
     bool ok = false;
@@ -128,7 +129,7 @@ struct PairPlan {
     sdfccd_RigidMotion mm, sm_value;
     sdfccd_QueryParams params;  // Config::query with the pair's margin
     bool continuous = true;     // not the DCD baseline
-    double margin = 0, start_margin = 0, travel = 0, kick = 0;
+    double margin = 0, start_margin = 0, travel = 0, feature_size = 0;
     const sdfccd_RigidMotion* sm() const { return static_sdf ? nullptr : &sm_value; }
 };
 
@@ -218,6 +219,7 @@ public:
     bool plan(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin, detail::PairPlan& P);
     // The discrete queries' parameters (start and end pose) with margin `dcd_margin`.
     sdfccd_QueryParams discreteParams(const detail::PairPlan& P, double dcd_margin) const;
+    bool faceSearch(const detail::PairPlan& P) const; // the face search runs for this pair
     // Config::batch_threads: runs the queries of every pair of `world`'s pair cache the bridge
     // handles and that the batch covers, stage by stage, into batch_cache (replacing it).
     void prefetch(double dt, double margin);

@@ -94,6 +94,12 @@ void SdfShape::getLocalBounds(btVector3& lo, btVector3& hi) const
     hi = m_hi;
 }
 
+double SdfShape::getFeatureSize() const
+{
+    const btVector3 s = m_scaling.absolute();
+    return m_featureSize * (double)btMin(s.x(), btMin(s.y(), s.z()));
+}
+
 bool SdfShape::hasFiniteBounds() const
 {
     for (int i = 0; i < 3; ++i)

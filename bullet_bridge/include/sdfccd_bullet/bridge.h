@@ -135,67 +135,10 @@ struct Config {
     /** Features within this distance (m) of the SDF count as in contact (the query's margin).
      * Default 0.01 m. Resting bodies hover at distance 0; the margin keeps their contacts alive. */
     double contact_margin = 0.01;
-    /** Contacts written per pair and step, 1..4 (the manifold holds 4). Default 4. */
+    /** Contacts written per pair and step into the pair's first manifold, 1..4 (a Bullet manifold
+     * holds 4). Up to 12 more go into three further manifolds, where the first 4 leave the body free
+     * to sink deeper than guard_tolerance by turning about them. Default 4. */
     int max_contacts = 4;
-    /** The vertices of a triangle in contact that are within this distance (m) of the surface at
-     * the triangle's time of impact are contact candidates too (a face landing flat gives its
-     * corners). Default 0.02 m. */
-    double vertex_distance = 0.02;
-    /** The reduction to 4 points weighs a candidate's spread (distance, area) by
-     * exp(-(its gap - the deepest gap) / scale): points about to touch are preferred to features
-     * that might only reach the surface late in the step. The scale is the smaller of this
-     * (default 0.3 m) and spread_depth_fraction times the mesh's radius. */
-    double spread_depth_scale = 0.3;
-    /** The reduction's depth scale relative to the mesh's radius (the largest distance of a vertex
-     * from the mesh's origin); <= 0: spread_depth_scale alone. Default 0.1: for a body a few
-     * centimetres across, a fixed 0.3 m scale lets features millimetres above the surface win the
-     * manifold by their larger spread (a 9 cm torus lying flat held its outer rim 4-6 mm up
-     * instead of its bottom ring in contact, stood on one point and wobbled like Euler's disk). */
-    double spread_depth_fraction = 0.1;
-    /** Extra manifolds per pair (0..3), for up to 4 more points each. The first 4 points (the
-     * deepest and the points spreading the contact polygon) span the whole candidate set, far
-     * speculative points included, so a body tipping flat can have ONE point in its contact patch,
-     * pivot about it and sink the rest of the patch. The extra points go where the held points
-     * still leave the body free to sink: the candidate that could end deepest, for any rotation
-     * about an axis in the contact plane up to the body's angular speed (relative to the SDF) plus
-     * kick_angular_speed, while every held point ends out of the surface, is held next, until no
-     * candidate could end deeper than cover_depth (see contact_policy.cpp). Default 3. */
-    int extra_manifolds = 3;
-    /** Angular speed (rad/s) a body may gain within a step from contacts solved with it (another
-     * body landing on it, a mesh-mesh pair) on top of its own. It widens the extra points' bound
-     * and the start-pose query's reach (kick_angular_speed x the mesh's radius x dt), and that
-     * query then also runs in steps whose predicted motion has no contact. Default 0: with the
-     * end-of-step projection it changes no penetration figure of the Bullet re-creations, and
-     * 1 rad/s costs the landscape scene about 30% more per step (more queries and candidates);
-     * it lets piles settle sooner (gimpact-demo: rest speed over the last second 0.06 -> 0 m/s). */
-    double kick_angular_speed = 0.0;
-    /** Depth (m) a candidate may reach, under that bound, without being held. Default 0.002. */
-    double cover_depth = 0.002;
-    /** Opt-in (negative: off, the default): the older rule for the extra points, used instead of
-     * the one above: ONE extra manifold with up to 4 points spread over the candidates within
-     * this distance (m) of the deepest gap that the first 4 points leave out (the contact patch
-     * around the deepest point). The paper's rigid scenes (samples/scenes) use 0.02. */
-    double patch_band = -1;
-    /** Opt-in (<= 0: off, the default): the face search. With subdivision on, the mesh's triangles
-     * with an edge longer than this (m) are also searched region by region (split at the edge
-     * midpoints down to regions with no edge longer than it; regions the SDF's Lipschitz bound
-     * shows out of reach are dropped; each leaf's deepest point from the library's DCD), at the
-     * start pose over the step's reach (the DCD baseline: at the end pose within the margin).
-     * The library's queries give one point per triangle and subdivide only around a point in
-     * contact, so a face over SDF features smaller than itself (a coarse box on a spike grid)
-     * can have its vertices and those points clear while features between them pierce it.
-     * Cost: about (edge / size)^2 regions per triangle lying within the reach of a surface (a
-     * face flat on the ground is never dropped), so only for scenes that need it: the paper's
-     * spikes scene uses 0.02. Stats::face_regions counts the regions visited. */
-    double face_search_size = 0;
-    /** In the discrete queries (start and end pose), adaptive subdivision does not split regions
-     * smaller than (discrete_subdivision_scale x the mesh's radius)^2: such regions' points lie
-     * within about that distance of the triangle's vertices, which are contact candidates
-     * already. Large triangles (a bar's face across a torus's two tube tops) still give their
-     * interior contacts. Cuts the landscape's SDF evaluations per step by 2.5x (its 1,002-triangle
-     * tori are no longer subdivided) with the same penetration; the CCD query keeps the library's
-     * subdivision. 0: the library's subdivision_min_area everywhere. Default 0.1. */
-    double discrete_subdivision_scale = 0.1;
     /** The guarantee (m; <= 0: off). When the bridge is registered with a dynamics world
      * (registerWith(btCollisionWorld*)), an action it adds (run after Bullet integrates each step)
      * checks the executed motion of every dynamic body whose swept box meets an SDF's: from its

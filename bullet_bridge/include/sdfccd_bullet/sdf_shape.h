@@ -79,6 +79,14 @@ public:
     /** False when the local box is unbounded (+-BT_LARGE_FLOAT), e.g. a half-space without setLocalBounds(). */
     bool hasFiniteBounds() const;
 
+    /** The size (m, unscaled) of the field's smallest features, e.g. the base radius of a grid of
+     * spikes; 0 (the default) when every feature is larger than the faces of the meshes meeting it.
+     * When positive, the bridge also searches each mesh face region by region down to a part of this
+     * size, so a feature between a face's vertices is found (Stats::face_regions). */
+    void setFeatureSize(double size) { m_featureSize = size > 0 ? size : 0; }
+    /** The feature size times the smallest local scaling factor. */
+    double getFeatureSize() const;
+
     /** Cells along the longest axis of the triangulation grid (default 48). Changing it drops
      * the cached triangulation. */
     void setTriangulationResolution(int cells);
@@ -132,6 +140,7 @@ private:
     btVector3 m_scaling;
     btScalar m_margin;
     int m_resolution;
+    double m_featureSize = 0;
     mutable sdfccd_SdfId m_scaled; // owned, created on demand
     mutable detail::StretchData m_stretch; // user data of the non-uniform scaling callback
     mutable bool m_scaledValid;
