@@ -54,7 +54,7 @@ static const double kFaceNormalAgreement = 0.9;
 
 // Adds points to `out` (up to k) maximising the spread of the projected points P.
 static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>& P, const btVector3& nref, int k, double tol,
-                   double depth_scale, double d_max, std::vector<int>& out)
+                   double depth_scale, std::vector<int>& out)
 {
     const int n = (int)c.size();
     std::vector<double> score(n, 0.0);
@@ -66,7 +66,6 @@ static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>
         double best = 0;
         for (int i = 0; i < n; ++i) {
             score[i] = -1;
-            if (!(c[i].d <= d_max)) continue;
             const btVector3& q = P[i];
             bool dup = false;
             for (int j : out) dup |= (double)(q - P[j]).length() <= tol;
@@ -105,10 +104,10 @@ static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>
     }
 }
 
-std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, double band)
+void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, std::vector<int>& out)
 {
-    std::vector<int> out;
-    if (c.empty() || k <= 0) return out;
+    out.clear();
+    if (c.empty() || k <= 0) return;
     int first = 0;
     for (int i = 1; i < (int)c.size(); ++i)
         if (c[i].d < c[first].d) first = i;
@@ -140,55 +139,7 @@ std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double t
         }
     }
     out.push_back(first);
-    // Optionally first among the points within `band` of the deepest (those in contact with it),
-    // then among all. (Off in the bridge: it helps piles of resting bodies but lets a body that
-    // lands on slanted points first slide between them.)
-    if (band >= 0) spread(c, P, nref, k, tol, depth_scale, d0 + band, out);
-    spread(c, P, nref, k, tol, depth_scale, INFINITY, out);
-    return out;
-}
-
-std::vector<int> coverContacts(const std::vector<Candidate>& c, const std::vector<int>& chosen, int limit, double slope,
-                               double depth, double tol)
-{
-    std::vector<int> out;
-    const int n = (int)c.size();
-    if (chosen.empty() || n == 0) return out;
-    // bound[i]: the smallest end gap candidate i is guaranteed by the points held so far (their
-    // gap plus the slope times the distance, among points of similar normal); +inf if none.
-    std::vector<double> bound(n, INFINITY);
-    std::vector<char> taken(n, 0);
-    const btScalar similar = btScalar(0.9);
-    auto hold = [&](int j) {
-        taken[j] = 1;
-        for (int i = 0; i < n; ++i) {
-            if (taken[i]) continue;
-            const double dist = (double)(c[i].pB0 - c[j].pB0).length();
-            if (dist <= tol) {
-                taken[i] = 1; // never two points at one place
-                continue;
-            }
-            if (c[i].n0.dot(c[j].n0) < similar) continue;
-            bound[i] = std::min(bound[i], c[j].d + slope * dist);
-        }
-    };
-    for (int j : chosen) hold(j);
-    while ((int)out.size() < limit) {
-        int pick = -1;
-        double worst = depth;
-        for (int i = 0; i < n; ++i) {
-            if (taken[i]) continue;
-            const double deficit = bound[i] - c[i].d; // how deep i may end while the held points stay out
-            if (deficit > worst || (pick >= 0 && deficit == worst && c[i].d < c[pick].d)) {
-                worst = deficit;
-                pick = i;
-            }
-        }
-        if (pick < 0) break;
-        out.push_back(pick);
-        hold(pick);
-    }
-    return out;
+    spread(c, P, nref, k, tol, depth_scale, out);
 }
 
 namespace {
@@ -922,8 +873,8 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     }
     const double tol = std::max(1e-6, 1e-3 * radius);
     const double depth_scale = std::min(kSpreadDepthMax, kSpreadDepthFraction * radius);
-    std::vector<int> pick;
-    if (any) pick = reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, -1);
+    pick.clear();
+    if (any) reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, pick);
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;
@@ -937,7 +888,20 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         const btVector3& n = scratch[pick[0]].n0;
         const double slope = dt * (double)(w - n * n.dot(w)).length();
         const double cover = cfg.guard_tolerance > 0 ? cfg.guard_tolerance : Config().guard_tolerance;
-        for (int i : coverContacts(scratch, pick, extra_limit, slope, cover, tol)) pick.push_back(i);
+        cover_set.resize(scratch.size());
+        for (size_t i = 0; i < scratch.size(); ++i) {
+            sdfccd_ContactPoint& p = cover_set[i];
+            std::memset(&p, 0, sizeof p);
+            p.surface_point = v3(scratch[i].pB0);
+            p.normal = v3(scratch[i].n0);
+            p.gap = scratch[i].d;
+        }
+        pick.resize((size_t)(first + extra_limit));
+        int32_t added = 0;
+        if (sdfccd_cover_contacts(cover_set.data(), (int32_t)scratch.size(), pick.data(), first, slope, cover, tol, pick.data() + first,
+                                  extra_limit, &added) != SDFCCD_OK)
+            added = 0;
+        pick.resize((size_t)(first + added));
     }
     writeManifolds(manifolds, manifold_count, scratch, pick, first, mw, sw, stats);
 }

@@ -105,19 +105,9 @@ struct Candidate {
  * maximising the triangle's area, then the one adding most area to the polygon; distances and
  * areas between the SDF surface points, projected on the plane of the deepest point's normal,
  * each weighted by exp(-(gap - deepest gap) / depth_scale). Points closer than `tol` to a chosen
- * one are never chosen (no duplicates). With band >= 0, points within `band` of the deepest gap
- * are spread first and the others only fill what is left.
- * Ties go to the smaller gap, then to the lower index: deterministic for a given input. */
-std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, double band);
-
-/** More points after `chosen` (at most `limit`), where the points held so far leave the body
- * free to sink: a candidate's end gap is bounded below by d_i - min_j (d_j + slope * |pB_i - pB_j|)
- * over held points j of similar normal (the gap change of a rigid body turning by at most `slope`
- * radians in the step about an axis in the contact plane, with each held point ending out of
- * the surface). The candidate with the largest possible depth beyond `depth` is held next (ties:
- * the smaller gap, then the lower index), until none is left. Never two points within `tol`. */
-std::vector<int> coverContacts(const std::vector<Candidate>& c, const std::vector<int>& chosen, int limit, double slope,
-                               double depth, double tol);
+ * one are never chosen (no duplicates). Ties go to the smaller gap, then to the lower index:
+ * deterministic for a given input. Writes into `out` (cleared; no allocation once it has grown). */
+void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, std::vector<int>& out);
 
 // The inputs of one pair's queries in a step: gather() and the batch prefetch build them alike.
 struct PairPlan {
@@ -268,6 +258,8 @@ public:
     double last_start_margin = 0; // the start-pose query's margin of the last gather()
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
+    std::vector<int> pick;                      // the chosen candidates
+    std::vector<sdfccd_ContactPoint> cover_set; // the candidates for sdfccd_cover_contacts
     std::vector<sdfccd_Contact> contacts, start_contacts;
     sdfccd_Workspace* workspace = nullptr; // the queries' scratch storage (no allocation per query)
     // Config::batch_threads: the world whose pair cache the batch reads (registerWith(world)) and
