@@ -25,6 +25,7 @@
 #include <LinearMath/btPoolAllocator.h>
 
 #include "sdfccd_bullet/sdfccd_bullet.h"
+#include "bullet_check.h"
 
 #ifndef SDFCCD_DATA_DIR
 #error "SDFCCD_DATA_DIR must be defined"
@@ -37,21 +38,8 @@ using sdfccd_bullet::MisuseHandler;
 using sdfccd_bullet::setMisuseHandler;
 using sdfccd_bullet::statusString;
 
-static int g_pass = 0, g_fail = 0;
-#define CHECK(cond, ...)                                                         \
-    do {                                                                         \
-        if (cond) {                                                              \
-            ++g_pass;                                                            \
-        } else {                                                                 \
-            ++g_fail;                                                            \
-            std::fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            std::fprintf(stderr, __VA_ARGS__);                                   \
-            std::fputc('\n', stderr);                                            \
-        }                                                                        \
-    } while (0)
 
 static const double kDt = 1.0 / 60.0;
-static const bool kVerbose = std::getenv("SDFCCD_TEST_VERBOSE") != nullptr;
 
 // ---- scene helpers ----
 
@@ -1615,6 +1603,5 @@ int main(int argc, char** argv)
     } else {
         ++g_pass;
     }
-    std::printf("%d passed, %d failed\n", g_pass, g_fail);
-    return g_fail == 0 ? 0 : 1;
+    return checkSummary();
 }
