@@ -272,6 +272,11 @@ public:
     btGImpactCollisionAlgorithm::CreateFunc gimpact_fn;
 };
 
+// The implementation of a Bridge, for the bridge's own sources (Bridge befriends it).
+struct BridgeAccess {
+    static BridgeImpl* of(Bridge& b) { return b.m_impl; }
+};
+
 SDFCCD_BULLET_NAMESPACE_END
 
 #endif

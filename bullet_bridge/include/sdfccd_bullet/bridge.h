@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 /** @file bridge.h  Registers sdfccd's triangle-SDF continuous collision detection in Bullet.
  *
- * What it does (Bullet 3.24; see notes/bullet-integration.md for the reasons):
+ * What it does (Bullet 3.24):
  *  - registers ONE collision algorithm, AFTER btGImpactCollisionAlgorithm::registerAlgorithm
  *    (which it calls itself), for these pairs in both body orders, in the contact-point and the
  *    closest-point tables (so contactTest/contactPairTest work):
@@ -215,6 +215,7 @@ struct Stats {
 };
 
 class BridgeImpl;
+struct BridgeAccess;
 
 /** The bridge: owns the create functions Bullet's dispatcher points to, the packed copies of
  * GImpact meshes, and the SDF wrappers of btSdfCollisionShape objects.
@@ -284,11 +285,8 @@ public:
     /** Sets every counter of stats() back to its initial value. */
     void resetStats();
 
-    /** The implementation object (internal: for the bridge's own algorithm and tests; its type
-     * is not part of the installed headers). */
-    BridgeImpl* impl() { return m_impl; }
-
 private:
+    friend struct BridgeAccess; // the bridge's own sources reach the implementation through it
     BridgeImpl* m_impl;
 };
 

@@ -28,15 +28,6 @@ SDFCCD_BULLET_NAMESPACE_BEGIN
  * to btSdfCollisionShape (a convex body touching any other type-29 shape crashes). */
 const int kDefaultSdfShapeType = FAST_CONCAVE_MESH_PROXYTYPE;
 
-namespace detail {
-/** User data of the non-uniform scaling callback SDF (internal). */
-struct StretchData {
-    sdfccd_SdfId child; /**< The wrapped (unscaled) SDF. */
-    double s[3];        /**< Local scaling along x, y, z. */
-    double smin;        /**< min(s): the factor that keeps the stretched distance a lower bound. */
-};
-}
-
 /** A static or moving Bullet shape whose surface is the zero level set of an sdfccd SDF (any
  * analytic, CSG, grid or callback SDF). Collides with GImpact meshes, convex shapes and other
  * SdfShapes through the bridge's CCD once Bridge::registerWith() was called; with everything else
@@ -142,7 +133,6 @@ private:
     int m_resolution;
     double m_featureSize = 0;
     mutable sdfccd_SdfId m_scaled; // owned, created on demand
-    mutable detail::StretchData m_stretch; // user data of the non-uniform scaling callback
     mutable bool m_scaledValid;
     // Triangulation (built lazily; Bullet's narrow phase is single-threaded in the Debian build).
     mutable bool m_triangulated;
