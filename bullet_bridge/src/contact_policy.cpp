@@ -8,21 +8,23 @@
 //     the CCD would then only report "penetrating at t0"), one CCD query (sdfccd_query_mesh on
 //     [0, dt]) with the contact margin. Its WHOLE contact set at the earliest time of impact is
 //     kept (the buffer grows to contacts_found; every triangle within the library's TOI window,
-//     with subdivision contacts), plus the vertices of those triangles within
-//     Config::vertex_distance of the surface then. No hit: no contact this step.
+//     with subdivision contacts), plus the vertices of those triangles within kVertexDistance of
+//     the surface then. No hit: no contact this step.
 //  3. Whenever the step has any contact, also when it starts in contact: the features of the
 //     start-pose query and those of a discrete query at the predicted end pose; each is
 //     constrained by its own closest surface point at the START of the step (the classic
 //     speculative-contact rule), so the rest of the motion (a rotation about a touching corner,
 //     a slide, a face landing after its first point) cannot push it in.
-//  4. Every candidate is expressed at the start of the step: point on the mesh, point on the SDF
-//     surface, normal, and gap d along the normal (negative: penetrating). The set is reduced to
-//     the manifold's 4 points: deepest, then the points maximising the contact polygon's area.
-//  5. The points are written into the pair's manifold the way btManifoldResult and
+//  4. Every candidate is expressed at the start of the step (point on the mesh, point on the SDF
+//     surface, normal, gap d along the normal; negative: penetrating) and the set is reduced to
+//     the manifold's 4 points: deepest, then the points maximising the contact polygon's area;
+//     cover points (sdfccd_cover_contacts) fill up to 3 more manifolds where the 4 leave the body
+//     free to turn and sink deeper than the guarantee's tolerance.
+//  5. The points are written into the pair's manifolds the way btManifoldResult and
 //     btPersistentManifold::refreshContactPoints do it: persistent points keep their warm-start
 //     impulses and lifetime, and the contact added / processed / started / ended callbacks fire.
-// The speculative constraint (notes/bullet-integration.md section 3.4 A): a point with gap d > 0
-// lets the solver close at most d in the step, so the mesh stops on the surface.
+// The speculative rule (the paper's Section 4: no advance past a time of impact): a point with gap
+// d > 0 lets the solver close at most d in the step, so the mesh stops on the surface.
 // All queries go through one reusable sdfccd_Workspace per bridge (no allocation per query).
 #include "internal.h"
 

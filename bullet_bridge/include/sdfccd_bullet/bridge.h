@@ -11,30 +11,16 @@
  *      as triangles: a box's 12, other shapes' btShapeHull hull;
  *      SdfShape vs SdfShape (Config::sdf_pairs): the moving one's isosurface triangulation
  *      against the other's field.
- *  - the contact model, per pair and step (contact_policy.cpp):
- *      1. a discrete query at the start pose (world transform) with the margin widened by the
- *         step's travel finds every feature that can reach the surface in the step; when its
- *         broad phase culls every triangle the step has no contact and nothing else runs;
- *      2. unless a feature is already within the margin (the step STARTS in contact), one CCD
- *         query (sdfccd_query_mesh) over the step from the start pose to the predicted end pose
- *         (interpolation transform); its whole contact set at the earliest time of impact is
- *         kept (every triangle in the library's TOI window, with subdivision contacts), plus
- *         those triangles' vertices within Config::vertex_distance; no hit, no contact;
- *      2b. whenever the step has any contact, also when it starts in contact, the start-pose
- *         features and those of a discrete query at the predicted end pose; each feature found
- *         is constrained by its own closest surface point at the start of the step
- *         (speculative contacts for the rest of the motion: resting, sliding and tipping over an
- *         edge cannot sink, and a fast body is held by its whole front, not one point);
- *         with Config::query.method DCD (the discrete baseline) step 2 always runs, first;
- *      3. every candidate is expressed at the start of the step (distance = gap along the normal,
- *         negative when penetrating) and the set is reduced to the manifold's 4 points: the
- *         deepest, then the points that maximise the contact polygon's area (as Bullet's
- *         sortCachedPoints and Box2D do), deterministically and never two at one place;
- *      4. points carry over the last step's warm-start impulses when they are the same material
- *         point, and the contact added (CF_CUSTOM_MATERIAL_CALLBACK), processed, started and
- *         ended callbacks fire as for Bullet's own manifolds.
- *    A point with gap d > 0 lets the solver close at most d in the step, so the mesh stops on
- *    the surface in its impact step; such speculative points have restitution 0.
+ *  - the contact model, per pair and step: the features within the step's reach at the start
+ *    pose, the CCD's contact set at the first time of impact of the predicted motion (start pose
+ *    = world transform, end pose = interpolation transform) and the features touching at the end
+ *    pose, each written as a point held by its surface point and normal at the start of the step
+ *    (a speculative contact with gap d > 0 lets the solver close at most d; restitution 0). The
+ *    set is reduced to the manifold's 4 points (deepest, then the largest contact area), and cover
+ *    points (sdfccd_cover_contacts) go into up to three more manifolds where the 4 leave the body
+ *    free to turn into the surface. Points of the same material point as the last step's keep
+ *    their warm-start impulses; Bullet's contact added, processed, started and ended callbacks
+ *    fire as for its own manifolds.
  *  - Bridge::check(world) reports misuse (not registered, registered too late, overwritten,
  *    an SdfShape with a dead handle); while a world steps, Bullet's
  *    GImpact algorithm colliding with an SdfShape (the bridge not in charge) goes to the misuse
@@ -176,8 +162,7 @@ struct Config {
     int batch_threads = 1;
     /** Query parameters passed to sdfccd_query_mesh (margin is replaced by contact_margin): the
      * library's defaults except fwgss_restarts (0): the bridge's discrete query over every
-     * feature within the step's travel catches what a restart would correct, for about 20% fewer
-     * SDF evaluations per query (landscape scene). */
+     * feature within the step's travel catches what a restart would correct. */
     sdfccd_QueryParams query;
     /** The defaults stated above. */
     Config() : query(sdfccd_default_query_params()) { query.fwgss_restarts = 0; }
