@@ -56,10 +56,10 @@ static const double kFaceNormalAgreement = 0.9;
 
 // Adds points to `out` (up to k) maximising the spread of the projected points P.
 static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>& P, const btVector3& nref, int k, double tol,
-                   double depth_scale, std::vector<int>& out)
+                   double depth_scale, std::vector<double>& score, std::vector<int>& out)
 {
     const int n = (int)c.size();
-    std::vector<double> score(n, 0.0);
+    score.assign((size_t)n, 0.0);
     while ((int)out.size() < k) {
         const size_t m = out.size();
         const btVector3& a0 = P[out[0]];
@@ -106,7 +106,7 @@ static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>
     }
 }
 
-void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, std::vector<int>& out)
+void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, PairScratch& w, std::vector<int>& out)
 {
     out.clear();
     if (c.empty() || k <= 0) return;
@@ -118,7 +118,8 @@ void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double d
     // mesh above one another (a bottom and a top corner) constrain the same place, and only the
     // one with the smaller gap matters.
     const btVector3 nref = c[first].n0;
-    std::vector<btVector3> P(c.size());
+    std::vector<btVector3>& P = w.flat;
+    P.resize(c.size());
     for (size_t i = 0; i < c.size(); ++i) P[i] = c[i].pB0 - nref * nref.dot(c[i].pB0);
     // Several points equally deep (a face landing flat): start from the one farthest from their
     // centre, a corner of the region, so the polygon grows to the region's corners.
@@ -141,7 +142,7 @@ void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double d
         }
     }
     out.push_back(first);
-    spread(c, P, nref, k, tol, depth_scale, out);
+    spread(c, P, nref, k, tol, depth_scale, w.score, out);
 }
 
 namespace {
@@ -158,7 +159,7 @@ struct Gatherer {
     BodyMotion M, S;
     double margin;
     std::vector<Candidate>* out;
-    std::vector<std::pair<uint32_t, double>> tris;
+    PairScratch* w;
     int64_t evals = 0; // our own sdfccd_sdf_eval calls
 
     // A material point (mesh frame) constrained by a surface point qB and normal nL (SDF frame)
@@ -193,12 +194,14 @@ struct Gatherer {
     // within `accept` there, each constrained from the start of the step.
     void addPose(const sdfccd_Contact* cs, int count, const btTransform& Mx, const btTransform& Sx, double accept)
     {
-        std::vector<uint32_t> ts;
+        std::vector<uint32_t>& ts = w->pose_tris;
+        ts.clear();
         for (int i = 0; i < count; ++i) {
             addFromStart(Mx.invXform(bt(cs[i].point)), (int)cs[i].triangle);
             if (cs[i].triangle < me->indices.size() / 3) ts.push_back(cs[i].triangle);
         }
-        std::vector<std::pair<uint32_t, uint32_t>> vt;
+        std::vector<std::pair<uint32_t, uint32_t>>& vt = w->pose_vertices;
+        vt.clear();
         for (uint32_t t : ts)
             for (int j = 0; j < 3; ++j) vt.push_back(std::make_pair(me->indices[3 * (size_t)t + j], t));
         std::sort(vt.begin(), vt.end());
@@ -234,10 +237,8 @@ struct Gatherer {
         const btTransform rel = Sx.inverseTimes(Mx); // mesh frame -> SDF frame
         const btMatrix3x3 sdf_basis_t = Sx.getBasis().transpose();
         const double size2 = size * size;
-        struct Region {
-            btVector3 c[3];
-        };
-        std::vector<Region> stack;
+        typedef FaceRegion Region;
+        std::vector<Region>& stack = w->regions;
         int64_t visited = 0;
         const size_t nt = me->indices.size() / 3;
         for (size_t t = 0; t < nt; ++t) {
@@ -311,6 +312,7 @@ struct Gatherer {
         // Contacts come sorted by time; one pose pair per distinct time.
         double t_pose = -1;
         btTransform Mx = M.t0, Sx = S.t0;
+        std::vector<std::pair<uint32_t, double>>& tris = w->tris;
         tris.clear();
         for (int i = 0; i < count; ++i) {
             const sdfccd_Contact& k = cs[i];
@@ -327,7 +329,8 @@ struct Gatherer {
             tris.push_back(std::make_pair(k.triangle, k.toi));
         }
         // Each (vertex, triangle's TOI) once, in a fixed order.
-        std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>> vt;
+        std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>>& vt = w->toi_vertices;
+        vt.clear();
         for (const auto& t : tris)
             for (int j = 0; j < 3; ++j) vt.push_back(std::make_pair(me->indices[3 * (size_t)t.first + j], std::make_pair(t.second, t.first)));
         std::sort(vt.begin(), vt.end());
@@ -589,6 +592,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     const btTransform sdf_world = P.sdf_world;
     G.margin = margin;
     G.out = &cands;
+    G.w = &work;
     G.evals = 0;
     const sdfccd_RigidMotion mm = P.mm;
     const sdfccd_RigidMotion* sm = P.sm();
@@ -757,7 +761,7 @@ namespace {
 // for the pair: the others never fire started or ended).
 void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, const std::vector<Candidate>& cands,
                     const std::vector<int>& pick, int first, const btCollisionObjectWrapper* mw,
-                    const btCollisionObjectWrapper* sw, Stats& stats)
+                    const btCollisionObjectWrapper* sw, PairScratch& w, Stats& stats)
 {
     const int per = (int)MANIFOLD_CACHE_SIZE;
     first = std::max(0, std::min(first, per));
@@ -765,8 +769,9 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
     const btCollisionObject* so = sw->getCollisionObject();
     const int n = std::min((int)pick.size(), first + per * (manifold_count - 1));
     // The last step's points of every manifold of the pair.
-    std::vector<btManifoldPoint> old;
-    std::vector<char> matched;
+    std::vector<btManifoldPoint>& old = w.old_points;
+    std::vector<char>& matched = w.matched;
+    old.clear();
     for (int m = 0; m < manifold_count; ++m)
         for (int i = 0; i < manifolds[m]->getNumContacts(); ++i) {
             old.push_back(manifolds[m]->getContactPoint(i));
@@ -777,7 +782,8 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
     const btTransform& worldA = mo->getWorldTransform();
     const btTransform& worldB = so->getWorldTransform();
     const int flags = mo->getCollisionFlags() | so->getCollisionFlags();
-    std::vector<btManifoldPoint> pts((size_t)n);
+    std::vector<btManifoldPoint>& pts = w.new_points;
+    pts.resize((size_t)n);
     for (int k = 0; k < n; ++k) {
         const Candidate& c = cands[pick[k]];
         btManifoldPoint pt(worldA.invXform(c.pA0), worldB.invXform(c.pB0), c.n0, (btScalar)c.d);
@@ -876,7 +882,7 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     const double tol = std::max(1e-6, 1e-3 * radius);
     const double depth_scale = std::min(kSpreadDepthMax, kSpreadDepthFraction * radius);
     pick.clear();
-    if (any) reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, pick);
+    if (any) reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, work, pick);
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;
@@ -905,7 +911,7 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
             added = 0;
         pick.resize((size_t)(first + added));
     }
-    writeManifolds(manifolds, manifold_count, scratch, pick, first, mw, sw, stats);
+    writeManifolds(manifolds, manifold_count, scratch, pick, first, mw, sw, work, stats);
 }
 
 double BridgeImpl::timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt)

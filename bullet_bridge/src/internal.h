@@ -107,7 +107,24 @@ struct Candidate {
  * each weighted by exp(-(gap - deepest gap) / depth_scale). Points closer than `tol` to a chosen
  * one are never chosen (no duplicates). Ties go to the smaller gap, then to the lower index:
  * deterministic for a given input. Writes into `out` (cleared; no allocation once it has grown). */
-void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, std::vector<int>& out);
+struct PairScratch;
+void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, PairScratch& w, std::vector<int>& out);
+
+// Storage the contact policy reuses from pair to pair and step to step (no allocation once grown).
+struct FaceRegion {
+    btVector3 c[3];
+};
+struct PairScratch {
+    std::vector<btVector3> flat;                  // reduction: surface points on the contact plane
+    std::vector<double> score;                    // reduction: each candidate's spread
+    std::vector<std::pair<uint32_t, double>> tris; // triangles of the CCD's contacts and their TOI
+    std::vector<uint32_t> pose_tris;              // triangles of a discrete query's contacts
+    std::vector<std::pair<uint32_t, uint32_t>> pose_vertices;                 // (vertex, triangle)
+    std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>> toi_vertices; // (vertex, (TOI, triangle))
+    std::vector<FaceRegion> regions;              // the face search's stack
+    std::vector<btManifoldPoint> old_points, new_points; // a pair's manifold points, last step and this one
+    std::vector<char> matched;                    // old points that persist
+};
 
 // The inputs of one pair's queries in a step: gather() and the batch prefetch build them alike.
 struct PairPlan {
@@ -259,6 +276,7 @@ public:
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
     std::vector<int> pick;                      // the chosen candidates
+    detail::PairScratch work;
     std::vector<sdfccd_ContactPoint> cover_set; // the candidates for sdfccd_cover_contacts
     std::vector<sdfccd_Contact> contacts, start_contacts;
     sdfccd_Workspace* workspace = nullptr; // the queries' scratch storage (no allocation per query)
