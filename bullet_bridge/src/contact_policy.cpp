@@ -450,6 +450,17 @@ void posePair(const btTransform& Mx, const btTransform& Sx, sdfccd_RigidMotion& 
     s1.pose = toPose(Sx);
 }
 
+// The start-pose query's verdicts, one rule for gather() and the batch: its broad phase culled
+// every triangle (the step provably has no contact), or a feature is already within the margin
+// (the step starts in contact: the CCD query is skipped).
+bool culled(const sdfccd_QueryResult& r) { return r.triangles_tested == 0 && r.state == SDFCCD_STATE_NO_HIT; }
+bool touching(const sdfccd_QueryResult& r, const sdfccd_Contact* c, int n, double margin)
+{
+    for (int i = 0; r.hit && i < n; ++i)
+        if (c[i].distance <= margin) return true;
+    return false;
+}
+
 // Room given to a batched query's contacts (a query that finds more is run again in the narrow
 // phase with room for all, as an unbatched one is).
 const int32_t kBatchCapacity = 256;
@@ -552,13 +563,9 @@ void BridgeImpl::prefetch(double dt, double margin)
     for (size_t k = 0; k < items.size(); ++k) {
         const CachedQuery& c = batch_cache[PairStageKey{ items[k].mo, items[k].so, kStageStart }];
         if (c.status != SDFCCD_OK) continue;
-        if (c.result.triangles_tested == 0 && c.result.state == SDFCCD_STATE_NO_HIT) continue;
-        if (faceSearch(items[k].P)) continue;
-        bool touching = false;
-        if (c.result.hit)
-            for (int i = 0; i < std::min(c.result.contact_count, kBatchCapacity) && !touching; ++i)
-                touching = c.contacts[(size_t)i].distance <= items[k].P.margin;
-        (touching ? end : ccd).push_back(k);
+        if (culled(c.result) || faceSearch(items[k].P)) continue;
+        const int n = std::min(c.result.contact_count, kBatchCapacity);
+        (touching(c.result, c.contacts.data(), n, items[k].P.margin) ? end : ccd).push_back(k);
     }
     runStage(ccd, kStageCcd);
     for (size_t k : ccd) {
@@ -680,14 +687,13 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     if (dt > 0 && continuous) {
         start_ran = true;
         start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0, kStageStart);
-        if (start_ok && r0.triangles_tested == 0 && r0.state == SDFCCD_STATE_NO_HIT) {
+        if (start_ok && culled(r0)) {
             stats.queries_skipped++;
             stats.last_state = (int)SDFCCD_STATE_NO_HIT;
             stats.last_toi_fraction = 1;
             return false;
         }
-        if (start_ok && r0.hit)
-            for (int i = 0; i < r0.contact_count && !starts_touching; ++i) starts_touching = start_contacts[(size_t)i].distance <= margin;
+        starts_touching = start_ok && touching(r0, start_contacts.data(), r0.contact_count, margin);
     }
     // The face search (SdfShape::setFeatureSize; part of the subdivision, so off without it): at
     // the start pose over the step's reach (DCD, the discrete baseline: at the end pose within
