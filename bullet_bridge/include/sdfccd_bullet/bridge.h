@@ -191,7 +191,7 @@ struct Stats {
                                             start clear by more than its executed motion could close. */
     int64_t guard_bisections = 0;      /**< Poses the CCD let through that the guarantee's discrete check found
                                             deeper than its tolerance (put back by bisection). */
-    int64_t face_regions = 0;          /**< Regions visited by the face search (Config::face_search_size). */
+    int64_t face_regions = 0;          /**< Regions visited by the face search (SdfShape::setFeatureSize). */
     int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
                                             they are counted in queries, end_pose_queries and sdf_evaluations too. */
     int64_t batches = 0;               /**< sdfccd_query_batch calls (Config::batch_threads; up to 3 per step). */
