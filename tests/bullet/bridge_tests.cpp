@@ -1215,7 +1215,7 @@ static void test_compound_fast()
     CHECK(rb_on > 0, "the guarantee never acted");
     CHECK(low_off < -0.05, "without the guarantee the child ends at z %.4f: the case does not need it", low_off);
     std::printf("compound at 200 m/s (%s): deepest %.5f m, lowest vertex ends at %.5f (%lld rollbacks); without the guarantee "
-                "it ends at %.3f\n", SDFCCD_BULLET_PRECISION_NAME, on, low_on, (long long)rb_on, low_off);
+                "it ends at %.3f (deepest %.3f m)\n", SDFCCD_BULLET_PRECISION_NAME, on, low_on, (long long)rb_on, low_off, off);
 }
 
 // Contact callbacks, counted per manifold.
