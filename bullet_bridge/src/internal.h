@@ -54,7 +54,6 @@ struct MeshEntry {
     btScalar margin = 0;
     int source_count = 0;
     double radius = 0; // largest vertex distance from the local origin
-    double max_area = 0; // largest triangle area (the face search's trigger)
     std::vector<double> vertices;
     std::vector<uint32_t> indices;
     bool ok = false;

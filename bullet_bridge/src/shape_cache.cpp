@@ -251,14 +251,6 @@ const MeshEntry* ShapeCache::meshFor(const btCollisionShape* shape)
     for (size_t i = 0; i + 2 < e.vertices.size(); i += 3)
         e.radius = std::max(e.radius, std::sqrt(e.vertices[i] * e.vertices[i] + e.vertices[i + 1] * e.vertices[i + 1] +
                                                 e.vertices[i + 2] * e.vertices[i + 2]));
-    for (size_t t = 0; t + 2 < e.indices.size(); t += 3) {
-        btVector3 c[3];
-        for (int j = 0; j < 3; ++j) {
-            const double* v = &e.vertices[3 * (size_t)e.indices[t + j]];
-            c[j] = btVector3((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
-        }
-        e.max_area = std::max(e.max_area, 0.5 * (double)(c[1] - c[0]).cross(c[2] - c[0]).length());
-    }
     sdfccd_MeshDef def = sdfccd_default_mesh_def();
     def.vertices = e.vertices.data();
     def.vertex_count = (uint32_t)(e.vertices.size() / 3);
