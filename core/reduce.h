@@ -32,4 +32,12 @@ typedef void scc_reduce_get_fn(const void* set, size_t i, scc_reduce_item* out);
  * (n doubles, or NULL) makes it O(n) per choice instead of O(n k); the result is the same. */
 size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out, double* scratch);
 
+/* Cover points (cover.c): up to k more indices of `set`, none in chosen[0..chosen_count-1], each the
+ * point whose end gap could fall furthest below `depth` while every held point (chosen, then picked)
+ * stays out, for a turn of `tilt` (m per m) of the body about an axis in the contact plane; a held
+ * point bounds only points of similar normal and points within `tol` of it are never picked. Ties go
+ * to the smaller gap, then the lower index. Returns the count written to out. O(n (chosen + k) k). */
+size_t scc_cover(const void* set, size_t n, scc_reduce_get_fn* get, const int32_t* chosen, size_t chosen_count, double tilt,
+                 double depth, double tol, size_t k, int32_t* out);
+
 #endif

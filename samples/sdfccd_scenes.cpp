@@ -4,27 +4,12 @@
 //   sdfccd_scenes --list
 //   sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]
 //                 [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]
-//                 [--margin M] [--patch-band B] [--guard T] [--spread-depth-scale D]
-//                 [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]
-//                 [--spread-depth-fraction F] [--face-search S]
-//                 [--discrete-subdivision-scale S] [--batch-threads N] [--data DIR] [--check KEY=LIMIT,...]
-//                 [--quiet] [--table4] [--inject-nan STEP[,KIND]]
+//                 [--margin M] [--guard T] [--solver-iterations N] [--batch-threads N] [--data DIR]
+//                 [--check KEY=LIMIT,...] [--quiet] [--table4] [--inject-nan STEP[,KIND]]
 //
-// --patch-band B / --spread-depth-scale D / --solver-iterations N override the Bullet scenes'
-// set-up (the bridge's Config::patch_band, Config::spread_depth_scale,
-// btContactSolverInfo::m_numIterations; B < 0 turns it off, D < 0 is the bridge's default). The
-// paper's rigid scenes default to B = 0.02 and D = 0.01, the Bullet re-creations to the bridge's
-// defaults. --guard T sets the bridge's Config::guard_tolerance (the guarantee; 0: off; default
-// 0.0005, off with --method dcd).
-// B < 0 given also drops the extra manifolds (Bullet's single 4-point manifold). --extra-manifolds N / --kick W / --cover-depth D /
-// override the bridge's Config::extra_manifolds, kick_angular_speed and cover_depth; by default
-// the bridge's own defaults. --spread-depth-fraction F
-// overrides Config::spread_depth_fraction (0: off); a depth scale D >= 0 (given or the scene's)
-// turns it off unless F is given, so D is the scale used. --face-search S sets the bridge's
-// Config::face_search_size (0: off; the spikes scene defaults to 0.02, others to off).
-// --discrete-subdivision-scale S overrides Config::discrete_subdivision_scale (0: the discrete
-// queries subdivide as the library does). --batch-threads N sets Config::batch_threads (the
-// step's queries of every pair as batches on N threads; the same results).
+// The Bullet scenes run the bridge's Config(); --margin M, --guard T (Config::guard_tolerance, the
+// guarantee; 0: off; off with --method dcd) and --batch-threads N (Config::batch_threads) set its
+// physical options, --solver-iterations N the scene's btContactSolverInfo::m_numIterations.
 // --table4 adds the paper's Table 4 figures (the CCD of the coming step through the C ABI, timed,
 // up to the first contact; see runner.h) as a "table4" line of the summary.
 // The Bullet build (float or double btScalar) is a separate library, so this program is built
@@ -78,10 +63,7 @@ void usage(std::FILE* f)
                  "usage: sdfccd_scenes --list\n"
                  "       sdfccd_scenes NAME [--method fwgss|fw|dcd|certified] [--no-subdivision] [--steps N] [--dt S]\n"
                  "                     [--csv FILE] [--snapshot DIR] [--precision float|double] [--stock] [--quick]\n"
-                 "                     [--margin M] [--patch-band B] [--guard T] [--spread-depth-scale D]\n"
-                 "                     [--solver-iterations N] [--extra-manifolds N] [--kick W] [--cover-depth D]\n"
-                 "                     [--spread-depth-fraction F] [--face-search S]\n"
-                 "                     [--discrete-subdivision-scale S] [--batch-threads N] [--data DIR]\n"
+                 "                     [--margin M] [--guard T] [--solver-iterations N] [--batch-threads N] [--data DIR]\n"
                  "                     [--check KEY=LIMIT,...] [--quiet] [--table4]\n"
                  "                     [--inject-nan STEP[,position|velocity|energy|phi|query]]  (test hook)\n"
                  "check keys: max_pen max_pen_ccd min_max_pen fails tunnelled min_tunnelled rest_speed rest_drift moving energy_gain\n"
@@ -153,17 +135,9 @@ int main(int argc, char** argv)
         else if (a == "--stock") opt.stock = true;
         else if (a == "--quick") opt.quick = true;
         else if (a == "--margin") opt.margin = std::atof(value("metres"));
-        else if (a == "--patch-band") opt.patch_band = std::atof(value("metres"));
-        else if (a == "--spread-depth-scale") opt.spread_depth_scale = std::atof(value("metres"));
-        else if (a == "--face-search") opt.face_search = std::atof(value("metres (0: off)"));
         else if (a == "--batch-threads") opt.batch_threads = std::atoi(value("a thread count"));
         else if (a == "--solver-iterations") opt.solver_iterations = std::atoi(value("a count"));
         else if (a == "--guard") opt.guard = std::atof(value("metres (0: off)"));
-        else if (a == "--extra-manifolds") opt.extra_manifolds = std::atoi(value("a count (0-3)"));
-        else if (a == "--kick") opt.kick = std::atof(value("rad/s"));
-        else if (a == "--cover-depth") opt.cover_depth = std::atof(value("metres"));
-        else if (a == "--spread-depth-fraction") opt.spread_depth_fraction = std::atof(value("a fraction of the mesh's radius (0: off)"));
-        else if (a == "--discrete-subdivision-scale") opt.discrete_subdivision_scale = std::atof(value("a fraction of the mesh radius"));
         else if (a == "--data") opt.data_dir = value("a folder");
         else if (a == "--check") check = value("limits");
         else if (a == "--quiet") quiet = true;

@@ -219,6 +219,151 @@ START_TEST(test_reduce_bad_input)
 }
 END_TEST
 
+/* ---- cover points (sdfccd_cover_contacts) ---- */
+
+static int32_t cover(const sdfccd_ContactPoint* c, int32_t n, const int32_t* chosen, int32_t m, double tilt, double depth, int32_t cap,
+                     int32_t* idx)
+{
+    int32_t count = -1;
+    ck_assert_msg(sdfccd_cover_contacts(c, n, chosen, m, tilt, depth, SAME, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert(count >= 0 && count <= cap);
+    return count;
+}
+
+/* No turn: only a point deeper than the held one by more than `depth` needs holding. */
+START_TEST(test_cover_no_tilt)
+{
+    sdfccd_ContactPoint c[3] = { cp(0, 0, 0, 0.0, 1), cp(1, 0, 0, -0.005, 2), cp(0, 1, 0, 0.0002, 3) };
+    const int32_t chosen[1] = { 0 };
+    int32_t idx[3];
+    ck_assert_int_eq(cover(c, 3, chosen, 1, 0.0, 0.0005, 3, idx), 1);
+    ck_assert_int_eq(idx[0], 1);
+    /* 5 mm short of its bound is within a depth of 6 mm: nothing */
+    ck_assert_int_eq(cover(c, 3, chosen, 1, 0.0, 0.006, 3, idx), 0);
+}
+END_TEST
+
+/* A turn of `tilt` about the held point lets a point at distance L sink by tilt L: held when that
+ * exceeds its gap by more than depth (closed form: 0.2 - 0.1 > 0; 0.05 - 0.1 < 0). */
+START_TEST(test_cover_tilt_closed_form)
+{
+    sdfccd_ContactPoint c[2] = { cp(0, 0, 0, 0.0, 1), cp(1, 0, 0, 0.1, 2) };
+    const int32_t chosen[1] = { 0 };
+    int32_t idx[2];
+    ck_assert_int_eq(cover(c, 2, chosen, 1, 0.2, 0.0005, 2, idx), 1);
+    ck_assert_int_eq(idx[0], 1);
+    ck_assert_int_eq(cover(c, 2, chosen, 1, 0.05, 0.0005, 2, idx), 0);
+}
+END_TEST
+
+/* The largest shortfall first; a point held then bounds its neighbours. */
+START_TEST(test_cover_order_and_neighbours)
+{
+    sdfccd_ContactPoint c[3] = { cp(0, 0, 0, 0.0, 1), cp(2, 0, 0, 0.0, 2), cp(2.1, 0, 0, 0.0, 3) };
+    const int32_t chosen[1] = { 0 };
+    int32_t idx[3];
+    /* shortfalls 0.2 and 0.21: point 2 first; then point 1 is bounded by it to 0.1 x 0.1 = 0.01 */
+    ck_assert_int_eq(cover(c, 3, chosen, 1, 0.1, 0.0005, 3, idx), 2);
+    ck_assert_int_eq(idx[0], 2);
+    ck_assert_int_eq(idx[1], 1);
+    ck_assert_int_eq(cover(c, 3, chosen, 1, 0.1, 0.02, 3, idx), 1); /* 0.01 <= 0.02: covered */
+    ck_assert_int_eq(idx[0], 2);
+    ck_assert_int_eq(cover(c, 3, chosen, 1, 0.1, 0.0005, 1, idx), 1); /* capacity */
+    ck_assert_int_eq(idx[0], 2);
+}
+END_TEST
+
+/* Equal shortfalls go to the smaller gap (0.1 x 1 - 0 = 0.1 x 2 - 0.1, exactly). */
+START_TEST(test_cover_tie)
+{
+    sdfccd_ContactPoint c[3] = { cp(0, 0, 0, 0.0, 1), cp(-2, 0, 0, 0.1, 2), cp(1, 0, 0, 0.0, 3) };
+    const int32_t chosen[1] = { 0 };
+    int32_t idx[3];
+    ck_assert_int_eq(cover(c, 3, chosen, 1, 0.1, 0.0005, 1, idx), 1);
+    ck_assert_int_eq(idx[0], 2);
+}
+END_TEST
+
+/* A point facing the other way (the far side of a thin wall) is not bounded by the held one; a point
+ * at the held one's place is never picked. */
+START_TEST(test_cover_normals_and_same_place)
+{
+    sdfccd_ContactPoint c[3] = { cp(0, 0, 0, 0.0, 1), cp(0.5, 0, 0, 0.0, 2), cp(0.5 * SAME, 0, 0, -1.0, 3) };
+    c[1].normal = (sdfccd_Vec3){ 0, 0, -1 };
+    const int32_t chosen[1] = { 0 };
+    int32_t idx[3];
+    ck_assert_int_eq(cover(c, 3, chosen, 1, 0.0, 0.0005, 3, idx), 1);
+    ck_assert_int_eq(idx[0], 1);
+    /* nothing chosen: nothing to cover */
+    ck_assert_int_eq(cover(c, 3, NULL, 0, 0.0, 0.0005, 3, idx), 0);
+}
+END_TEST
+
+/* Random sets against a brute-force reading of the rule: when fewer than capacity are picked, every
+ * point left (not at a held point's place) ends no deeper than depth below its bound. */
+START_TEST(test_cover_random_property)
+{
+    enum { N = 300, CAP = 12 };
+    static sdfccd_ContactPoint c[N];
+    unsigned seed = 12345u;
+    for (int trial = 0; trial < 20; ++trial) {
+        for (int i = 0; i < N; ++i) {
+            seed = seed * 1664525u + 1013904223u;
+            double x = (seed >> 8) / 16777216.0 - 0.5;
+            seed = seed * 1664525u + 1013904223u;
+            double y = (seed >> 8) / 16777216.0 - 0.5;
+            seed = seed * 1664525u + 1013904223u;
+            double g = 0.004 * ((seed >> 8) / 16777216.0) - 0.001;
+            c[i] = cp(x, y, 0, g, (uint64_t)i);
+        }
+        int32_t red[4], n_red = reduce(c, N, 4, red), idx[CAP];
+        const double tilt = 0.002 * trial, depth = 0.0005;
+        int32_t m = cover(c, N, red, n_red, tilt, depth, CAP, idx);
+        int32_t held[4 + CAP], nh = 0;
+        for (int32_t j = 0; j < n_red; ++j) held[nh++] = red[j];
+        for (int32_t j = 0; j < m; ++j) {
+            ck_assert(!contains(red, n_red, idx[j]));
+            ck_assert(!contains(idx, j, idx[j]));
+            held[nh++] = idx[j];
+        }
+        if (m == CAP) continue;
+        for (int i = 0; i < N; ++i) {
+            if (contains(held, nh, i)) continue;
+            double bound = INFINITY;
+            int near = 0;
+            for (int32_t h = 0; h < nh; ++h) {
+                const sdfccd_Vec3 a = c[i].surface_point, b = c[held[h]].surface_point;
+                const double d = hypot(hypot(a.x - b.x, a.y - b.y), a.z - b.z);
+                near |= d <= SAME;
+                bound = fmin(bound, c[held[h]].gap + tilt * d);
+            }
+            ck_assert_msg(near || bound - c[i].gap <= depth, "trial %d: point %d may sink %g below its bound", trial, i, bound - c[i].gap);
+        }
+    }
+}
+END_TEST
+
+START_TEST(test_cover_bad_input)
+{
+    sdfccd_ContactPoint c[2] = { cp(0, 0, 0, 0, 1), cp(1, 0, 0, 0, 2) };
+    int32_t chosen[1] = { 0 }, idx[2], count = -7;
+    ck_assert_int_eq(sdfccd_cover_contacts(c, 2, chosen, 1, 0, 0, SAME, idx, 2, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_cover_contacts(NULL, 2, chosen, 1, 0, 0, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_cover_contacts(c, 2, NULL, 1, 0, 0, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_cover_contacts(c, 2, chosen, 1, 0, 0, SAME, NULL, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_cover_contacts(c, 2, chosen, -1, 0, 0, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_cover_contacts(c, 2, chosen, 1, -1, 0, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_cover_contacts(c, 2, chosen, 1, 0, NAN, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    chosen[0] = 2;
+    ck_assert_int_eq(sdfccd_cover_contacts(c, 2, chosen, 1, 0, 0, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    chosen[0] = 0;
+    c[1].gap = INFINITY;
+    ck_assert_int_eq(sdfccd_cover_contacts(c, 2, chosen, 1, 0, 0, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(strlen(sdfccd_last_error()) > 0);
+    ck_assert_int_eq(count, -7); /* not written on error */
+}
+END_TEST
+
 /* A torus mesh (ring in the xy-plane, major R, minor r, nu x nv quads); a vertex ring at the bottom. */
 static sdfccd_MeshId torus_mesh(double R, double r, int nu, int nv)
 {
@@ -629,6 +774,13 @@ int main(void)
     tcase_add_test(tc, test_reduce_thousand_points);
     tcase_add_test(tc, test_reduce_same_place);
     tcase_add_test(tc, test_reduce_bad_input);
+    tcase_add_test(tc, test_cover_no_tilt);
+    tcase_add_test(tc, test_cover_tilt_closed_form);
+    tcase_add_test(tc, test_cover_order_and_neighbours);
+    tcase_add_test(tc, test_cover_tie);
+    tcase_add_test(tc, test_cover_normals_and_same_place);
+    tcase_add_test(tc, test_cover_random_property);
+    tcase_add_test(tc, test_cover_bad_input);
     suite_add_tcase(s, tc);
     TCase* tq = tcase_create("mesh query");
     test_add_memory_fixture(tq);

@@ -71,7 +71,7 @@ public:
         btPersistentManifold* all[1 + kMaxExtra] = { m_manifold };
         int count = 1;
         if (!m_closest && m_bridge->cfg.max_contacts >= MANIFOLD_CACHE_SIZE)
-            for (int i = 0; i < (m_bridge->cfg.patch_band >= 0 ? 1 : m_bridge->cfg.extra_manifolds); ++i) {
+            for (int i = 0; i < kMaxExtra; ++i) {
                 if (!m_extra[i]) m_extra[i] = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
                 all[count++] = m_extra[i];
             }
@@ -98,7 +98,7 @@ public:
 private:
     BridgeImpl* m_bridge;
     btPersistentManifold* m_manifold;
-    btPersistentManifold* m_extra[kMaxExtra] = { nullptr, nullptr, nullptr }; // Config::extra_manifolds
+    btPersistentManifold* m_extra[kMaxExtra] = { nullptr, nullptr, nullptr }; // the cover points (contact_policy.cpp)
     bool m_own;
     bool m_mesh_is_body1;
     bool m_closest;
@@ -147,13 +147,8 @@ struct BridgeImpl::CreateFunc : public btCollisionAlgorithmCreateFunc {
 BridgeImpl::BridgeImpl(const Config& c) : cfg(c)
 {
     cfg.max_contacts = std::max(1, std::min(cfg.max_contacts, 4));
-    cfg.extra_manifolds = std::max(0, std::min(cfg.extra_manifolds, 3));
-    if (!(cfg.kick_angular_speed >= 0)) cfg.kick_angular_speed = 0;
-    if (!(cfg.cover_depth >= 0)) cfg.cover_depth = 0;
-    if (!(cfg.spread_depth_fraction >= 0)) cfg.spread_depth_fraction = 0;
     cfg.batch_threads = std::max(1, std::min(cfg.batch_threads, 256));
     if (!(cfg.contact_margin >= 0)) cfg.contact_margin = 0;
-    if (!(cfg.vertex_distance >= 0)) cfg.vertex_distance = 0;
 }
 
 BridgeImpl::~BridgeImpl() { sdfccd_destroy_workspace(workspace); }

@@ -8,21 +8,23 @@
 //     the CCD would then only report "penetrating at t0"), one CCD query (sdfccd_query_mesh on
 //     [0, dt]) with the contact margin. Its WHOLE contact set at the earliest time of impact is
 //     kept (the buffer grows to contacts_found; every triangle within the library's TOI window,
-//     with subdivision contacts), plus the vertices of those triangles within
-//     Config::vertex_distance of the surface then. No hit: no contact this step.
+//     with subdivision contacts), plus the vertices of those triangles within kVertexDistance of
+//     the surface then. No hit: no contact this step.
 //  3. Whenever the step has any contact, also when it starts in contact: the features of the
 //     start-pose query and those of a discrete query at the predicted end pose; each is
 //     constrained by its own closest surface point at the START of the step (the classic
 //     speculative-contact rule), so the rest of the motion (a rotation about a touching corner,
 //     a slide, a face landing after its first point) cannot push it in.
-//  4. Every candidate is expressed at the start of the step: point on the mesh, point on the SDF
-//     surface, normal, and gap d along the normal (negative: penetrating). The set is reduced to
-//     the manifold's 4 points: deepest, then the points maximising the contact polygon's area.
-//  5. The points are written into the pair's manifold the way btManifoldResult and
+//  4. Every candidate is expressed at the start of the step (point on the mesh, point on the SDF
+//     surface, normal, gap d along the normal; negative: penetrating) and the set is reduced to
+//     the manifold's 4 points: deepest, then the points maximising the contact polygon's area;
+//     cover points (sdfccd_cover_contacts) fill up to 3 more manifolds where the 4 leave the body
+//     free to turn and sink deeper than the guarantee's tolerance.
+//  5. The points are written into the pair's manifolds the way btManifoldResult and
 //     btPersistentManifold::refreshContactPoints do it: persistent points keep their warm-start
 //     impulses and lifetime, and the contact added / processed / started / ended callbacks fire.
-// The speculative constraint (notes/bullet-integration.md section 3.4 A): a point with gap d > 0
-// lets the solver close at most d in the step, so the mesh stops on the surface.
+// The speculative rule (the paper's Section 4: no advance past a time of impact): a point with gap
+// d > 0 lets the solver close at most d in the step, so the mesh stops on the surface.
 // All queries go through one reusable sdfccd_Workspace per bridge (no allocation per query).
 #include "internal.h"
 
@@ -36,16 +38,28 @@ namespace detail {
 
 // Among points giving at least this share of the best spread, the one with the smallest gap wins.
 static const double kSpreadShare = 0.95;
+// The reduction's depth scale: a tenth of the mesh's radius, at most 0.3 m (a body's far features
+// count less than those about to touch, in proportion to its size).
+static const double kSpreadDepthFraction = 0.1, kSpreadDepthMax = 0.3;
+// The vertices of a triangle in contact within this distance of the surface at its TOI are
+// candidates too (a face landing flat gives its corners).
+static const double kVertexDistance = 0.02;
+// The discrete queries do not split subdivision regions smaller than (this x the mesh's radius)^2:
+// their points lie that close to the triangle's vertices, which are candidates already.
+static const double kDiscreteSubdivisionScale = 0.1;
+// The face search splits faces down to regions with edges at most this share of the SDF's feature
+// size (SdfShape::setFeatureSize).
+static const double kFaceRegionShare = 0.4;
 // The face search keeps the field's normal at a point of a face inside the SDF when it is
 // within about 25 degrees of the face's inward direction (a face on a smooth surface).
 static const double kFaceNormalAgreement = 0.9;
 
 // Adds points to `out` (up to k) maximising the spread of the projected points P.
 static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>& P, const btVector3& nref, int k, double tol,
-                   double depth_scale, double d_max, std::vector<int>& out)
+                   double depth_scale, std::vector<double>& score, std::vector<int>& out)
 {
     const int n = (int)c.size();
-    std::vector<double> score(n, 0.0);
+    score.assign((size_t)n, 0.0);
     while ((int)out.size() < k) {
         const size_t m = out.size();
         const btVector3& a0 = P[out[0]];
@@ -54,7 +68,6 @@ static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>
         double best = 0;
         for (int i = 0; i < n; ++i) {
             score[i] = -1;
-            if (!(c[i].d <= d_max)) continue;
             const btVector3& q = P[i];
             bool dup = false;
             for (int j : out) dup |= (double)(q - P[j]).length() <= tol;
@@ -93,10 +106,10 @@ static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>
     }
 }
 
-std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, double band)
+void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, PairScratch& w, std::vector<int>& out)
 {
-    std::vector<int> out;
-    if (c.empty() || k <= 0) return out;
+    out.clear();
+    if (c.empty() || k <= 0) return;
     int first = 0;
     for (int i = 1; i < (int)c.size(); ++i)
         if (c[i].d < c[first].d) first = i;
@@ -105,7 +118,8 @@ std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double t
     // mesh above one another (a bottom and a top corner) constrain the same place, and only the
     // one with the smaller gap matters.
     const btVector3 nref = c[first].n0;
-    std::vector<btVector3> P(c.size());
+    std::vector<btVector3>& P = w.flat;
+    P.resize(c.size());
     for (size_t i = 0; i < c.size(); ++i) P[i] = c[i].pB0 - nref * nref.dot(c[i].pB0);
     // Several points equally deep (a face landing flat): start from the one farthest from their
     // centre, a corner of the region, so the polygon grows to the region's corners.
@@ -128,55 +142,7 @@ std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double t
         }
     }
     out.push_back(first);
-    // Optionally first among the points within `band` of the deepest (those in contact with it),
-    // then among all. (Off in the bridge: it helps piles of resting bodies but lets a body that
-    // lands on slanted points first slide between them.)
-    if (band >= 0) spread(c, P, nref, k, tol, depth_scale, d0 + band, out);
-    spread(c, P, nref, k, tol, depth_scale, INFINITY, out);
-    return out;
-}
-
-std::vector<int> coverContacts(const std::vector<Candidate>& c, const std::vector<int>& chosen, int limit, double slope,
-                               double depth, double tol)
-{
-    std::vector<int> out;
-    const int n = (int)c.size();
-    if (chosen.empty() || n == 0) return out;
-    // bound[i]: the smallest end gap candidate i is guaranteed by the points held so far (their
-    // gap plus the slope times the distance, among points of similar normal); +inf if none.
-    std::vector<double> bound(n, INFINITY);
-    std::vector<char> taken(n, 0);
-    const btScalar similar = btScalar(0.9);
-    auto hold = [&](int j) {
-        taken[j] = 1;
-        for (int i = 0; i < n; ++i) {
-            if (taken[i]) continue;
-            const double dist = (double)(c[i].pB0 - c[j].pB0).length();
-            if (dist <= tol) {
-                taken[i] = 1; // never two points at one place
-                continue;
-            }
-            if (c[i].n0.dot(c[j].n0) < similar) continue;
-            bound[i] = std::min(bound[i], c[j].d + slope * dist);
-        }
-    };
-    for (int j : chosen) hold(j);
-    while ((int)out.size() < limit) {
-        int pick = -1;
-        double worst = depth;
-        for (int i = 0; i < n; ++i) {
-            if (taken[i]) continue;
-            const double deficit = bound[i] - c[i].d; // how deep i may end while the held points stay out
-            if (deficit > worst || (pick >= 0 && deficit == worst && c[i].d < c[pick].d)) {
-                worst = deficit;
-                pick = i;
-            }
-        }
-        if (pick < 0) break;
-        out.push_back(pick);
-        hold(pick);
-    }
-    return out;
+    spread(c, P, nref, k, tol, depth_scale, w.score, out);
 }
 
 namespace {
@@ -193,7 +159,7 @@ struct Gatherer {
     BodyMotion M, S;
     double margin;
     std::vector<Candidate>* out;
-    std::vector<std::pair<uint32_t, double>> tris;
+    PairScratch* w;
     int64_t evals = 0; // our own sdfccd_sdf_eval calls
 
     // A material point (mesh frame) constrained by a surface point qB and normal nL (SDF frame)
@@ -228,12 +194,14 @@ struct Gatherer {
     // within `accept` there, each constrained from the start of the step.
     void addPose(const sdfccd_Contact* cs, int count, const btTransform& Mx, const btTransform& Sx, double accept)
     {
-        std::vector<uint32_t> ts;
+        std::vector<uint32_t>& ts = w->pose_tris;
+        ts.clear();
         for (int i = 0; i < count; ++i) {
             addFromStart(Mx.invXform(bt(cs[i].point)), (int)cs[i].triangle);
             if (cs[i].triangle < me->indices.size() / 3) ts.push_back(cs[i].triangle);
         }
-        std::vector<std::pair<uint32_t, uint32_t>> vt;
+        std::vector<std::pair<uint32_t, uint32_t>>& vt = w->pose_vertices;
+        vt.clear();
         for (uint32_t t : ts)
             for (int j = 0; j < 3; ++j) vt.push_back(std::make_pair(me->indices[3 * (size_t)t + j], t));
         std::sort(vt.begin(), vt.end());
@@ -247,7 +215,7 @@ struct Gatherer {
             addFromStart(local, (int)vt[i].second);
         }
     }
-    // The face search (Config::face_search_size): the mesh's triangles with an edge longer than
+    // The face search (SdfShape::setFeatureSize): the mesh's triangles with an edge longer than
     // `size` at pose (Mx, Sx), split into 4 at their edge midpoints down to regions with no edge
     // longer than `size`; a region whose centroid is farther from the surface than `lipschitz`
     // times its radius plus `accept` has no point within `accept` and is dropped; each remaining
@@ -269,10 +237,8 @@ struct Gatherer {
         const btTransform rel = Sx.inverseTimes(Mx); // mesh frame -> SDF frame
         const btMatrix3x3 sdf_basis_t = Sx.getBasis().transpose();
         const double size2 = size * size;
-        struct Region {
-            btVector3 c[3];
-        };
-        std::vector<Region> stack;
+        typedef FaceRegion Region;
+        std::vector<Region>& stack = w->regions;
         int64_t visited = 0;
         const size_t nt = me->indices.size() / 3;
         for (size_t t = 0; t < nt; ++t) {
@@ -346,6 +312,7 @@ struct Gatherer {
         // Contacts come sorted by time; one pose pair per distinct time.
         double t_pose = -1;
         btTransform Mx = M.t0, Sx = S.t0;
+        std::vector<std::pair<uint32_t, double>>& tris = w->tris;
         tris.clear();
         for (int i = 0; i < count; ++i) {
             const sdfccd_Contact& k = cs[i];
@@ -362,7 +329,8 @@ struct Gatherer {
             tris.push_back(std::make_pair(k.triangle, k.toi));
         }
         // Each (vertex, triangle's TOI) once, in a fixed order.
-        std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>> vt;
+        std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>>& vt = w->toi_vertices;
+        vt.clear();
         for (const auto& t : tris)
             for (int j = 0; j < 3; ++j) vt.push_back(std::make_pair(me->indices[3 * (size_t)t.first + j], std::make_pair(t.second, t.first)));
         std::sort(vt.begin(), vt.end());
@@ -440,18 +408,21 @@ bool BridgeImpl::plan(const btCollisionObjectWrapper* mw, const btCollisionObjec
     // query was moved first).
     P.continuous = P.params.method != SDFCCD_METHOD_DCD;
     P.start_margin = margin;
-    P.travel = P.kick = 0;
+    P.travel = 0;
     if (dt > 0) {
         const double reach = P.me->radius + (double)(P.M.t0.getOrigin() - P.S.t0.getOrigin()).length();
         P.travel = dt * ((double)(P.M.v - P.S.v).length() + (double)P.M.w.length() * P.me->radius + (double)P.S.w.length() * reach);
-        // A kick (a velocity change from another contact solved in the same step, e.g. a body
-        // landing on this one) is not in the predicted motion: the start-pose query also reaches
-        // as far as kick_angular_speed about the body's centre carries its farthest point in the
-        // step, and its features count even when the predicted motion has no contact.
-        P.kick = dt * cfg.kick_angular_speed * P.me->radius;
-        P.start_margin = margin + P.travel + P.kick;
+        P.start_margin = margin + P.travel;
     }
+    // The face search's region size comes from the SDF shape's smallest feature.
+    const SdfShape* shape = dynamic_cast<const SdfShape*>(sw->getCollisionShape());
+    P.feature_size = shape ? shape->getFeatureSize() : 0.0;
     return true;
+}
+
+bool BridgeImpl::faceSearch(const PairPlan& P) const
+{
+    return P.params.subdivision && P.feature_size > 0;
 }
 
 sdfccd_QueryParams BridgeImpl::discreteParams(const PairPlan& P, double dcd_margin) const
@@ -460,10 +431,10 @@ sdfccd_QueryParams BridgeImpl::discreteParams(const PairPlan& P, double dcd_marg
     std::memcpy(&dcd, &P.params, sizeof dcd);
     dcd.method = SDFCCD_METHOD_DCD;
     dcd.margin = dcd_margin;
-    // Subdivision regions below (discrete_subdivision_scale x the mesh radius)^2 are not split:
+    // Subdivision regions below (kDiscreteSubdivisionScale x the mesh radius)^2 are not split:
     // their points lie that close to the triangle's vertices, which are candidates already.
     // (Not for the DCD baseline, which keeps the library's subdivision.)
-    const double sub = cfg.discrete_subdivision_scale * P.me->radius;
+    const double sub = kDiscreteSubdivisionScale * P.me->radius;
     if (P.continuous && sub > 0) dcd.subdivision_min_area = std::max(dcd.subdivision_min_area, sub * sub);
     return dcd;
 }
@@ -477,6 +448,17 @@ void posePair(const btTransform& Mx, const btTransform& Sx, sdfccd_RigidMotion& 
     s1 = sdfccd_default_rigid_motion();
     m1.pose = toPose(Mx);
     s1.pose = toPose(Sx);
+}
+
+// The start-pose query's verdicts, one rule for gather() and the batch: its broad phase culled
+// every triangle (the step provably has no contact), or a feature is already within the margin
+// (the step starts in contact: the CCD query is skipped).
+bool culled(const sdfccd_QueryResult& r) { return r.triangles_tested == 0 && r.state == SDFCCD_STATE_NO_HIT; }
+bool touching(const sdfccd_QueryResult& r, const sdfccd_Contact* c, int n, double margin)
+{
+    for (int i = 0; r.hit && i < n; ++i)
+        if (c[i].distance <= margin) return true;
+    return false;
 }
 
 // Room given to a batched query's contacts (a query that finds more is run again in the narrow
@@ -581,13 +563,9 @@ void BridgeImpl::prefetch(double dt, double margin)
     for (size_t k = 0; k < items.size(); ++k) {
         const CachedQuery& c = batch_cache[PairStageKey{ items[k].mo, items[k].so, kStageStart }];
         if (c.status != SDFCCD_OK) continue;
-        if (c.result.triangles_tested == 0 && c.result.state == SDFCCD_STATE_NO_HIT) continue;
-        if (cfg.face_search_size > 0 && items[k].P.params.subdivision) continue;
-        bool touching = false;
-        if (c.result.hit)
-            for (int i = 0; i < std::min(c.result.contact_count, kBatchCapacity) && !touching; ++i)
-                touching = c.contacts[(size_t)i].distance <= items[k].P.margin;
-        (touching ? end : ccd).push_back(k);
+        if (culled(c.result) || faceSearch(items[k].P)) continue;
+        const int n = std::min(c.result.contact_count, kBatchCapacity);
+        (touching(c.result, c.contacts.data(), n, items[k].P.margin) ? end : ccd).push_back(k);
     }
     runStage(ccd, kStageCcd);
     for (size_t k : ccd) {
@@ -621,6 +599,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     const btTransform sdf_world = P.sdf_world;
     G.margin = margin;
     G.out = &cands;
+    G.w = &work;
     G.evals = 0;
     const sdfccd_RigidMotion mm = P.mm;
     const sdfccd_RigidMotion* sm = P.sm();
@@ -704,29 +683,29 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // together on a resting body). Otherwise (2) the CCD query over the step; no hit, no contact.
     sdfccd_QueryResult r0{};
     bool start_ran = false, start_ok = false, starts_touching = false;
-    const double start_margin = P.start_margin, travel = P.travel, kick = P.kick;
+    const double start_margin = P.start_margin, travel = P.travel;
     if (dt > 0 && continuous) {
         start_ran = true;
         start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0, kStageStart);
-        if (start_ok && r0.triangles_tested == 0 && r0.state == SDFCCD_STATE_NO_HIT) {
+        if (start_ok && culled(r0)) {
             stats.queries_skipped++;
             stats.last_state = (int)SDFCCD_STATE_NO_HIT;
             stats.last_toi_fraction = 1;
             return false;
         }
-        if (start_ok && r0.hit)
-            for (int i = 0; i < r0.contact_count && !starts_touching; ++i) starts_touching = start_contacts[(size_t)i].distance <= margin;
+        starts_touching = start_ok && touching(r0, start_contacts.data(), r0.contact_count, margin);
     }
-    // The face search (Config::face_search_size; part of the subdivision, so off without it): at
+    // The face search (SdfShape::setFeatureSize; part of the subdivision, so off without it): at
     // the start pose over the step's reach (DCD, the discrete baseline: at the end pose within
     // the margin, as its own query). Its features count like the start-pose query's, even when
     // the CCD query misses them (a face landing flat on tips between its FW points).
     size_t face_found = 0;
-    if (dt > 0 && cfg.face_search_size > 0 && params.subdivision) {
+    if (dt > 0 && faceSearch(P)) {
         sdfccd_SdfInfo info;
         const double lip = sdfccd_sdf_get_info(G.sdf, &info) == SDFCCD_OK && info.lipschitz > 0 ? info.lipschitz : 1.0;
-        stats.face_regions += continuous ? G.searchFaces(cfg.face_search_size, G.M.t0, G.S.t0, start_margin, lip, params)
-                                         : G.searchFaces(cfg.face_search_size, G.M.t1, G.S.t1, margin, lip, params);
+        const double fs = kFaceRegionShare * P.feature_size;
+        stats.face_regions += continuous ? G.searchFaces(fs, G.M.t0, G.S.t0, start_margin, lip, params)
+                                         : G.searchFaces(fs, G.M.t1, G.S.t1, margin, lip, params);
         face_found = cands.size();
         for (size_t i = 0; i < face_found && continuous && !starts_touching; ++i) starts_touching = cands[i].d <= margin;
     }
@@ -746,15 +725,15 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.last_state = (int)res.state;
         if (!res.hit) {
             stats.last_toi_fraction = 1;
-            // The predicted motion is clear: only a kick can bring the start pose's features in,
-            // or the face search found features the CCD query missed.
-            if ((kick > 0 || face_found > 0) && start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, start_margin);
+            // The predicted motion is clear: only the face search can have found features the
+            // CCD query missed; the start pose's features then count too.
+            if (face_found > 0 && start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, start_margin);
             return cands.empty() ? false : finish();
         }
         stats.hits++;
         stats.last_toi_fraction = res.fraction;
-        G.addContacts(contacts.data(), res.contact_count, margin + std::max(cfg.vertex_distance, params.contact_slop));
-        if (dt > 0 && !start_ran && (res.toi > 0 || travel + kick > margin)) {
+        G.addContacts(contacts.data(), res.contact_count, margin + std::max(kVertexDistance, params.contact_slop));
+        if (dt > 0 && !start_ran && (res.toi > 0 || travel > margin)) {
             start_ran = true;
             start_ok = discrete(start_contacts, G.M.t0, G.S.t0, start_margin, &r0, kStageStart);
         }
@@ -769,7 +748,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // the vertex distance count too, as they would have with the CCD's contacts (a face resting
     // flat gives its corners).
     if (dt > 0) {
-        const double accept = starts_touching ? std::max(start_margin, margin + std::max(cfg.vertex_distance, params.contact_slop))
+        const double accept = starts_touching ? std::max(start_margin, margin + std::max(kVertexDistance, params.contact_slop))
                                               : start_margin;
         if (start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, accept);
         sdfccd_QueryResult r1;
@@ -787,8 +766,8 @@ namespace {
 // the first manifold gains its first point and ended when it empties (the first manifold speaks
 // for the pair: the others never fire started or ended).
 void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, const std::vector<Candidate>& cands,
-                    const std::vector<int>& pick, int first, bool own_manifold_only, const btCollisionObjectWrapper* mw,
-                    const btCollisionObjectWrapper* sw, Stats& stats)
+                    const std::vector<int>& pick, int first, const btCollisionObjectWrapper* mw,
+                    const btCollisionObjectWrapper* sw, PairScratch& w, Stats& stats)
 {
     const int per = (int)MANIFOLD_CACHE_SIZE;
     first = std::max(0, std::min(first, per));
@@ -796,13 +775,12 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
     const btCollisionObject* so = sw->getCollisionObject();
     const int n = std::min((int)pick.size(), first + per * (manifold_count - 1));
     // The last step's points of every manifold of the pair.
-    std::vector<btManifoldPoint> old;
-    std::vector<char> matched;
-    std::vector<int> old_m;
+    std::vector<btManifoldPoint>& old = w.old_points;
+    std::vector<char>& matched = w.matched;
+    old.clear();
     for (int m = 0; m < manifold_count; ++m)
         for (int i = 0; i < manifolds[m]->getNumContacts(); ++i) {
             old.push_back(manifolds[m]->getContactPoint(i));
-            old_m.push_back(m);
         }
     matched.assign(old.size(), 0);
     const int primary_old = manifolds[0]->getNumContacts();
@@ -810,7 +788,8 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
     const btTransform& worldA = mo->getWorldTransform();
     const btTransform& worldB = so->getWorldTransform();
     const int flags = mo->getCollisionFlags() | so->getCollisionFlags();
-    std::vector<btManifoldPoint> pts((size_t)n);
+    std::vector<btManifoldPoint>& pts = w.new_points;
+    pts.resize((size_t)n);
     for (int k = 0; k < n; ++k) {
         const Candidate& c = cands[pick[k]];
         btManifoldPoint pt(worldA.invXform(c.pA0), worldB.invXform(c.pB0), c.n0, (btScalar)c.d);
@@ -834,9 +813,7 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
         // (btPersistentManifold::getCacheEntry / replaceContactPoint).
         int best = -1;
         btScalar best_d2 = match * match;
-        const int target = k < first ? 0 : 1 + (k - first) / per;
         for (size_t j = 0; j < old.size(); ++j) {
-            if (own_manifold_only && old_m[j] != target) continue; // the patch rule: per manifold
             const btScalar d2 = (old[j].m_localPointA - pt.m_localPointA).length2();
             if (!matched[j] && d2 < best_d2) {
                 best_d2 = d2;
@@ -909,42 +886,38 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         start_gaps[std::make_pair(mw->getCollisionObject(), sw->getCollisionObject())] = std::make_pair(guard_step, d0);
     }
     const double tol = std::max(1e-6, 1e-3 * radius);
-    double depth_scale = cfg.spread_depth_scale;
-    if (cfg.spread_depth_fraction > 0) depth_scale = std::min(depth_scale, cfg.spread_depth_fraction * radius);
-    std::vector<int> pick;
-    if (any) pick = reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, -1);
+    const double depth_scale = std::min(kSpreadDepthMax, kSpreadDepthFraction * radius);
+    pick.clear();
+    if (any) reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, work, pick);
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;
     }
     const int first = (int)pick.size();
     // More points where the first ones leave the body free to sink: every candidate that could end
-    // deeper than cover_depth while the points held so far stay out, for any rotation of the body
-    // (relative to the SDF) about an axis in the contact plane up to its angular speed plus
-    // kick_angular_speed during the step (a kick from another contact solved in the same step).
+    // deeper than the guarantee's tolerance while the points held so far stay out, for any rotation
+    // of the body (relative to the SDF) about an axis in the contact plane up to its angular speed.
     const int extra_limit = (manifold_count - 1) * (int)MANIFOLD_CACHE_SIZE;
-    if (any && !pick.empty() && extra_limit > 0 && cfg.patch_band >= 0) {
-        // The older rule (Config::patch_band): up to 4 points spread over the candidates within
-        // the band of the deepest gap that are not within tol of a point already picked.
-        const double d0 = scratch[pick[0]].d;
-        std::vector<Candidate> sub;
-        std::vector<int> from;
-        for (int i = 0; i < (int)scratch.size(); ++i) {
-            if (!(scratch[i].d <= d0 + cfg.patch_band)) continue;
-            bool near = false;
-            for (int j : pick) near |= (double)(scratch[i].pB0 - scratch[j].pB0).length() <= tol;
-            if (near) continue;
-            sub.push_back(scratch[i]);
-            from.push_back(i);
-        }
-        for (int i : reduceContacts(sub, (int)MANIFOLD_CACHE_SIZE, tol, depth_scale, -1)) pick.push_back(from[i]);
-    } else if (any && !pick.empty() && extra_limit > 0) {
+    if (any && !pick.empty() && extra_limit > 0) {
         const btVector3& n = scratch[pick[0]].n0;
-        const double w_tilt = (double)(w - n * n.dot(w)).length();
-        const double slope = dt * (w_tilt + cfg.kick_angular_speed);
-        for (int i : coverContacts(scratch, pick, extra_limit, slope, cfg.cover_depth, tol)) pick.push_back(i);
+        const double slope = dt * (double)(w - n * n.dot(w)).length();
+        const double cover = cfg.guard_tolerance > 0 ? cfg.guard_tolerance : Config().guard_tolerance;
+        cover_set.resize(scratch.size());
+        for (size_t i = 0; i < scratch.size(); ++i) {
+            sdfccd_ContactPoint& p = cover_set[i];
+            std::memset(&p, 0, sizeof p);
+            p.surface_point = v3(scratch[i].pB0);
+            p.normal = v3(scratch[i].n0);
+            p.gap = scratch[i].d;
+        }
+        pick.resize((size_t)(first + extra_limit));
+        int32_t added = 0;
+        if (sdfccd_cover_contacts(cover_set.data(), (int32_t)scratch.size(), pick.data(), first, slope, cover, tol, pick.data() + first,
+                                  extra_limit, &added) != SDFCCD_OK)
+            added = 0;
+        pick.resize((size_t)(first + added));
     }
-    writeManifolds(manifolds, manifold_count, scratch, pick, first, cfg.patch_band >= 0, mw, sw, stats);
+    writeManifolds(manifolds, manifold_count, scratch, pick, first, mw, sw, work, stats);
 }
 
 double BridgeImpl::timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt)

@@ -104,19 +104,26 @@ struct Candidate {
  * maximising the triangle's area, then the one adding most area to the polygon; distances and
  * areas between the SDF surface points, projected on the plane of the deepest point's normal,
  * each weighted by exp(-(gap - deepest gap) / depth_scale). Points closer than `tol` to a chosen
- * one are never chosen (no duplicates). With band >= 0, points within `band` of the deepest gap
- * are spread first and the others only fill what is left.
- * Ties go to the smaller gap, then to the lower index: deterministic for a given input. */
-std::vector<int> reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, double band);
+ * one are never chosen (no duplicates). Ties go to the smaller gap, then to the lower index:
+ * deterministic for a given input. Writes into `out` (cleared; no allocation once it has grown). */
+struct PairScratch;
+void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, PairScratch& w, std::vector<int>& out);
 
-/** More points after `chosen` (at most `limit`), where the points held so far leave the body
- * free to sink: a candidate's end gap is bounded below by d_i - min_j (d_j + slope * |pB_i - pB_j|)
- * over held points j of similar normal (the gap change of a rigid body turning by at most `slope`
- * radians in the step about an axis in the contact plane, with each held point ending out of
- * the surface). The candidate with the largest possible depth beyond `depth` is held next (ties:
- * the smaller gap, then the lower index), until none is left. Never two points within `tol`. */
-std::vector<int> coverContacts(const std::vector<Candidate>& c, const std::vector<int>& chosen, int limit, double slope,
-                               double depth, double tol);
+// Storage the contact policy reuses from pair to pair and step to step (no allocation once grown).
+struct FaceRegion {
+    btVector3 c[3];
+};
+struct PairScratch {
+    std::vector<btVector3> flat;                  // reduction: surface points on the contact plane
+    std::vector<double> score;                    // reduction: each candidate's spread
+    std::vector<std::pair<uint32_t, double>> tris; // triangles of the CCD's contacts and their TOI
+    std::vector<uint32_t> pose_tris;              // triangles of a discrete query's contacts
+    std::vector<std::pair<uint32_t, uint32_t>> pose_vertices;                 // (vertex, triangle)
+    std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>> toi_vertices; // (vertex, (TOI, triangle))
+    std::vector<FaceRegion> regions;              // the face search's stack
+    std::vector<btManifoldPoint> old_points, new_points; // a pair's manifold points, last step and this one
+    std::vector<char> matched;                    // old points that persist
+};
 
 // The inputs of one pair's queries in a step: gather() and the batch prefetch build them alike.
 struct PairPlan {
@@ -128,7 +135,7 @@ struct PairPlan {
     sdfccd_RigidMotion mm, sm_value;
     sdfccd_QueryParams params;  // Config::query with the pair's margin
     bool continuous = true;     // not the DCD baseline
-    double margin = 0, start_margin = 0, travel = 0, kick = 0;
+    double margin = 0, start_margin = 0, travel = 0, feature_size = 0;
     const sdfccd_RigidMotion* sm() const { return static_sdf ? nullptr : &sm_value; }
 };
 
@@ -218,6 +225,7 @@ public:
     bool plan(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin, detail::PairPlan& P);
     // The discrete queries' parameters (start and end pose) with margin `dcd_margin`.
     sdfccd_QueryParams discreteParams(const detail::PairPlan& P, double dcd_margin) const;
+    bool faceSearch(const detail::PairPlan& P) const; // the face search runs for this pair
     // Config::batch_threads: runs the queries of every pair of `world`'s pair cache the bridge
     // handles and that the batch covers, stage by stage, into batch_cache (replacing it).
     void prefetch(double dt, double margin);
@@ -266,6 +274,9 @@ public:
     double last_start_margin = 0; // the start-pose query's margin of the last gather()
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
+    std::vector<int> pick;                      // the chosen candidates
+    detail::PairScratch work;
+    std::vector<sdfccd_ContactPoint> cover_set; // the candidates for sdfccd_cover_contacts
     std::vector<sdfccd_Contact> contacts, start_contacts;
     sdfccd_Workspace* workspace = nullptr; // the queries' scratch storage (no allocation per query)
     // Config::batch_threads: the world whose pair cache the batch reads (registerWith(world)) and
@@ -276,6 +287,11 @@ public:
     struct CreateFunc;
     std::unique_ptr<CreateFunc> fn[2]; // contact points, closest points
     btGImpactCollisionAlgorithm::CreateFunc gimpact_fn;
+};
+
+// The implementation of a Bridge, for the bridge's own sources (Bridge befriends it).
+struct BridgeAccess {
+    static BridgeImpl* of(Bridge& b) { return b.m_impl; }
 };
 
 SDFCCD_BULLET_NAMESPACE_END

@@ -31,7 +31,6 @@ SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type)
       m_triangulated(false), m_meshInterface(nullptr), m_bvh(nullptr), m_misuseReported(0)
 {
     m_shapeType = shape_type;
-    m_stretch.child = kNullSdf;
     m_lo.setValue(-BT_LARGE_FLOAT, -BT_LARGE_FLOAT, -BT_LARGE_FLOAT);
     m_hi.setValue(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT);
     sdfccd_SdfInfo info;
@@ -94,6 +93,12 @@ void SdfShape::getLocalBounds(btVector3& lo, btVector3& hi) const
     hi = m_hi;
 }
 
+double SdfShape::getFeatureSize() const
+{
+    const btVector3 s = m_scaling.absolute();
+    return m_featureSize * (double)btMin(s.x(), btMin(s.y(), s.z()));
+}
+
 bool SdfShape::hasFiniteBounds() const
 {
     for (int i = 0; i < 3; ++i)
@@ -136,14 +141,9 @@ sdfccd_SdfId SdfShape::querySdf() const
     if (sx == sy && sy == sz) {
         st = sdfccd_create_transformed(m_sdf, sdfccd_pose_identity(), sx, &m_scaled);
     } else {
-        m_stretch.child = m_sdf;
-        m_stretch.s[0] = sx;
-        m_stretch.s[1] = sy;
-        m_stretch.s[2] = sz;
-        m_stretch.smin = std::min(sx, std::min(sy, sz));
         sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
         def.eval = stretchEval;
-        def.user = &m_stretch;
+        def.user = const_cast<SdfShape*>(this);
         def.lipschitz = 1.0;
         def.bounds.lo.x = m_lo.x() * sx; def.bounds.hi.x = m_hi.x() * sx;
         def.bounds.lo.y = m_lo.y() * sy; def.bounds.hi.y = m_hi.y() * sy;
@@ -162,16 +162,18 @@ namespace {
 double stretchEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
 {
     // phi(x) = min(s) * phi_child(x / s): never above the distance to the stretched solid.
-    const detail::StretchData* d = static_cast<const detail::StretchData*>(user);
-    sdfccd_Vec3 q = { p.x / d->s[0], p.y / d->s[1], p.z / d->s[2] };
+    const SdfShape* shape = static_cast<const SdfShape*>(user);
+    const btVector3& sc = shape->getLocalScaling();
+    const double s[3] = { (double)sc.x(), (double)sc.y(), (double)sc.z() }, smin = std::min(s[0], std::min(s[1], s[2]));
+    sdfccd_Vec3 q = { p.x / s[0], p.y / s[1], p.z / s[2] };
     double v = 0.0;
     sdfccd_Vec3 g = { 0, 0, 1 };
-    if (sdfccd_sdf_eval(d->child, q, &v, &g) != SDFCCD_OK) v = INFINITY;
+    if (sdfccd_sdf_eval(shape->sdf(), q, &v, &g) != SDFCCD_OK) v = INFINITY;
     if (out_grad) {
-        sdfccd_Vec3 h = { g.x * d->smin / d->s[0], g.y * d->smin / d->s[1], g.z * d->smin / d->s[2] };
+        sdfccd_Vec3 h = { g.x * smin / s[0], g.y * smin / s[1], g.z * smin / s[2] };
         *out_grad = h;
     }
-    return d->smin * v;
+    return smin * v;
 }
 } // namespace
 

@@ -817,13 +817,13 @@ void softForget(BridgeImpl* impl)
 
 SoftBodyStats softBodyStats(const Bridge& bridge)
 {
-    const detail::SoftState* st = detail::softOf(const_cast<Bridge&>(bridge).impl());
+    const detail::SoftState* st = detail::softOf(BridgeAccess::of(const_cast<Bridge&>(bridge)));
     return st ? st->stats : SoftBodyStats();
 }
 
 bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance)
 {
-    detail::SoftState* st = detail::softOf(bridge.impl());
+    detail::SoftState* st = detail::softOf(BridgeAccess::of(bridge));
     if (!st || !(tolerance > 0) || !std::isfinite(tolerance)) return false;
     st->auto_guard = on;
     st->auto_tolerance = tolerance;
@@ -834,7 +834,7 @@ bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance)
 int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tolerance)
 {
     if (!world || !(tolerance > 0) || !std::isfinite(tolerance)) return -1;
-    detail::SoftState* st = detail::softOf(bridge.impl());
+    detail::SoftState* st = detail::softOf(BridgeAccess::of(bridge));
     if (!st || !st->dispatcher || st->dispatcher != world->getDispatcher()) return -1;
     if (st->world == world && st->guarded_this_step) { // the automatic guard already checked this step
         st->guarded_this_step = false;

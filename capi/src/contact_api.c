@@ -354,3 +354,30 @@ sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t 
     *out_count = (int32_t)scc_reduce(points, (size_t)count, public_item, same_place_distance, -1, (size_t)capacity, out_indices, NULL);
     return SDFCCD_OK;
 }
+
+sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points, int32_t count, const int32_t* chosen, int32_t chosen_count,
+                                    double tilt, double depth, double same_place_distance, int32_t* out_indices, int32_t capacity,
+                                    int32_t* out_count)
+{
+    static const char fn[] = "sdfccd_cover_contacts";
+    if (!out_count) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_count is NULL", fn);
+    if (count < 0 || chosen_count < 0 || capacity < 0)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: count (%d), chosen_count (%d) and capacity (%d) must be >= 0", fn, count,
+                             chosen_count, capacity);
+    if ((count > 0 && !points) || (chosen_count > 0 && !chosen) || (capacity > 0 && !out_indices))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: points, chosen or out_indices is NULL", fn);
+    if (!(isfinite(tilt) && tilt >= 0.0) || !(isfinite(depth) && depth >= 0.0) ||
+        !(isfinite(same_place_distance) && same_place_distance >= 0.0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: tilt, depth and same_place_distance must be finite and >= 0", fn);
+    for (int32_t j = 0; j < chosen_count; ++j)
+        if (chosen[j] < 0 || chosen[j] >= count)
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: chosen[%d] = %d is outside [0, %d)", fn, j, chosen[j], count);
+    for (int32_t i = 0; i < count; ++i) {
+        const sdfccd_ContactPoint* c = &points[i];
+        if (!scc_vfinite(sdfccd__v(c->surface_point)) || !scc_vfinite(sdfccd__v(c->normal)) || !isfinite(c->gap))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: point %d has a non-finite surface point, normal or gap", fn, i);
+    }
+    *out_count = (int32_t)scc_cover(points, (size_t)count, public_item, chosen, (size_t)chosen_count, tilt, depth,
+                                    same_place_distance, (size_t)capacity, out_indices);
+    return SDFCCD_OK;
+}

@@ -49,7 +49,7 @@ BulletWorld::BulletWorld(const btVector3& gravity, sdfccd_bullet::Bridge* bridge
     else btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
 }
 
-BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_axis, const BridgeSetup& setup)
+BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_axis)
     : m_opt(opt), m_gravity(gravity), m_up(up_axis)
 {
     up[0] = up[1] = up[2] = 0;
@@ -59,41 +59,11 @@ BulletScene::BulletScene(const Options& opt, const btVector3& gravity, int up_ax
     cfg.query.method = opt.method;
     cfg.query.subdivision = opt.subdivision ? 1 : 0;
     if (opt.margin >= 0) cfg.contact_margin = opt.margin;
-    cfg.patch_band = std::isnan(opt.patch_band) ? setup.patch_band : opt.patch_band;
-    const double sds = std::isnan(opt.spread_depth_scale) ? setup.spread_depth_scale : opt.spread_depth_scale;
-    if (sds >= 0) {
-        cfg.spread_depth_scale = sds; // the scale used as given
-        cfg.spread_depth_fraction = 0;
-    }
-    if (opt.spread_depth_fraction >= 0) cfg.spread_depth_fraction = opt.spread_depth_fraction;
-    // --patch-band -1 (B < 0 given) is Bullet's single 4-point manifold: no extra points either.
-    if (!std::isnan(opt.patch_band) && opt.patch_band < 0) cfg.extra_manifolds = 0;
-    if (opt.extra_manifolds >= 0) cfg.extra_manifolds = opt.extra_manifolds;
-    if (opt.kick >= 0) cfg.kick_angular_speed = opt.kick;
-    if (opt.cover_depth >= 0) cfg.cover_depth = opt.cover_depth;
     if (!std::isnan(opt.guard)) cfg.guard_tolerance = opt.guard > 0 ? opt.guard : 0;
-    const double face = std::isnan(opt.face_search) ? setup.face_search : opt.face_search;
-    cfg.face_search_size = face > 0 ? face : 0;
-    if (opt.discrete_subdivision_scale >= 0) cfg.discrete_subdivision_scale = opt.discrete_subdivision_scale;
     if (opt.batch_threads >= 1) cfg.batch_threads = opt.batch_threads;
     ccd_margin = cfg.contact_margin;
     if (!opt.stock) m_bridge.reset(new sdfccd_bullet::Bridge(cfg)); // before the world, destroyed after it
-    if (m_bridge && cfg.patch_band >= 0) {
-        char buf[96];
-        std::snprintf(buf, sizeof buf, " [patch manifold, band %g m]", cfg.patch_band);
-        m_description += buf;
-    }
     if (m_bridge && !(cfg.guard_tolerance > 0)) m_description += " [guarantee off]";
-    if (m_bridge && sds >= 0) {
-        char buf[96];
-        std::snprintf(buf, sizeof buf, " [spread depth scale %g m]", sds);
-        m_description += buf;
-    }
-    if (m_bridge && cfg.face_search_size > 0 && cfg.query.subdivision) {
-        char buf[96];
-        std::snprintf(buf, sizeof buf, " [face search %g m]", cfg.face_search_size);
-        m_description += buf;
-    }
     m_bullet.reset(new BulletWorld(gravity, m_bridge.get()));
     m_world = &m_bullet->world;
     m_dispatcher = &m_bullet->dispatcher;
@@ -175,7 +145,8 @@ static Frame frameOf(const btTransform& t)
 }
 
 Collider& BulletScene::addStaticSdf(const std::string& name, sdfccd_SdfId sdf, const btVector3& pos, const btQuaternion& rot,
-                                    sdfccd_Aabb bounds, int stock_resolution, sdfccd_SdfId exact, sdfccd_MeshId exact_mesh)
+                                    sdfccd_Aabb bounds, int stock_resolution, sdfccd_SdfId exact, sdfccd_MeshId exact_mesh,
+                                    double feature_size)
 {
     own(sdf);
     if (exact.index1 && (exact.index1 != sdf.index1 || exact.generation != sdf.generation)) own(exact);
@@ -208,6 +179,7 @@ Collider& BulletScene::addStaticSdf(const std::string& name, sdfccd_SdfId sdf, c
         }
     } else {
         sdfccd_bullet::SdfShape* s = new sdfccd_bullet::SdfShape(sdf);
+        s->setFeatureSize(feature_size);
         if (!s->hasFiniteBounds()) s->setLocalBounds(btVector3((btScalar)bounds.lo.x, (btScalar)bounds.lo.y, (btScalar)bounds.lo.z),
                                                      btVector3((btScalar)bounds.hi.x, (btScalar)bounds.hi.y, (btScalar)bounds.hi.z));
         m_shapes.emplace_back(s);

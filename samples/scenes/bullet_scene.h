@@ -36,18 +36,10 @@ struct BulletWorld {
     sdfccd_bullet::Status status = sdfccd_bullet::Status::Ok;
 };
 
-/** A scene's defaults of the bridge set-up, used where Options leaves them NaN (negative: the
- * bridge's own default / off). */
-struct BridgeSetup {
-    double patch_band = -1;         /**< Config::patch_band. */
-    double spread_depth_scale = -1; /**< Config::spread_depth_scale. */
-    double face_search = -1;        /**< Config::face_search_size (<= 0: off). */
-};
-
 class BulletScene : public Scene {
 public:
-    /** `setup`: the scene's defaults of the bridge set-up (BridgeSetup). */
-    BulletScene(const Options& opt, const btVector3& gravity, int up_axis, const BridgeSetup& setup = BridgeSetup());
+    /** A world with the bridge's Config() (the run's method, margin, guarantee and threads aside). */
+    BulletScene(const Options& opt, const btVector3& gravity, int up_axis);
     ~BulletScene() override;
 
     void step(int i, double dt) override;
@@ -65,9 +57,11 @@ public:
     /** A static SDF surface at `pos`/`rot`: SdfShape of `sdf` through the bridge, or (stock) the
      * isosurface of `sdf` inside `bounds` (local frame) at `stock_resolution` cells along the longest
      * axis as a btBvhTriangleMeshShape. `exact`/`exact_mesh` is the measuring reference. The scene
-     * takes ownership of `sdf`, `exact` and `exact_mesh` (destroyed with the scene; `exact` may equal `sdf`). */
+     * takes ownership of `sdf`, `exact` and `exact_mesh` (destroyed with the scene; `exact` may equal `sdf`).
+     * `feature_size`: the SDF's smallest feature (SdfShape::setFeatureSize; 0: none smaller than a face). */
     Collider& addStaticSdf(const std::string& name, sdfccd_SdfId sdf, const btVector3& pos, const btQuaternion& rot,
-                           sdfccd_Aabb bounds, int stock_resolution, sdfccd_SdfId exact, sdfccd_MeshId exact_mesh = sdfccd_MeshId());
+                           sdfccd_Aabb bounds, int stock_resolution, sdfccd_SdfId exact, sdfccd_MeshId exact_mesh = sdfccd_MeshId(),
+                           double feature_size = 0);
     /** A static btSdfCollisionShape read from a .cdf file (bridge variant; stock: the isosurface of
      * `grid`, the same file loaded by sdfccd). `grid` (owned) is also the measuring reference. */
     Collider& addStaticBtSdf(const std::string& name, const std::string& cdf_path, sdfccd_SdfId grid, const btVector3& pos,

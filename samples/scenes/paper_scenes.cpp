@@ -43,27 +43,9 @@ namespace {
 
 const double kPi = 3.14159265358979323846;
 const double kG = 9.81;
-// The bridge's patch manifold (Config::patch_band): 4 more contact points per pair around the
-// deepest one. The paper's simulator constrains every contact it finds; Bullet's manifold holds 4,
-// and with 4 a body resting or landing on several features pivots about the one it has and lets
-// the others in (hoop: 1.7 mm resting, 0.03 mm with the patch). --patch-band -1 turns it off.
-const double kPatchBand = 0.02;
-// The paper's response rule (Section 4, after Eq. 12: the simulation does not advance past a time
-// of impact) is the bridge's guarantee, on by default (Config::guard_tolerance 0.5 mm; off with
-// the DCD baseline). --guard 0 turns it off, --guard T sets its tolerance.
-// The bridge's reduction to manifold points weighs a point's spread against its gap over this
-// depth scale (Config::spread_depth_scale, default 0.3 m). The paper's bodies are centimetres thick
-// (the shuriken 4 mm): at 0.3 m the blade edges at the shuriken's mid-plane, 2 mm above its lower
-// face, spread wider and won the manifold, and the shuriken rested 1.9 mm deep on the ground (0.0
-// at 0.01 m). --spread-depth-scale -1 gives the bridge's default.
-const double kSpreadDepthScale = 0.01;
-// The spike grid's tips are smaller than the coarse box's faces: the library's queries give one
-// point per triangle (Frank-Wolfe from its vertices, which sit between tips) and subdivide only
-// around a point in contact, so a face could land on and sink into tips while its vertices and
-// those points stayed clear (21.7 mm). The bridge's face search (Config::face_search_size) also
-// searches each face region by region down to 2 cm for every point within the step's reach.
-// Part of the subdivision (off with --no-subdivision); --face-search 0 turns it off.
-const double kSpikesFaceSearch = 0.02;
+// The scenes run the bridge's Config(). The paper's response rule (Section 4, after Eq. 12: the
+// simulation does not advance past a time of impact) is the bridge's guarantee, on by default
+// (--guard 0 turns it off, --guard T sets its tolerance; off with the DCD baseline).
 
 // Appends an axis-aligned box (half extents h, centre c) to v/f, triangles counter-clockwise outward.
 void appendBox(std::vector<double>& v, std::vector<uint32_t>& f, const double* h, const double* c)
@@ -125,21 +107,7 @@ Collider& addGround(BulletScene& s, double top, double half = 3)
 
 class PaperScene : public BulletScene {
 public:
-    /** `spread_depth_scale`: the scene's Config::spread_depth_scale (< 0: the bridge's default). */
-    explicit PaperScene(const Options& opt, double spread_depth_scale = kSpreadDepthScale, double face_search = -1)
-        : BulletScene(opt, btVector3(0, 0, (btScalar)-kG), 2, setup(opt, spread_depth_scale, face_search))
-    {
-    }
-
-private:
-    static BridgeSetup setup(const Options&, double spread_depth_scale, double face_search)
-    {
-        BridgeSetup s;
-        s.patch_band = kPatchBand;
-        s.spread_depth_scale = spread_depth_scale;
-        s.face_search = face_search;
-        return s;
-    }
+    explicit PaperScene(const Options& opt) : BulletScene(opt, btVector3(0, 0, (btScalar)-kG), 2) {}
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -247,10 +215,7 @@ public:
 // ---------------------------------------------------------------------------------------------
 class BunnyOnGrid : public PaperScene {
 public:
-    // Depth scale 0.3 m (Config::spread_depth_scale's default, given, so not scaled down by
-    // spread_depth_fraction): with 0.01 m the bunny holds the margin (0.38 mm) but still creeps
-    // 2.3 mm over the last of 200 steps; with 0.3 m it holds (0.57 mm) and settles (0.04 mm).
-    explicit BunnyOnGrid(const Options& opt) : PaperScene(opt, 0.3) {}
+    using PaperScene::PaperScene;
     bool build()
     {
         const Options& o = options();
@@ -323,7 +288,7 @@ public:
 // ---------------------------------------------------------------------------------------------
 class Spikes : public PaperScene {
 public:
-    explicit Spikes(const Options& opt) : PaperScene(opt, kSpreadDepthScale, kSpikesFaceSearch) {}
+    using PaperScene::PaperScene;
     bool build()
     {
         std::shared_ptr<MeshData> box = loadDataMesh(options(), "bullet3/cube.obj", 0.5, "coarse_box");
@@ -332,8 +297,14 @@ public:
         sdfccd_SpikeGridDef def = sdfccd_default_spike_grid_def();
         sdfccd_SdfId spikes{};
         if (sdfccd_create_spike_grid(&def, &spikes) != SDFCCD_OK) return false;
+        // The tips are smaller than the coarse box's faces: the library's queries give one point per
+        // triangle (Frank-Wolfe from its vertices, which sit between tips) and subdivide only around a
+        // point in contact, so a face could sink into tips while its vertices stayed clear (21.7 mm).
+        // The shape states its smallest feature, the cones' base radius; the bridge then searches each
+        // face region by region (SdfShape::setFeatureSize). Part of the subdivision (--no-subdivision).
         Collider& c = addStaticSdf("spike_grid", spikes, btVector3(0, 0, 0), btQuaternion::getIdentity(),
-                                   sdfccd_Aabb{ { -1.05, -1.05, -0.3 }, { 1.05, 1.05, 0.12 } }, 128, spikes);
+                                   sdfccd_Aabb{ { -1.05, -1.05, -0.3 }, { 1.05, 1.05, 0.12 } }, 128, spikes, sdfccd_MeshId(),
+                                   def.base_radius);
         c.killBelow(up, 0.25 + 0.05); // the box's centre within 5 cm of resting on the ground plane
         for (int i = 0; i < def.count_x; ++i) // the tips, measured at the faces' closest points
             for (int j = 0; j < def.count_y; ++j) {

@@ -35,21 +35,8 @@ struct Options {
     bool stock = false;   /**< Bullet scenes: the SDF surfaces as btBvhTriangleMeshShape (no bridge). */
     bool quick = false;   /**< Fewer bodies where a scene is large (the ctest variants; documented per scene). */
     double margin = -1;   /**< Contact margin (m) of the bridge / queries; < 0: the scene's default. */
-    double patch_band = NAN; /**< Bullet scenes: the bridge's Config::patch_band (< 0: off; NaN: the scene's default,
-                                  0.02 in the paper's rigid scenes, off in the Bullet re-creations). */
-    double spread_depth_scale = NAN; /**< Bullet scenes: the bridge's Config::spread_depth_scale (m); < 0: the bridge's
-                                          default (0.3); NaN: the scene's default (0.01 in the paper's rigid scenes). */
-    double face_search = NAN; /**< Bullet scenes: the bridge's Config::face_search_size (m; <= 0: off; NaN: the scene's
-                                   default, 0.02 in the spikes scene, off elsewhere). */
     int solver_iterations = -1; /**< Bullet scenes: btContactSolverInfo::m_numIterations; < 0: the scene's default. */
     double guard = NAN; /**< Bullet scenes: the bridge's Config::guard_tolerance (m); <= 0: off; NaN: its default. */
-    int extra_manifolds = -1;   /**< Bullet scenes: the bridge's Config::extra_manifolds (< 0: its default). */
-    double kick = -1;           /**< Bullet scenes: the bridge's Config::kick_angular_speed (< 0: its default). */
-    double cover_depth = -1;    /**< Bullet scenes: the bridge's Config::cover_depth (< 0: its default). */
-    double spread_depth_fraction = -1; /**< Bullet scenes: the bridge's Config::spread_depth_fraction (< 0: its default, or
-                                            0 when a spread depth scale >= 0 is set; 0: off). */
-    double discrete_subdivision_scale = -1; /**< Bullet scenes: the bridge's Config::discrete_subdivision_scale (< 0: its
-                                                 default; 0: the library's own subdivision). */
     int batch_threads = -1; /**< Bullet scenes: the bridge's Config::batch_threads (< 1: its default, 1). */
     std::string data_dir; /**< The project's data/ folder. */
 };

@@ -29,6 +29,7 @@
 #include <BulletCollision/Gimpact/btGImpactShape.h>
 
 #include "sdfccd_bullet/sdfccd_bullet.h"
+#include "bullet_check.h"
 
 #ifndef SDFCCD_SHURIKEN_OBJ
 #error "SDFCCD_SHURIKEN_OBJ must be defined (path of samples/report/dataset/shuriken.obj)"
@@ -38,25 +39,12 @@ using sdfccd_bullet::Bridge;
 using sdfccd_bullet::SdfShape;
 using sdfccd_bullet::Status;
 
-static int g_pass = 0, g_fail = 0;
-#define CHECK(cond, ...)                                                         \
-    do {                                                                         \
-        if (cond) {                                                              \
-            ++g_pass;                                                            \
-        } else {                                                                 \
-            ++g_fail;                                                            \
-            std::fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            std::fprintf(stderr, __VA_ARGS__);                                   \
-            std::fputc('\n', stderr);                                            \
-        }                                                                        \
-    } while (0)
 
 static const double kDt = 1.0 / 60.0;
 static const double kMass = 0.05;
 static const double kMaxPenetration = 1e-3;
 static const int kSteps = 6;       // the impact comes in the first step; five more after it
 static const int kLattice = 3;     // face points: barycentric lattice with 3 divisions per edge
-static const bool kVerbose = std::getenv("SDFCCD_TEST_VERBOSE") != nullptr;
 
 // ---- the shuriken ----
 struct Shuriken {
@@ -194,24 +182,23 @@ struct Shot {
 
 // Uniform double in [0, 1) from the generator's raw output (std's distributions differ between
 // standard libraries; this mapping does not).
-static double uniform(std::mt19937& g) { return (double)g() / 4294967296.0; }
 
 static Shot makeShot(std::mt19937& g, int target, const Target& T)
 {
     Shot s;
     s.target = target;
-    s.speed = 100 + 400 * uniform(g);
-    s.incidence_deg = 80 * uniform(g);
+    s.speed = 100 + 400 * uniform01(g);
+    s.incidence_deg = 80 * uniform01(g);
     // A uniformly random orientation (Shoemake's method).
-    const double u1 = uniform(g), u2 = uniform(g), u3 = uniform(g);
+    const double u1 = uniform01(g), u2 = uniform01(g), u3 = uniform01(g);
     s.orientation = btQuaternion((btScalar)(std::sqrt(1 - u1) * std::sin(2 * M_PI * u2)), (btScalar)(std::sqrt(1 - u1) * std::cos(2 * M_PI * u2)),
                                  (btScalar)(std::sqrt(u1) * std::sin(2 * M_PI * u3)), (btScalar)(std::sqrt(u1) * std::cos(2 * M_PI * u3)));
     s.orientation.normalize();
-    s.tumbling = uniform(g) < 0.5;
-    s.spin = 200 * uniform(g);
+    s.tumbling = uniform01(g) < 0.5;
+    s.spin = 200 * uniform01(g);
     btVector3 axis = btVector3(0, 0, 1);
     if (s.tumbling) {
-        const double z = 2 * uniform(g) - 1, a = 2 * M_PI * uniform(g), r = std::sqrt(std::max(0.0, 1 - z * z));
+        const double z = 2 * uniform01(g) - 1, a = 2 * M_PI * uniform01(g), r = std::sqrt(std::max(0.0, 1 - z * z));
         axis = btVector3((btScalar)(r * std::cos(a)), (btScalar)(r * std::sin(a)), (btScalar)z);
     } else {
         axis = btMatrix3x3(s.orientation) * axis; // about the shuriken's own axis
@@ -221,12 +208,12 @@ static Shot makeShot(std::mt19937& g, int target, const Target& T)
     const btVector3 n = T.normal;
     btVector3 t1, t2;
     btPlaneSpace1(n, t1, t2);
-    const double az = 2 * M_PI * uniform(g), th = s.incidence_deg * M_PI / 180;
+    const double az = 2 * M_PI * uniform01(g), th = s.incidence_deg * M_PI / 180;
     const btVector3 tangent = t1 * (btScalar)std::cos(az) + t2 * (btScalar)std::sin(az);
     s.dir = (-n * (btScalar)std::cos(th) + tangent * (btScalar)std::sin(th)).normalized();
     // The centre starts clear of the surface (by more than the body's radius) and reaches the aim
     // point within the first step.
-    const double reach = s.speed * kDt * (0.3 + 0.6 * uniform(g));
+    const double reach = s.speed * kDt * (0.3 + 0.6 * uniform01(g));
     const double dist = std::max(reach, (0.05 + 1.1 * T.thickness + 0.04) / std::max(0.17, std::cos(th)));
     s.start = T.hit - s.dir * (btScalar)dist;
     return s;
@@ -420,6 +407,5 @@ int main(int argc, char** argv)
         ++g_fail;
         std::fprintf(stderr, "FAIL: %lld bytes of sdfccd memory still allocated\n", (long long)sdfccd_byte_count());
     }
-    std::printf("%d passed, %d failed\n", g_pass, g_fail);
-    return g_fail == 0 ? 0 : 1;
+    return checkSummary();
 }

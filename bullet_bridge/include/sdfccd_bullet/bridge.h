@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 /** @file bridge.h  Registers sdfccd's triangle-SDF continuous collision detection in Bullet.
  *
- * What it does (Bullet 3.24; see notes/bullet-integration.md for the reasons):
+ * What it does (Bullet 3.24):
  *  - registers ONE collision algorithm, AFTER btGImpactCollisionAlgorithm::registerAlgorithm
  *    (which it calls itself), for these pairs in both body orders, in the contact-point and the
  *    closest-point tables (so contactTest/contactPairTest work):
@@ -11,30 +11,16 @@
  *      as triangles: a box's 12, other shapes' btShapeHull hull;
  *      SdfShape vs SdfShape (Config::sdf_pairs): the moving one's isosurface triangulation
  *      against the other's field.
- *  - the contact model, per pair and step (contact_policy.cpp):
- *      1. a discrete query at the start pose (world transform) with the margin widened by the
- *         step's travel finds every feature that can reach the surface in the step; when its
- *         broad phase culls every triangle the step has no contact and nothing else runs;
- *      2. unless a feature is already within the margin (the step STARTS in contact), one CCD
- *         query (sdfccd_query_mesh) over the step from the start pose to the predicted end pose
- *         (interpolation transform); its whole contact set at the earliest time of impact is
- *         kept (every triangle in the library's TOI window, with subdivision contacts), plus
- *         those triangles' vertices within Config::vertex_distance; no hit, no contact;
- *      2b. whenever the step has any contact, also when it starts in contact, the start-pose
- *         features and those of a discrete query at the predicted end pose; each feature found
- *         is constrained by its own closest surface point at the start of the step
- *         (speculative contacts for the rest of the motion: resting, sliding and tipping over an
- *         edge cannot sink, and a fast body is held by its whole front, not one point);
- *         with Config::query.method DCD (the discrete baseline) step 2 always runs, first;
- *      3. every candidate is expressed at the start of the step (distance = gap along the normal,
- *         negative when penetrating) and the set is reduced to the manifold's 4 points: the
- *         deepest, then the points that maximise the contact polygon's area (as Bullet's
- *         sortCachedPoints and Box2D do), deterministically and never two at one place;
- *      4. points carry over the last step's warm-start impulses when they are the same material
- *         point, and the contact added (CF_CUSTOM_MATERIAL_CALLBACK), processed, started and
- *         ended callbacks fire as for Bullet's own manifolds.
- *    A point with gap d > 0 lets the solver close at most d in the step, so the mesh stops on
- *    the surface in its impact step; such speculative points have restitution 0.
+ *  - the contact model, per pair and step: the features within the step's reach at the start
+ *    pose, the CCD's contact set at the first time of impact of the predicted motion (start pose
+ *    = world transform, end pose = interpolation transform) and the features touching at the end
+ *    pose, each written as a point held by its surface point and normal at the start of the step
+ *    (a speculative contact with gap d > 0 lets the solver close at most d; restitution 0). The
+ *    set is reduced to the manifold's 4 points (deepest, then the largest contact area), and cover
+ *    points (sdfccd_cover_contacts) go into up to three more manifolds where the 4 leave the body
+ *    free to turn into the surface. Points of the same material point as the last step's keep
+ *    their warm-start impulses; Bullet's contact added, processed, started and ended callbacks
+ *    fire as for its own manifolds.
  *  - Bridge::check(world) reports misuse (not registered, registered too late, overwritten,
  *    an SdfShape with a dead handle); while a world steps, Bullet's
  *    GImpact algorithm colliding with an SdfShape (the bridge not in charge) goes to the misuse
@@ -135,67 +121,10 @@ struct Config {
     /** Features within this distance (m) of the SDF count as in contact (the query's margin).
      * Default 0.01 m. Resting bodies hover at distance 0; the margin keeps their contacts alive. */
     double contact_margin = 0.01;
-    /** Contacts written per pair and step, 1..4 (the manifold holds 4). Default 4. */
+    /** Contacts written per pair and step into the pair's first manifold, 1..4 (a Bullet manifold
+     * holds 4). Up to 12 more go into three further manifolds, where the first 4 leave the body free
+     * to sink deeper than guard_tolerance by turning about them. Default 4. */
     int max_contacts = 4;
-    /** The vertices of a triangle in contact that are within this distance (m) of the surface at
-     * the triangle's time of impact are contact candidates too (a face landing flat gives its
-     * corners). Default 0.02 m. */
-    double vertex_distance = 0.02;
-    /** The reduction to 4 points weighs a candidate's spread (distance, area) by
-     * exp(-(its gap - the deepest gap) / scale): points about to touch are preferred to features
-     * that might only reach the surface late in the step. The scale is the smaller of this
-     * (default 0.3 m) and spread_depth_fraction times the mesh's radius. */
-    double spread_depth_scale = 0.3;
-    /** The reduction's depth scale relative to the mesh's radius (the largest distance of a vertex
-     * from the mesh's origin); <= 0: spread_depth_scale alone. Default 0.1: for a body a few
-     * centimetres across, a fixed 0.3 m scale lets features millimetres above the surface win the
-     * manifold by their larger spread (a 9 cm torus lying flat held its outer rim 4-6 mm up
-     * instead of its bottom ring in contact, stood on one point and wobbled like Euler's disk). */
-    double spread_depth_fraction = 0.1;
-    /** Extra manifolds per pair (0..3), for up to 4 more points each. The first 4 points (the
-     * deepest and the points spreading the contact polygon) span the whole candidate set, far
-     * speculative points included, so a body tipping flat can have ONE point in its contact patch,
-     * pivot about it and sink the rest of the patch. The extra points go where the held points
-     * still leave the body free to sink: the candidate that could end deepest, for any rotation
-     * about an axis in the contact plane up to the body's angular speed (relative to the SDF) plus
-     * kick_angular_speed, while every held point ends out of the surface, is held next, until no
-     * candidate could end deeper than cover_depth (see contact_policy.cpp). Default 3. */
-    int extra_manifolds = 3;
-    /** Angular speed (rad/s) a body may gain within a step from contacts solved with it (another
-     * body landing on it, a mesh-mesh pair) on top of its own. It widens the extra points' bound
-     * and the start-pose query's reach (kick_angular_speed x the mesh's radius x dt), and that
-     * query then also runs in steps whose predicted motion has no contact. Default 0: with the
-     * end-of-step projection it changes no penetration figure of the Bullet re-creations, and
-     * 1 rad/s costs the landscape scene about 30% more per step (more queries and candidates);
-     * it lets piles settle sooner (gimpact-demo: rest speed over the last second 0.06 -> 0 m/s). */
-    double kick_angular_speed = 0.0;
-    /** Depth (m) a candidate may reach, under that bound, without being held. Default 0.002. */
-    double cover_depth = 0.002;
-    /** Opt-in (negative: off, the default): the older rule for the extra points, used instead of
-     * the one above: ONE extra manifold with up to 4 points spread over the candidates within
-     * this distance (m) of the deepest gap that the first 4 points leave out (the contact patch
-     * around the deepest point). The paper's rigid scenes (samples/scenes) use 0.02. */
-    double patch_band = -1;
-    /** Opt-in (<= 0: off, the default): the face search. With subdivision on, the mesh's triangles
-     * with an edge longer than this (m) are also searched region by region (split at the edge
-     * midpoints down to regions with no edge longer than it; regions the SDF's Lipschitz bound
-     * shows out of reach are dropped; each leaf's deepest point from the library's DCD), at the
-     * start pose over the step's reach (the DCD baseline: at the end pose within the margin).
-     * The library's queries give one point per triangle and subdivide only around a point in
-     * contact, so a face over SDF features smaller than itself (a coarse box on a spike grid)
-     * can have its vertices and those points clear while features between them pierce it.
-     * Cost: about (edge / size)^2 regions per triangle lying within the reach of a surface (a
-     * face flat on the ground is never dropped), so only for scenes that need it: the paper's
-     * spikes scene uses 0.02. Stats::face_regions counts the regions visited. */
-    double face_search_size = 0;
-    /** In the discrete queries (start and end pose), adaptive subdivision does not split regions
-     * smaller than (discrete_subdivision_scale x the mesh's radius)^2: such regions' points lie
-     * within about that distance of the triangle's vertices, which are contact candidates
-     * already. Large triangles (a bar's face across a torus's two tube tops) still give their
-     * interior contacts. Cuts the landscape's SDF evaluations per step by 2.5x (its 1,002-triangle
-     * tori are no longer subdivided) with the same penetration; the CCD query keeps the library's
-     * subdivision. 0: the library's subdivision_min_area everywhere. Default 0.1. */
-    double discrete_subdivision_scale = 0.1;
     /** The guarantee (m; <= 0: off). When the bridge is registered with a dynamics world
      * (registerWith(btCollisionWorld*)), an action it adds (run after Bullet integrates each step)
      * checks the executed motion of every dynamic body whose swept box meets an SDF's: from its
@@ -233,8 +162,7 @@ struct Config {
     int batch_threads = 1;
     /** Query parameters passed to sdfccd_query_mesh (margin is replaced by contact_margin): the
      * library's defaults except fwgss_restarts (0): the bridge's discrete query over every
-     * feature within the step's travel catches what a restart would correct, for about 20% fewer
-     * SDF evaluations per query (landscape scene). */
+     * feature within the step's travel catches what a restart would correct. */
     sdfccd_QueryParams query;
     /** The defaults stated above. */
     Config() : query(sdfccd_default_query_params()) { query.fwgss_restarts = 0; }
@@ -263,7 +191,7 @@ struct Stats {
                                             start clear by more than its executed motion could close. */
     int64_t guard_bisections = 0;      /**< Poses the CCD let through that the guarantee's discrete check found
                                             deeper than its tolerance (put back by bisection). */
-    int64_t face_regions = 0;          /**< Regions visited by the face search (Config::face_search_size). */
+    int64_t face_regions = 0;          /**< Regions visited by the face search (SdfShape::setFeatureSize). */
     int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
                                             they are counted in queries, end_pose_queries and sdf_evaluations too. */
     int64_t batches = 0;               /**< sdfccd_query_batch calls (Config::batch_threads; up to 3 per step). */
@@ -272,6 +200,7 @@ struct Stats {
 };
 
 class BridgeImpl;
+struct BridgeAccess;
 
 /** The bridge: owns the create functions Bullet's dispatcher points to, the packed copies of
  * GImpact meshes, and the SDF wrappers of btSdfCollisionShape objects.
@@ -341,11 +270,8 @@ public:
     /** Sets every counter of stats() back to its initial value. */
     void resetStats();
 
-    /** The implementation object (internal: for the bridge's own algorithm and tests; its type
-     * is not part of the installed headers). */
-    BridgeImpl* impl() { return m_impl; }
-
 private:
+    friend struct BridgeAccess; // the bridge's own sources reach the implementation through it
     BridgeImpl* m_impl;
 };
 

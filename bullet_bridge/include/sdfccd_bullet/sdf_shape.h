@@ -28,15 +28,6 @@ SDFCCD_BULLET_NAMESPACE_BEGIN
  * to btSdfCollisionShape (a convex body touching any other type-29 shape crashes). */
 const int kDefaultSdfShapeType = FAST_CONCAVE_MESH_PROXYTYPE;
 
-namespace detail {
-/** User data of the non-uniform scaling callback SDF (internal). */
-struct StretchData {
-    sdfccd_SdfId child; /**< The wrapped (unscaled) SDF. */
-    double s[3];        /**< Local scaling along x, y, z. */
-    double smin;        /**< min(s): the factor that keeps the stretched distance a lower bound. */
-};
-}
-
 /** A static or moving Bullet shape whose surface is the zero level set of an sdfccd SDF (any
  * analytic, CSG, grid or callback SDF). Collides with GImpact meshes, convex shapes and other
  * SdfShapes through the bridge's CCD once Bridge::registerWith() was called; with everything else
@@ -78,6 +69,14 @@ public:
     void getLocalBounds(btVector3& lo, btVector3& hi) const;
     /** False when the local box is unbounded (+-BT_LARGE_FLOAT), e.g. a half-space without setLocalBounds(). */
     bool hasFiniteBounds() const;
+
+    /** The size (m, unscaled) of the field's smallest features, e.g. the base radius of a grid of
+     * spikes; 0 (the default) when every feature is larger than the faces of the meshes meeting it.
+     * When positive, the bridge also searches each mesh face region by region down to a part of this
+     * size, so a feature between a face's vertices is found (Stats::face_regions). */
+    void setFeatureSize(double size) { m_featureSize = size > 0 ? size : 0; }
+    /** The feature size times the smallest local scaling factor. */
+    double getFeatureSize() const;
 
     /** Cells along the longest axis of the triangulation grid (default 48). Changing it drops
      * the cached triangulation. */
@@ -132,8 +131,8 @@ private:
     btVector3 m_scaling;
     btScalar m_margin;
     int m_resolution;
+    double m_featureSize = 0;
     mutable sdfccd_SdfId m_scaled; // owned, created on demand
-    mutable detail::StretchData m_stretch; // user data of the non-uniform scaling callback
     mutable bool m_scaledValid;
     // Triangulation (built lazily; Bullet's narrow phase is single-threaded in the Debian build).
     mutable bool m_triangulated;

@@ -160,6 +160,22 @@ typedef struct sdfccd_ContactPoint {
 SDFCCD_API sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
                                                 int32_t* out_indices, int32_t capacity, int32_t* out_count);
 
+/** Cover points: the points to hold after a reduction (sdfccd_reduce_contacts()) where the chosen
+ * ones still leave the body free to sink. A chosen point j with gap g_j keeps a point i of similar
+ * normal (cosine at least 0.9) from ending deeper than g_j + tilt * |i - j| (surface points) while
+ * the body turns by at most `tilt` (m per m, the body's angular speed across the normal times the
+ * step) about an axis in the contact plane; the point whose bound exceeds its own gap by most,
+ * and by more than `depth` (m), is held next, until none is left or `capacity` are written. A point
+ * within `same_place_distance` of a held one is never picked. Ties go to the smaller gap, then the
+ * lower index. Writes the indices into `points` to out_indices[0 .. *out_count - 1], in the order
+ * picked, none of them in `chosen`. No allocation. O(count (chosen_count + capacity) capacity).
+ * Errors (::SDFCCD_INVALID_ARGUMENT): NULL pointers (points / chosen may be NULL with a zero count),
+ * negative counts, an index of `chosen` outside [0, count), tilt, depth or same_place_distance not
+ * finite and >= 0, a non-finite point, normal or gap. */
+SDFCCD_API sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points, int32_t count, const int32_t* chosen,
+                                               int32_t chosen_count, double tilt, double depth, double same_place_distance,
+                                               int32_t* out_indices, int32_t capacity, int32_t* out_count);
+
 /** Settings of contact generation. Must be initialised with sdfccd_default_contact_params(). */
 typedef struct sdfccd_ContactParams {
     sdfccd_QueryParams query;    /**< The CCD of the step (method, caps); `query.margin` is the contact distance: a
