@@ -24,25 +24,14 @@
 #include "sdfccd_bullet/sdfccd_bullet.h"
 #include "sdfccd_bullet/soft_body.h"
 
+#include "bullet_check.h"
+
 using sdfccd_bullet::Bridge;
 using sdfccd_bullet::SdfShape;
 using sdfccd_bullet::Status;
 
-static int g_pass = 0, g_fail = 0;
-#define CHECK(cond, ...)                                                         \
-    do {                                                                         \
-        if (cond) {                                                              \
-            ++g_pass;                                                            \
-        } else {                                                                 \
-            ++g_fail;                                                            \
-            std::fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            std::fprintf(stderr, __VA_ARGS__);                                   \
-            std::fputc('\n', stderr);                                            \
-        }                                                                        \
-    } while (0)
 
 static const double kDt = 1.0 / 60.0;
-static const bool kVerbose = std::getenv("SDFCCD_TEST_VERBOSE") != nullptr;
 
 // A soft-rigid world, z up, with or without the bridge (registered before any body is added).
 struct SoftWorld {
@@ -773,6 +762,5 @@ int main(int argc, char** argv)
     } else {
         ++g_pass;
     }
-    std::printf("%d passed, %d failed\n", g_pass, g_fail);
-    return g_fail == 0 ? 0 : 1;
+    return checkSummary();
 }
