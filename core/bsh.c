@@ -271,6 +271,7 @@ static double field(trav* tr, scc_vec3 x)
 static int march(trav* tr, uint32_t i, uint32_t s, double from, double to, double* out_tc)
 {
     const segment* sg = &tr->seg[s];
+    if (tr->in->mm->node_clear && tr->in->mm->node_clear[i]) return 0; /* proven clear (scc_bsh_certify) */
     tr->stats->nodes_visited += 1;
     scc_vec3 A = centre_at(tr, i, sg->ta, &sg->q[0], &sg->p[0]);
     scc_vec3 M = centre_at(tr, i, sg->tm, &sg->q[1], &sg->p[1]);
@@ -316,6 +317,7 @@ static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void
     double te = t_end;
     while (n && ok) {
         uint32_t i = stack[--n];
+        if (tr->in->mm->node_clear && tr->in->mm->node_clear[i]) continue; /* proven clear (scc_bsh_certify) */
         tr->stats->nodes_visited += 1;
         scc_vec3 c = centre_at(tr, i, t_end, &q, &p);
         double clear = (field(tr, c) - tr->in->p->margin) / tr->lipschitz - node_radius(tr, i) * (1.0 + 1e-12);
@@ -447,4 +449,63 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
     }
     scc_ws_adopt(ws, SCC_WS_HEAP, heap.a, heap.cap * sizeof(item));
     return ok;
+}
+
+/* The certificate of one node and, where it fails, of its children (scc_bsh_certify). */
+typedef struct cert_ctx {
+    const scc_bsh* bsh;
+    const scc_mesh_motion* mm;
+    const scc_sdf* sdf;
+    double level, lipschitz, lin, ang; /* lin = |v| T, ang = |w| T */
+    scc_quat q0, q1;
+    scc_vec3 p0, p1;
+    uint8_t* clear;
+    int64_t evals, left;
+} cert_ctx;
+
+static void certify_node(cert_ctx* c, uint32_t i)
+{
+    const scc_bsh_node* n = &c->bsh->nodes[i];
+    const scc_mesh_motion* mm = c->mm;
+    scc_vec3 x0 = scc_sdf_frame_point(mm->sdf, mm->t0, scc_add(scc_quat_rotate(c->q0, n->center), c->p0));
+    scc_vec3 x1 = scc_sdf_frame_point(mm->sdf, mm->t1, scc_add(scc_quat_rotate(c->q1, n->center), c->p1));
+    double L = c->lin + c->ang * (scc_dist(n->center, mm->body->c_local) + n->radius);
+    double low = 0.5 * (scc_sdf_eval(c->sdf, x0, NULL) + scc_sdf_eval(c->sdf, x1, NULL) - c->lipschitz * (2.0 * n->radius + L));
+    c->evals += 2;
+    if (low > c->level) { /* NaN fails */
+        c->clear[i] = 1;
+        return;
+    }
+    c->clear[i] = 0;
+    if (n->is_leaf) {
+        c->left += 1;
+        return;
+    }
+    certify_node(c, n->first);
+    certify_node(c, n->first + 1);
+}
+
+int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, uint8_t* clear,
+                        int64_t* io_evals)
+{
+    if (!bsh || !bsh->node_count || !mm->body) return -1;
+    if (mm->sdf && (scc_len2(mm->sdf->v) > 0.0 || scc_len2(mm->sdf->w) > 0.0)) return -1; /* a moving SDF frame */
+    cert_ctx c;
+    c.bsh = bsh;
+    c.mm = mm;
+    c.sdf = sdf;
+    c.level = level;
+    c.lipschitz = sdf->lipschitz > 0.0 ? sdf->lipschitz : 1.0;
+    double T = fabs(mm->t1 - mm->t0);
+    c.lin = scc_len(mm->body->v) * T;
+    c.ang = scc_len(mm->body->w) * T;
+    c.lin += 1e-12 * (1.0 + c.lin); /* rounding of the poses */
+    scc_rigid_pose_at(mm->body, mm->t0, &c.q0, &c.p0);
+    scc_rigid_pose_at(mm->body, mm->t1, &c.q1, &c.p1);
+    c.clear = clear;
+    c.evals = 0;
+    c.left = 0;
+    certify_node(&c, 0);
+    *io_evals += c.evals;
+    return c.left;
 }

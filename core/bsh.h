@@ -93,4 +93,17 @@ typedef int scc_bsh_visit_fn(void* user, uint32_t triangle, double t_candidate, 
 int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_mesh_query_in* in, double t_end,
                      scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats);
 
+/* The guard's certificate (no CCD): for a rigid motion over [mm->t0, mm->t1] against a static SDF
+ * (or one whose frame does not move), node i of `bsh` is proven clear of phi <= level at every time
+ * when (phi(c0) + phi(c1) - K (2 r + L)) / 2 > level, with c0, c1 its centre at t0 and t1, r its
+ * radius, K the field's Lipschitz bound and L = |v| T + |w| T (|c - centre of rotation| + r) a bound
+ * on the length of the path of any point of the sphere. (Phi along a path of length L from phi0 to
+ * phi1 stays >= (phi0 + phi1 - K L) / 2, and every point of the sphere is within r of the centre.)
+ * Writes clear[i] = 1 for each node so proven, whose subtree is then skipped (left 0 below it), and
+ * 0 for the others; returns the number of leaves not proven clear (the triangles the CCD must still
+ * check), or -1 when the motion is not one it applies to (nothing written). Adds its SDF evaluations
+ * (two per node visited) to *io_evals. */
+int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, uint8_t* clear,
+                        int64_t* io_evals);
+
 #endif

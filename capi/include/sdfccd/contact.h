@@ -99,6 +99,10 @@ typedef struct sdfccd_GuardResult {
                                     budget ran out, so CLEAR is not proven (ROLLED_BACK still is a real contact). */
     int32_t queries;           /**< Mesh queries run: 1, more when part of the body started deep. */
     int64_t sdf_evaluations;   /**< SDF evaluations, all queries. */
+    int32_t pinned;            /**< sdfccd_guard_step_rigid(): 1 when no time after t0 is safe (the body stays at its
+                                    start pose); 0 otherwise and from sdfccd_guard_rigid(). */
+    int32_t certified;         /**< sdfccd_guard_step_rigid(): 1 when the motion was proven clear without a CCD (or
+                                    did not move relative to a static SDF). */
 } sdfccd_GuardResult;
 
 /** The guarantee: checks the executed motion of a rigid mesh against one SDF (itself possibly moving
@@ -115,6 +119,55 @@ typedef struct sdfccd_GuardResult {
 SDFCCD_API sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
                                             sdfccd_MeshId mesh, const sdfccd_RigidMotion* executed, double t0, double t1,
                                             const sdfccd_GuardParams* params, sdfccd_GuardResult* out);
+
+/** The guarantee as an engine applies it after a step: where to put the body. The same check as
+ * sdfccd_guard_rigid() (same params; rigid motion; `sdf_motion` NULL or the SDF's motion), with:
+ *  - a certificate first, which proves most of a motion clear without a CCD: phi is K-Lipschitz (the
+ *    SDF's bound), so along a point path of length L from phi0 to phi1 the minimum is at least
+ *    (phi0 + phi1 - K L) / 2. Each sphere of the mesh's bounding-sphere hierarchy (radius r) is
+ *    evaluated at its centre at t0 and t1, with L bounded by |v| T + |w| T (distance of its centre
+ *    from the centre of rotation + r); where (phi0 + phi1 - K (2 r + L)) / 2 > -tolerance/2 the
+ *    sphere is clear at every time, and the CCD and the discrete checks below skip it; only the
+ *    triangles near the surface (a resting body's contact) are checked. A motion that does not move
+ *    relative to a static SDF (a sleeping body) is ::SDFCCD_GUARD_CLEAR at no cost. The certificate
+ *    applies when the SDF does not move (`sdf_motion` NULL or with zero velocities); it is exact, as
+ *    sure as the SDF's Lipschitz bound;
+ *  - the safe time: when a point reaches -tolerance, the body goes back further, to the first time
+ *    a point reached -tolerance/2 (so that the next step starts shallower than the tolerance);
+ *  - a discrete check of the pose at that time (the deepest point of every triangle near the
+ *    surface, DCD): if a point is deeper than the tolerance there (what the CCD's local search
+ *    missed), the safe time is bisected (12 halvings of [t0, toi]) to the last time that check
+ *    finds no point deeper than tolerance/2. `out->pinned` is 1 when that time is t0.
+ * Tolerance semantics: at `safe_pose` no point the CCD or the discrete check finds is deeper than
+ * the tolerance; a body not rolled back took no such point deeper than the tolerance (a triangle
+ * that starts deeper: its own level, see ::sdfccd_GuardResult) in the step. A body that starts deep
+ * (::SDFCCD_GUARD_INSIDE_AT_START) is left to the contacts. Errors: as sdfccd_guard_rigid(). */
+SDFCCD_API sdfccd_Status sdfccd_guard_step_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                                 sdfccd_MeshId mesh, const sdfccd_RigidMotion* executed, double t0, double t1,
+                                                 const sdfccd_GuardParams* params, sdfccd_GuardResult* out);
+
+/** A rigid body's velocity state (world frame), for sdfccd_guard_response(). */
+typedef struct sdfccd_BodyState {
+    sdfccd_Vec3 center;            /**< Centre of mass (m), at the safe pose. */
+    sdfccd_Vec3 linear_velocity;   /**< Of the centre of mass (m/s). */
+    sdfccd_Vec3 angular_velocity;  /**< rad/s. */
+    double inverse_mass;           /**< 1/kg, >= 0 (0: immovable). */
+    double inverse_inertia[9];     /**< World inverse inertia tensor, row-major (symmetric, positive semi-definite). */
+} sdfccd_BodyState;
+
+/** The velocity a body leaves with after sdfccd_guard_step_rigid() rolled it back (`result`; any
+ * other state leaves `body` unchanged). The SDF's body `sdf_body` (NULL: static) counts as
+ * infinitely heavy. Pinned: the body takes the SDF body's motion (at rest relative to it).
+ * Otherwise, when `repeated` is nonzero (the body was rolled back in the previous step too: its
+ * contacts did not stop it), it loses its velocity into the surface at `result->point` along
+ * `result->normal`: first its centre's, then, if that point still approaches (a spin), an inelastic
+ * impulse there along the normal makes the approach zero, with Coulomb friction (`friction` >= 0)
+ * reducing the point's tangential velocity by at most friction times that impulse. A body rolled
+ * back for the first time keeps its velocity: the next step starts in contact and its contacts take
+ * the impact. Errors (::SDFCCD_INVALID_ARGUMENT): NULL result or body, non-finite values, a negative
+ * friction or inverse mass. */
+SDFCCD_API sdfccd_Status sdfccd_guard_response(const sdfccd_GuardResult* result, int32_t repeated, const sdfccd_BodyState* sdf_body,
+                                               double friction, sdfccd_BodyState* body);
 
 /** Which feature of the mesh a contact point lies on (from its barycentric weights, 1e-6). */
 typedef enum sdfccd_FeatureKind {
