@@ -456,6 +456,8 @@ typedef struct cert_ctx {
     const scc_bsh* bsh;
     const scc_mesh_motion* mm;
     const scc_sdf* sdf;
+    const scc_params* dcd; /* the second stage's local search at leaves (NULL: none) */
+    int refine;
     double level, lipschitz, lin, ang; /* lin = |v| T, ang = |w| T */
     scc_quat q0, q1;
     scc_vec3 p0, p1;
@@ -467,11 +469,30 @@ static void certify_node(cert_ctx* c, uint32_t i)
 {
     const scc_bsh_node* n = &c->bsh->nodes[i];
     const scc_mesh_motion* mm = c->mm;
+    if (c->refine && c->clear[i]) return; /* proven over a longer interval */
     scc_vec3 x0 = scc_sdf_frame_point(mm->sdf, mm->t0, scc_add(scc_quat_rotate(c->q0, n->center), c->p0));
     scc_vec3 x1 = scc_sdf_frame_point(mm->sdf, mm->t1, scc_add(scc_quat_rotate(c->q1, n->center), c->p1));
     double L = c->lin + c->ang * (scc_dist(n->center, mm->body->c_local) + n->radius);
     double low = 0.5 * (scc_sdf_eval(c->sdf, x0, NULL) + scc_sdf_eval(c->sdf, x1, NULL) - c->lipschitz * (2.0 * n->radius + L));
     c->evals += 2;
+    if (!(low > c->level) && n->is_leaf && c->dcd) {
+        /* Second stage: the triangle's deepest point at t0 (DCD, Section 3.2) less the farthest any
+         * of its points moves: phi stays above it over the whole interval. */
+        scc_tri_motion m;
+        scc_tri_state s0, s1;
+        scc_mesh_triangle_motion(mm, n->first, &m);
+        scc_tri_state_at(&m, mm->t0, &s0);
+        scc_dcd_result d0 = scc_dcd(c->sdf, s0.x, c->dcd);
+        c->evals += d0.evals;
+        low = d0.phi - c->lipschitz * L;
+        if (!(low > c->level) && d0.phi - 0.5 * c->lipschitz * L > c->level) {
+            /* and at t1: every point's path runs from >= phi_min(t0) to >= phi_min(t1) */
+            scc_tri_state_at(&m, mm->t1, &s1);
+            scc_dcd_result d1 = scc_dcd(c->sdf, s1.x, c->dcd);
+            c->evals += d1.evals;
+            low = 0.5 * (d0.phi + d1.phi - c->lipschitz * L);
+        }
+    }
     if (low > c->level) { /* NaN fails */
         c->clear[i] = 1;
         return;
@@ -485,8 +506,8 @@ static void certify_node(cert_ctx* c, uint32_t i)
     certify_node(c, n->first + 1);
 }
 
-int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, uint8_t* clear,
-                        int64_t* io_evals)
+int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, const scc_params* dcd, int refine,
+                        uint8_t* clear, int64_t* io_evals)
 {
     if (!bsh || !bsh->node_count || !mm->body) return -1;
     if (mm->sdf && (scc_len2(mm->sdf->v) > 0.0 || scc_len2(mm->sdf->w) > 0.0)) return -1; /* a moving SDF frame */
@@ -494,6 +515,8 @@ int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc
     c.bsh = bsh;
     c.mm = mm;
     c.sdf = sdf;
+    c.dcd = dcd;
+    c.refine = refine;
     c.level = level;
     c.lipschitz = sdf->lipschitz > 0.0 ? sdf->lipschitz : 1.0;
     double T = fabs(mm->t1 - mm->t0);

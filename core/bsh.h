@@ -99,11 +99,14 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
  * radius, K the field's Lipschitz bound and L = |v| T + |w| T (|c - centre of rotation| + r) a bound
  * on the length of the path of any point of the sphere. (Phi along a path of length L from phi0 to
  * phi1 stays >= (phi0 + phi1 - K L) / 2, and every point of the sphere is within r of the centre.)
- * Writes clear[i] = 1 for each node so proven, whose subtree is then skipped (left 0 below it), and
- * 0 for the others; returns the number of leaves not proven clear (the triangles the CCD must still
- * check), or -1 when the motion is not one it applies to (nothing written). Adds its SDF evaluations
- * (two per node visited) to *io_evals. */
-int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, uint8_t* clear,
-                        int64_t* io_evals);
+ * With `dcd` (not NULL), a leaf that fails gets a second stage: its triangle's deepest point at t0
+ * by DCD (params `dcd`), phi_min, and it is clear when phi_min - K L > level (as sure as that
+ * local search, like the CCD it replaces). Writes clear[i] = 1 for each node so proven, whose
+ * subtree is then skipped, and 0 for the others; returns the number of leaves not proven clear
+ * (the triangles the CCD must still check), or -1 when the motion is not one it applies to (nothing
+ * written). `refine`: `clear` already holds this certificate for a longer interval from the same
+ * t0; nodes proven there are kept. Adds its SDF evaluations to *io_evals. */
+int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, const scc_params* dcd, int refine,
+                        uint8_t* clear, int64_t* io_evals);
 
 #endif

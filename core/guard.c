@@ -126,6 +126,7 @@ static int deep_at(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
     dp.method = SCC_METHOD_DCD;
     dp.margin = level;
     dp.contact_slop = 0.0;
+    dp.subdivision = 0; /* a yes/no question: the deepest point per triangle is enough */
     scc_query_summary s;
     if (!scc_query_mesh_ws(sdf, &m, &dp, ws, c, 1, &s)) return 0;
     *evals += s.evals;
@@ -150,11 +151,12 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
         return 1;
     }
     const scc_bsh* bsh = mm->mesh->bsh;
+    uint8_t* flags = NULL;
     if (bsh && p->broad_phase) {
-        uint8_t* flags = scc_ws_get(ws, SCC_WS_CERTIFIED, bsh->node_count);
+        flags = scc_ws_get(ws, SCC_WS_CERTIFIED, bsh->node_count);
         if (!flags) return 0;
         int64_t evals = 0;
-        out->uncertified = scc_bsh_certify(bsh, &run, sdf, -0.5 * tolerance, flags, &evals);
+        out->uncertified = scc_bsh_certify(bsh, &run, sdf, -0.5 * tolerance, p, 0, flags, &evals);
         if (out->uncertified == 0) {
             out->evals = evals;
             out->certified = 1;
@@ -172,6 +174,8 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
     if (out->state == SCC_GUARD_ROLLED_BACK && out->toi > mm->t0) {
         scc_mesh_motion h = run;
         h.t1 = out->toi;
+        if (run.node_clear) /* the certificate over the shorter interval proves more (flags refined in place) */
+            (void)scc_bsh_certify(bsh, &h, sdf, -0.5 * tolerance, p, 1, flags, &out->evals);
         scc_guard_out half;
         if (!scc_guard(sdf, &h, p, 0.5 * tolerance, ws, &half)) return 0;
         out->evals += half.evals;
@@ -193,7 +197,16 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
         out->normal = c.normal;
         out->triangle = c.triangle;
         double lo = mm->t0, hi = out->toi;
-        for (int it = 0; it < 12; ++it) {
+        /* Already deeper than half the tolerance at t0 (a body the contacts hold slightly deep): no
+         * later time can be shown safe by this check; the body stays at its start. */
+        if (!deep_at(sdf, &run, p, mm->t0, -0.5 * tolerance, ws, &c, &found, &out->evals)) return 0;
+        if (found) {
+            out->point = c.point;
+            out->normal = c.normal;
+            out->triangle = c.triangle;
+            hi = lo;
+        }
+        for (int it = 0; it < 12 && hi > lo; ++it) {
             const double mid = 0.5 * (lo + hi);
             if (!deep_at(sdf, &run, p, mid, -0.5 * tolerance, ws, &c, &found, &out->evals)) return 0;
             if (found) {
