@@ -457,10 +457,9 @@ typedef struct cert_ctx {
     const scc_mesh_motion* mm;
     const scc_sdf* sdf;
     const scc_params* dcd; /* the second stage's local search at leaves (NULL: none) */
-    int refine;
-    double level, lipschitz, lin, ang; /* lin = |v| T, ang = |w| T */
-    scc_quat q0, q1;
-    scc_vec3 p0, p1;
+    double level, lipschitz, lin, ang, tm; /* lin = |v| T, ang = |w| T, tm the middle of the interval */
+    scc_quat q;
+    scc_vec3 p;                            /* the pose at tm */
     uint8_t* clear;
     int64_t evals, left;
 } cert_ctx;
@@ -469,29 +468,20 @@ static void certify_node(cert_ctx* c, uint32_t i)
 {
     const scc_bsh_node* n = &c->bsh->nodes[i];
     const scc_mesh_motion* mm = c->mm;
-    if (c->refine && c->clear[i]) return; /* proven over a longer interval */
-    scc_vec3 x0 = scc_sdf_frame_point(mm->sdf, mm->t0, scc_add(scc_quat_rotate(c->q0, n->center), c->p0));
-    scc_vec3 x1 = scc_sdf_frame_point(mm->sdf, mm->t1, scc_add(scc_quat_rotate(c->q1, n->center), c->p1));
-    double L = c->lin + c->ang * (scc_dist(n->center, mm->body->c_local) + n->radius);
-    double low = 0.5 * (scc_sdf_eval(c->sdf, x0, NULL) + scc_sdf_eval(c->sdf, x1, NULL) - c->lipschitz * (2.0 * n->radius + L));
-    c->evals += 2;
+    scc_vec3 x = scc_sdf_frame_point(mm->sdf, c->tm, scc_add(scc_quat_rotate(c->q, n->center), c->p));
+    double half_path = 0.5 * (c->lin + c->ang * (scc_dist(n->center, mm->body->c_local) + n->radius));
+    double low = scc_sdf_eval(c->sdf, x, NULL) - c->lipschitz * (n->radius + half_path);
+    c->evals += 1;
     if (!(low > c->level) && n->is_leaf && c->dcd) {
-        /* Second stage: the triangle's deepest point at t0 (DCD, Section 3.2) less the farthest any
-         * of its points moves: phi stays above it over the whole interval. */
+        /* Second stage: the triangle's deepest point at tm (DCD, Section 3.2) less the farthest any
+         * of its points moves in half the interval. */
         scc_tri_motion m;
-        scc_tri_state s0, s1;
+        scc_tri_state st;
         scc_mesh_triangle_motion(mm, n->first, &m);
-        scc_tri_state_at(&m, mm->t0, &s0);
-        scc_dcd_result d0 = scc_dcd(c->sdf, s0.x, c->dcd);
-        c->evals += d0.evals;
-        low = d0.phi - c->lipschitz * L;
-        if (!(low > c->level) && d0.phi - 0.5 * c->lipschitz * L > c->level) {
-            /* and at t1: every point's path runs from >= phi_min(t0) to >= phi_min(t1) */
-            scc_tri_state_at(&m, mm->t1, &s1);
-            scc_dcd_result d1 = scc_dcd(c->sdf, s1.x, c->dcd);
-            c->evals += d1.evals;
-            low = 0.5 * (d0.phi + d1.phi - c->lipschitz * L);
-        }
+        scc_tri_state_at(&m, c->tm, &st);
+        scc_dcd_result d = scc_dcd(c->sdf, st.x, c->dcd);
+        c->evals += d.evals;
+        low = d.phi - c->lipschitz * half_path;
     }
     if (low > c->level) { /* NaN fails */
         c->clear[i] = 1;
@@ -506,7 +496,7 @@ static void certify_node(cert_ctx* c, uint32_t i)
     certify_node(c, n->first + 1);
 }
 
-int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, const scc_params* dcd, int refine,
+int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, const scc_params* dcd,
                         uint8_t* clear, int64_t* io_evals)
 {
     if (!bsh || !bsh->node_count || !mm->body) return -1;
@@ -516,15 +506,14 @@ int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc
     c.mm = mm;
     c.sdf = sdf;
     c.dcd = dcd;
-    c.refine = refine;
     c.level = level;
     c.lipschitz = sdf->lipschitz > 0.0 ? sdf->lipschitz : 1.0;
     double T = fabs(mm->t1 - mm->t0);
     c.lin = scc_len(mm->body->v) * T;
     c.ang = scc_len(mm->body->w) * T;
     c.lin += 1e-12 * (1.0 + c.lin); /* rounding of the poses */
-    scc_rigid_pose_at(mm->body, mm->t0, &c.q0, &c.p0);
-    scc_rigid_pose_at(mm->body, mm->t1, &c.q1, &c.p1);
+    c.tm = 0.5 * (mm->t0 + mm->t1);
+    scc_rigid_pose_at(mm->body, c.tm, &c.q, &c.p);
     c.clear = clear;
     c.evals = 0;
     c.left = 0;

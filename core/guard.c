@@ -111,6 +111,8 @@ int scc_guard(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p
     scc_sdf_eval(sdf, out->point, &out->normal);
     out->normal = scc_normalize_or(out->normal, first->normal);
     out->triangle = first->triangle;
+    memcpy(out->bary, first->bary, sizeof out->bary);
+    out->level = lv;
     out->state = SCC_GUARD_ROLLED_BACK;
     return 1;
 }
@@ -156,7 +158,7 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
         flags = scc_ws_get(ws, SCC_WS_CERTIFIED, bsh->node_count);
         if (!flags) return 0;
         int64_t evals = 0;
-        out->uncertified = scc_bsh_certify(bsh, &run, sdf, -0.5 * tolerance, p, 0, flags, &evals);
+        out->uncertified = scc_bsh_certify(bsh, &run, sdf, -0.5 * tolerance, p, flags, &evals);
         if (out->uncertified == 0) {
             out->evals = evals;
             out->certified = 1;
@@ -171,25 +173,27 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
     out->evals += cert_evals;
     out->uncertified = uncertified;
     if (out->state == SCC_GUARD_INSIDE_AT_START) return 1; /* left to the contacts */
+    double check_level = -tolerance;
     if (out->state == SCC_GUARD_ROLLED_BACK && out->toi > mm->t0) {
-        scc_mesh_motion h = run;
-        h.t1 = out->toi;
-        if (run.node_clear) /* the certificate over the shorter interval proves more (flags refined in place) */
-            (void)scc_bsh_certify(bsh, &h, sdf, -0.5 * tolerance, p, 1, flags, &out->evals);
-        scc_guard_out half;
-        if (!scc_guard(sdf, &h, p, 0.5 * tolerance, ws, &half)) return 0;
-        out->evals += half.evals;
-        out->queries += half.queries;
-        if (half.state == SCC_GUARD_ROLLED_BACK) {
-            out->toi = half.toi;
-            out->point = half.point;
-            out->normal = half.normal;
-            out->triangle = half.triangle;
-        }
+        /* Back to where the first point was half the tolerance above the level it reached. */
+        scc_contact first;
+        memset(&first, 0, sizeof first);
+        first.triangle = out->triangle;
+        memcpy(first.bary, out->bary, sizeof first.bary);
+        first.toi = out->toi;
+        const double speed = scc_mesh_speed_bound(&run);
+        const double time_tol = speed > 0.0 ? fmin(p->time_tol, 0.1 * tolerance / speed) : p->time_tol;
+        out->toi = safe_time(sdf, &run, &first, out->level + 0.5 * tolerance, time_tol, &out->evals);
+        scc_tri_motion m;
+        scc_mesh_triangle_motion(&run, out->triangle, &m);
+        out->point = scc_tri_point_at(&m, out->bary, out->toi, NULL);
+        out->evals += 1;
+        scc_sdf_eval(sdf, out->point, &out->normal);
+        check_level = -0.5 * tolerance;
     }
     scc_contact c;
     int found = 0;
-    if (!deep_at(sdf, &run, p, out->toi, -tolerance, ws, &c, &found, &out->evals)) return 0;
+    if (!deep_at(sdf, &run, p, out->toi, check_level, ws, &c, &found, &out->evals)) return 0;
     if (found) {
         out->bisections = 1;
         out->state = SCC_GUARD_ROLLED_BACK;

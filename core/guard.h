@@ -13,6 +13,8 @@ typedef struct scc_guard_out {
     double toi;              /* the safe time: t1 unless ROLLED_BACK */
     scc_vec3 point, normal;  /* ROLLED_BACK: the first point to reach its level, and grad phi there, at toi */
     uint32_t triangle;       /* ROLLED_BACK: its triangle */
+    double bary[3];          /* ROLLED_BACK by the CCD: the point's weights on the triangle */
+    double level;            /* ROLLED_BACK by the CCD: the level it reached (-tolerance, lower if it started deep) */
     double min_gap_start;    /* smallest phi at t0 of a contact the queries saw (INFINITY: none) */
     scc_state query_state;   /* state of the last mesh query */
     int64_t evals;           /* SDF evaluations, all queries */
@@ -35,13 +37,14 @@ int scc_guard(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p
  * (0) A motion that does not move relative to a static SDF is CLEAR (nothing gets deeper).
  * (1) The certificate (scc_bsh_certify) at level -tolerance/2 proves the nodes of the mesh's BSH
  *     that stay clear; when all do, CLEAR without a CCD; otherwise the checks below skip them.
- * (2) scc_guard at the tolerance. A rollback goes back further, to where a point first reached
- *     -tolerance/2 (scc_guard over [t0, toi] at half the tolerance), so that the body starts the
- *     next step shallower than the tolerance.
+ * (2) scc_guard at the tolerance. A rollback goes back further, to where the point that reached
+ *     the level first was half the tolerance higher, so that the body starts the next step
+ *     shallower than the tolerance.
  * (3) The pose at the safe time is checked with the discrete query (another local search: it
- *     catches what the CCD missed, e.g. a large triangle reaching the surface in two places);
- *     deeper than the tolerance, the safe time is bisected (12 halvings) down to the last time the
- *     discrete query finds no point deeper than -tolerance/2; `pinned` when that is t0.
+ *     catches what the CCD missed, e.g. a large triangle reaching the surface in two places) at
+ *     -tolerance (-tolerance/2 after a rollback); a point found there sends the body back: pinned
+ *     at t0 when the start pose has a point below -tolerance/2, else to the last time that check
+ *     finds none (bisection, 12 halvings); `pinned` when that is t0.
  * INSIDE_AT_START returns after (2) (left to the contacts). Rigid motion only (mm->body). */
 int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, double tolerance, scc_workspace* ws,
                    scc_guard_out* out);
