@@ -452,6 +452,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
 }
 
 /* The certificate of one node and, where it fails, of its children (scc_bsh_certify). */
+enum { CERT_TIME_SPLITS = 2 };
 typedef struct cert_ctx {
     const scc_bsh* bsh;
     const scc_mesh_motion* mm;
@@ -464,6 +465,22 @@ typedef struct cert_ctx {
     int64_t evals, left;
 } cert_ctx;
 
+/* Second stage at a leaf over [ta, tb]: the triangle's deepest point at the middle time (DCD,
+ * Section 3.2) less K times the farthest any of its points moves in half the interval (half_path);
+ * where that fails with the deepest point still above the level, each half of the interval is
+ * tried the same way (at most `splits` times deep). */
+static int leaf_clear(cert_ctx* c, const scc_tri_motion* m, double ta, double tb, double half_path, int splits)
+{
+    scc_tri_state st;
+    scc_tri_state_at(m, 0.5 * (ta + tb), &st);
+    scc_dcd_result d = scc_dcd(c->sdf, st.x, c->dcd);
+    c->evals += d.evals;
+    if (d.phi - c->lipschitz * half_path > c->level) return 1;
+    if (splits <= 0 || !(d.phi > c->level)) return 0;
+    const double mid = 0.5 * (ta + tb);
+    return leaf_clear(c, m, ta, mid, 0.5 * half_path, splits - 1) && leaf_clear(c, m, mid, tb, 0.5 * half_path, splits - 1);
+}
+
 static void certify_node(cert_ctx* c, uint32_t i)
 {
     const scc_bsh_node* n = &c->bsh->nodes[i];
@@ -473,15 +490,9 @@ static void certify_node(cert_ctx* c, uint32_t i)
     double low = scc_sdf_eval(c->sdf, x, NULL) - c->lipschitz * (n->radius + half_path);
     c->evals += 1;
     if (!(low > c->level) && n->is_leaf && c->dcd) {
-        /* Second stage: the triangle's deepest point at tm (DCD, Section 3.2) less the farthest any
-         * of its points moves in half the interval. */
         scc_tri_motion m;
-        scc_tri_state st;
         scc_mesh_triangle_motion(mm, n->first, &m);
-        scc_tri_state_at(&m, c->tm, &st);
-        scc_dcd_result d = scc_dcd(c->sdf, st.x, c->dcd);
-        c->evals += d.evals;
-        low = d.phi - c->lipschitz * half_path;
+        if (leaf_clear(c, &m, mm->t0, mm->t1, half_path, CERT_TIME_SPLITS)) low = INFINITY;
     }
     if (low > c->level) { /* NaN fails */
         c->clear[i] = 1;

@@ -101,7 +101,8 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
  *     phi(c(tm)) - K (r + h) > level,   d = |c - centre of rotation| + r,
  * K the field's Lipschitz bound. With `dcd` (not NULL), a leaf that fails gets a second stage: its
  * triangle's deepest point at tm by DCD (params `dcd`), phi_min, and it is clear when
- * phi_min - K h > level (as sure as that local search, like the CCD it replaces). Writes clear[i] = 1
+ * phi_min - K h > level (as sure as that local search, like the CCD it replaces); where that fails
+ * with phi_min > level, each half of the interval is tried the same way (h halves), twice deep. Writes clear[i] = 1
  * for each node so proven, whose subtree is then skipped, and 0 for the others; returns the number
  * of leaves not proven clear (the triangles the CCD must still check), or -1 when the motion is not
  * one it applies to (nothing written). Adds its SDF evaluations (one per node, plus the DCDs) to
