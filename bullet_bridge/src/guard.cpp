@@ -10,8 +10,6 @@
 // velocities).
 #include "internal.h"
 
-#include <cmath>
-
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
 using namespace detail;
@@ -46,8 +44,7 @@ void sweptBox(const btCollisionShape* s, const btTransform& t0, const btTransfor
     btVector3 c;
     btScalar r;
     s->getBoundingSphere(c, r);
-    const btScalar R = c.length() + r;
-    const btVector3 e(R, R, R);
+    const btVector3 e = btVector3(1, 1, 1) * (c.length() + r);
     btVector3 slo = t0.getOrigin(), shi = t0.getOrigin();
     slo.setMin(t1.getOrigin());
     shi.setMax(t1.getOrigin());
@@ -74,6 +71,17 @@ void leaves(const btCollisionShape* s, const btTransform& offset, std::vector<st
     out.push_back(std::make_pair(s, offset));
 }
 
+sdfccd_BodyState bodyState(const btRigidBody* b)
+{
+    sdfccd_BodyState s;
+    s.center = v3(b->getCenterOfMassPosition());
+    s.linear_velocity = v3(b->getLinearVelocity());
+    s.angular_velocity = v3(b->getAngularVelocity());
+    s.inverse_mass = (double)b->getInvMass();
+    for (int k = 0; k < 9; ++k) s.inverse_inertia[k] = (double)b->getInvInertiaTensorWorld()[k / 3][k % 3];
+    return s;
+}
+
 } // namespace
 
 sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out)
@@ -82,25 +90,6 @@ sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const 
     return sdfccd_rigid_motion_from_poses(&pa, &pb, v3(c), 0, dt, out);
 }
 
-btTransform poseAt(const sdfccd_RigidMotion& m, double t)
-{
-    const btQuaternion q0((btScalar)m.pose.orientation.x, (btScalar)m.pose.orientation.y, (btScalar)m.pose.orientation.z,
-                          (btScalar)m.pose.orientation.w);
-    const btVector3 w = bt(m.angular_velocity);
-    const double ang = (double)w.length() * t;
-    btQuaternion dq(0, 0, 0, 1);
-    if (ang > 0) dq = btQuaternion(w.normalized(), (btScalar)ang);
-    const btQuaternion q = dq * q0;
-    const btVector3 lc = bt(m.local_center);
-    const btVector3 g0 = bt(m.pose.position) + quatRotate(q0, lc);
-    const btVector3 g = g0 + bt(m.linear_velocity) * (btScalar)t;
-    btTransform r(q.normalized(), g - quatRotate(q.normalized(), lc));
-    return r;
-}
-
-} // namespace detail
-
-namespace detail {
 
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world)
 {
@@ -129,23 +118,6 @@ void BridgeImpl::snapshotStartPoses(const btCollisionWorld* world)
     for (int i = 0; i < objs.size(); ++i) start_poses[(size_t)i] = std::make_pair(static_cast<const btCollisionObject*>(objs[i]), objs[i]->getWorldTransform());
 }
 
-namespace {
-
-sdfccd_BodyState bodyState(const btRigidBody* b)
-{
-    sdfccd_BodyState s;
-    s.center = v3(b->getCenterOfMassPosition());
-    s.linear_velocity = v3(b->getLinearVelocity());
-    s.angular_velocity = v3(b->getAngularVelocity());
-    s.inverse_mass = (double)b->getInvMass();
-    const btMatrix3x3& I = b->getInvInertiaTensorWorld();
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) s.inverse_inertia[3 * r + c] = (double)I[r][c];
-    return s;
-}
-
-} // namespace
-
 void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
 {
     const btCollisionObjectArray& objs = world->getCollisionObjectArray();
@@ -171,12 +143,12 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         gp.tolerance = cfg.guard_tolerance;
         gp.query.fwgss_restarts = cfg.query.fwgss_restarts; // the bridge's (0): the core's discrete check backs it
         // The SDFs and the boxes they sweep in the step.
-        struct SdfObject {
+        struct SdfObject { // the SDF's motion: a static one still has its pose (NULL would mean the world origin)
             const btCollisionObject* co;
             sdfccd_SdfId sdf;
             btTransform t0, t1;
             btVector3 lo, hi;
-            sdfccd_RigidMotion motion; // the SDF's (a static one still has its pose: NULL would mean the world origin)
+            sdfccd_RigidMotion motion;
         };
         std::vector<SdfObject> sdfs;
         for (int i = 0; i < objs.size(); ++i) {
@@ -206,16 +178,15 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             startOf(i, t0);
             const btTransform t1 = body->getWorldTransform();
             const btCollisionShape* shape = body->getCollisionShape();
-            btVector3 lo, hi;
+            btVector3 lo, hi, pad = btVector3(1, 1, 1) * (btScalar)gp.tolerance;
             sweptBox(shape, t0, t1, lo, hi);
-            const btVector3 pad((btScalar)gp.tolerance, (btScalar)gp.tolerance, (btScalar)gp.tolerance);
             lo -= pad;
             hi += pad;
             parts.clear();
-            sdfccd_GuardResult best;
-            best.state = SDFCCD_GUARD_CLEAR;
+            sdfccd_GuardResult best = sdfccd_GuardResult();
             best.toi = dt;
             const SdfObject* best_sdf = nullptr;
+            btTransform best_part;
             for (const SdfObject& o : sdfs) {
                 if (o.co == body || !overlaps(lo, hi, o.lo, o.hi)) continue;
                 if (t0 == t1 && o.t0 == o.t1) { // neither moved (a sleeping body): nothing went deeper
@@ -227,11 +198,10 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     if (part.first == o.co->getCollisionShape() || !isMeshLike(part.first)) continue;
                     const MeshEntry* me = shapes.meshFor(part.first);
                     if (!me) continue;
-                    const btTransform inv = part.second.inverse();
                     sdfccd_RigidMotion mm;
                     sdfccd_GuardResult r;
                     stats.guard_queries++;
-                    if (motionFromPoses(t0 * part.second, t1 * part.second, inv.getOrigin(), dt, &mm) != SDFCCD_OK ||
+                    if (motionFromPoses(t0 * part.second, t1 * part.second, part.second.inverse().getOrigin(), dt, &mm) != SDFCCD_OK ||
                         sdfccd_guard_step_rigid(workspace, o.sdf, &o.motion, me->id, &mm, 0, dt, &gp, &r) != SDFCCD_OK) {
                         stats.query_errors++;
                         continue;
@@ -241,24 +211,24 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     if (r.state == SDFCCD_GUARD_ROLLED_BACK && r.toi < best.toi) {
                         best = r;
                         best_sdf = &o;
+                        best_part = part.second;
                     }
                 }
             }
             if (!best_sdf) continue;
-            // Back to the safe time along the executed motion (the body's own frame), then the
-            // velocity (sdfccd_guard_response: kept the first time; lost into the surface when the
-            // body was rolled back in the previous step as well; pinned: at rest relative to the SDF).
-            sdfccd_RigidMotion bm;
-            if (motionFromPoses(t0, t1, btVector3(0, 0, 0), dt, &bm) != SDFCCD_OK) continue;
-            body->setCenterOfMassTransform(poseAt(bm, best.toi));
+            // The safe pose (of the part that hit first: the body's follows), then the velocity
+            // (sdfccd_guard_response; "again": rolled back in the previous step as well).
+            const sdfccd_Quat& q = best.safe_pose.orientation;
+            body->setCenterOfMassTransform(btTransform(btQuaternion((btScalar)q.x, (btScalar)q.y, (btScalar)q.z, (btScalar)q.w).normalized(),
+                                                       bt(best.safe_pose.position)) * best_part.inverse());
             auto last = last_rollback.find(body);
             const bool again = last != last_rollback.end() && last->second == guard_step - 1;
             last_rollback[body] = guard_step;
             const btRigidBody* sb = btRigidBody::upcast(best_sdf->co);
             const sdfccd_BodyState ss = sb ? bodyState(sb) : sdfccd_BodyState();
             sdfccd_BodyState bs = bodyState(body);
-            if (sdfccd_guard_response(&best, again, sb ? &ss : nullptr, (double)(body->getFriction() * best_sdf->co->getFriction()), &bs) ==
-                SDFCCD_OK) {
+            const double mu = (double)(body->getFriction() * best_sdf->co->getFriction());
+            if (sdfccd_guard_response(&best, again, sb ? &ss : nullptr, mu, &bs) == SDFCCD_OK) {
                 body->setLinearVelocity(bt(bs.linear_velocity));
                 body->setAngularVelocity(bt(bs.angular_velocity));
             }
