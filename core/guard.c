@@ -175,7 +175,6 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
     if (out->state == SCC_GUARD_INSIDE_AT_START) return 1; /* left to the contacts */
     double check_level = -tolerance;
     if (out->state == SCC_GUARD_ROLLED_BACK && out->toi > mm->t0) {
-        /* Back to where the first point was half the tolerance above the level it reached. */
         scc_contact first;
         memset(&first, 0, sizeof first);
         first.triangle = out->triangle;
@@ -183,7 +182,21 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
         first.toi = out->toi;
         const double speed = scc_mesh_speed_bound(&run);
         const double time_tol = speed > 0.0 ? fmin(p->time_tol, 0.1 * tolerance / speed) : p->time_tol;
-        out->toi = safe_time(sdf, &run, &first, out->level + 0.5 * tolerance, time_tol, &out->evals);
+        /* The first time a point was at -tolerance/2: the check at half the tolerance over [t0, toi]
+         * (the CCD), else the first point's own time at that level. */
+        scc_mesh_motion h = run;
+        h.t1 = first.toi;
+        scc_guard_out half;
+        if (!scc_guard(sdf, &h, p, 0.5 * tolerance, ws, &half)) return 0;
+        out->evals += half.evals;
+        out->queries += half.queries;
+        if (half.state == SCC_GUARD_ROLLED_BACK) {
+            out->toi = half.toi;
+            out->triangle = half.triangle;
+            memcpy(out->bary, half.bary, sizeof out->bary);
+        } else {
+            out->toi = safe_time(sdf, &run, &first, out->level + 0.5 * tolerance, time_tol, &out->evals);
+        }
         scc_tri_motion m;
         scc_mesh_triangle_motion(&run, out->triangle, &m);
         out->point = scc_tri_point_at(&m, out->bary, out->toi, NULL);

@@ -37,9 +37,9 @@ int scc_guard(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p
  * (0) A motion that does not move relative to a static SDF is CLEAR (nothing gets deeper).
  * (1) The certificate (scc_bsh_certify) at level -tolerance/2 proves the nodes of the mesh's BSH
  *     that stay clear; when all do, CLEAR without a CCD; otherwise the checks below skip them.
- * (2) scc_guard at the tolerance. A rollback goes back further, to where the point that reached
- *     the level first was half the tolerance higher, so that the body starts the next step
- *     shallower than the tolerance.
+ * (2) scc_guard at the tolerance. A rollback goes back further, to the first time a point was at
+ *     -tolerance/2 (scc_guard over [t0, toi] at half the tolerance; else the first point's own time
+ *     at that level), so that the body starts the next step shallower than the tolerance.
  * (3) The pose at the safe time is checked with the discrete query (another local search: it
  *     catches what the CCD missed, e.g. a large triangle reaching the surface in two places) at
  *     -tolerance (-tolerance/2 after a rollback); a point found there sends the body back: pinned

@@ -124,20 +124,26 @@ SDFCCD_API sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId s
  * sdfccd_guard_rigid() (same params; rigid motion; `sdf_motion` NULL or the SDF's motion), with:
  *  - a certificate first, which proves most of a motion clear without a CCD: phi is K-Lipschitz (the
  *    SDF's bound), so along a point path of length L from phi0 to phi1 the minimum is at least
- *    (phi0 + phi1 - K L) / 2. Each sphere of the mesh's bounding-sphere hierarchy (radius r) is
- *    evaluated at its centre at t0 and t1, with L bounded by |v| T + |w| T (distance of its centre
- *    from the centre of rotation + r); where (phi0 + phi1 - K (2 r + L)) / 2 > -tolerance/2 the
- *    sphere is clear at every time, and the CCD and the discrete checks below skip it; only the
- *    triangles near the surface (a resting body's contact) are checked. A motion that does not move
+ *    (phi0 + phi1 - K L) / 2; with every point's speed bounded by |v| + |w| d (d its distance from
+ *    the centre of rotation), a point stays within h = (|v| + |w| d) T / 2 of where it is at the
+ *    middle of the step. Each sphere of the mesh's bounding-sphere hierarchy (centre c, radius r)
+ *    is evaluated once, at c at the middle time: where phi(c) - K (r + h) > -tolerance/2 the sphere
+ *    is clear at every time of the step, and the CCD and the discrete checks below skip it. A leaf
+ *    that fails is tried with its triangle's deepest point at the middle time (DCD) less K h, and
+ *    where that fails above the level, on each half of the step the same way (twice deep): that
+ *    stage is as sure as the DCD's local search, the same kind of search as the CCD it replaces.
+ *    Only the triangles near the surface that move (a sliding body's contact) reach the CCD. A motion that does not move
  *    relative to a static SDF (a sleeping body) is ::SDFCCD_GUARD_CLEAR at no cost. The certificate
- *    applies when the SDF does not move (`sdf_motion` NULL or with zero velocities); it is exact, as
- *    sure as the SDF's Lipschitz bound;
+ *    applies when the SDF does not move (`sdf_motion` NULL or with zero velocities); its first stage
+ *    is exact, as sure as the SDF's Lipschitz bound;
  *  - the safe time: when a point reaches -tolerance, the body goes back further, to the first time
  *    a point reached -tolerance/2 (so that the next step starts shallower than the tolerance);
- *  - a discrete check of the pose at that time (the deepest point of every triangle near the
- *    surface, DCD): if a point is deeper than the tolerance there (what the CCD's local search
- *    missed), the safe time is bisected (12 halvings of [t0, toi]) to the last time that check
- *    finds no point deeper than tolerance/2. `out->pinned` is 1 when that time is t0.
+ *  - a discrete check of the pose at that time (the deepest point of every triangle the certificate
+ *    left, DCD): if a point is deeper than the tolerance there (half the tolerance after a rollback;
+ *    what the CCD's local search missed), the body stays at its start pose when that pose already
+ *    has a point deeper than tolerance/2, else the safe time is bisected (12 halvings of [t0, toi])
+ *    to the last time that check finds no point deeper than tolerance/2. `out->pinned` is 1 when
+ *    the safe time is t0.
  * Tolerance semantics: at `safe_pose` no point the CCD or the discrete check finds is deeper than
  * the tolerance; a body not rolled back took no such point deeper than the tolerance (a triangle
  * that starts deeper: its own level, see ::sdfccd_GuardResult) in the step. A body that starts deep
