@@ -132,8 +132,9 @@ SDFCCD_API sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId s
  *    that fails is tried with its triangle's deepest point at the middle time (DCD) less K h, and
  *    where that fails above the level, on each half of the step the same way (twice deep): that
  *    stage is as sure as the DCD's local search, the same kind of search as the CCD it replaces.
- *    Only the triangles near the surface that move (a sliding body's contact) reach the CCD. A motion that does not move
- *    relative to a static SDF (a sleeping body) is ::SDFCCD_GUARD_CLEAR at no cost. The certificate
+ *    Only the triangles near the surface that move (a sliding body's contact) reach the CCD. A
+ *    motion that does not move relative to a static SDF (a sleeping body) is ::SDFCCD_GUARD_CLEAR at
+ *    no cost. The certificate
  *    applies when the SDF does not move (`sdf_motion` NULL or with zero velocities); its first stage
  *    is exact, as sure as the SDF's Lipschitz bound;
  *  - the safe time: when a point reaches -tolerance, the body goes back further, to the first time
@@ -144,9 +145,11 @@ SDFCCD_API sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId s
  *    has a point deeper than tolerance/2, else the safe time is bisected (12 halvings of [t0, toi])
  *    to the last time that check finds no point deeper than tolerance/2. `out->pinned` is 1 when
  *    the safe time is t0.
- * Tolerance semantics: at `safe_pose` no point the CCD or the discrete check finds is deeper than
- * the tolerance; a body not rolled back took no such point deeper than the tolerance (a triangle
- * that starts deeper: its own level, see ::sdfccd_GuardResult) in the step. A body that starts deep
+ * Tolerance semantics: CLEAR: no point went below -tolerance at any time of the step (a triangle
+ * that starts deeper: below its own level, see ::sdfccd_GuardResult), as far as the certificate (exact
+ * up to its DCD stage), the CCD and the discrete check at t1 can see. ROLLED_BACK: no point went
+ * below -tolerance before `toi`, and at `safe_pose` the discrete check finds no point below
+ * -tolerance/2, except when pinned at a start pose that already had one. A body that starts deep
  * (::SDFCCD_GUARD_INSIDE_AT_START) is left to the contacts. Errors: as sdfccd_guard_rigid(). */
 SDFCCD_API sdfccd_Status sdfccd_guard_step_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
                                                  sdfccd_MeshId mesh, const sdfccd_RigidMotion* executed, double t0, double t1,
