@@ -271,6 +271,7 @@ static double field(trav* tr, scc_vec3 x)
 static int march(trav* tr, uint32_t i, uint32_t s, double from, double to, double* out_tc)
 {
     const segment* sg = &tr->seg[s];
+    if (tr->in->mm->node_clear && tr->in->mm->node_clear[i]) return 0; /* proven clear (scc_bsh_certify) */
     tr->stats->nodes_visited += 1;
     scc_vec3 A = centre_at(tr, i, sg->ta, &sg->q[0], &sg->p[0]);
     scc_vec3 M = centre_at(tr, i, sg->tm, &sg->q[1], &sg->p[1]);
@@ -316,6 +317,7 @@ static int traverse_static(trav* tr, double t_end, scc_bsh_visit_fn* visit, void
     double te = t_end;
     while (n && ok) {
         uint32_t i = stack[--n];
+        if (tr->in->mm->node_clear && tr->in->mm->node_clear[i]) continue; /* proven clear (scc_bsh_certify) */
         tr->stats->nodes_visited += 1;
         scc_vec3 c = centre_at(tr, i, t_end, &q, &p);
         double clear = (field(tr, c) - tr->in->p->margin) / tr->lipschitz - node_radius(tr, i) * (1.0 + 1e-12);
@@ -447,4 +449,86 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
     }
     scc_ws_adopt(ws, SCC_WS_HEAP, heap.a, heap.cap * sizeof(item));
     return ok;
+}
+
+/* The certificate of one node and, where it fails, of its children (scc_bsh_certify). */
+enum { CERT_TIME_SPLITS = 2 };
+typedef struct cert_ctx {
+    const scc_bsh* bsh;
+    const scc_mesh_motion* mm;
+    const scc_sdf* sdf;
+    const scc_params* dcd; /* the second stage's local search at leaves (NULL: none) */
+    double level, lipschitz, lin, ang, tm; /* lin = |v| T, ang = |w| T, tm the middle of the interval */
+    scc_quat q;
+    scc_vec3 p;                            /* the pose at tm */
+    uint8_t* clear;
+    int64_t evals, left;
+} cert_ctx;
+
+/* Second stage at a leaf over [ta, tb]: the triangle's deepest point at the middle time (DCD,
+ * Section 3.2) less K times the farthest any of its points moves in half the interval (half_path);
+ * where that fails with the deepest point still above the level, each half of the interval is
+ * tried the same way (at most `splits` times deep). */
+static int leaf_clear(cert_ctx* c, const scc_tri_motion* m, double ta, double tb, double half_path, int splits)
+{
+    scc_tri_state st;
+    scc_tri_state_at(m, 0.5 * (ta + tb), &st);
+    scc_dcd_result d = scc_dcd(c->sdf, st.x, c->dcd);
+    c->evals += d.evals;
+    if (d.phi - c->lipschitz * half_path > c->level) return 1;
+    if (splits <= 0 || !(d.phi > c->level)) return 0;
+    const double mid = 0.5 * (ta + tb);
+    return leaf_clear(c, m, ta, mid, 0.5 * half_path, splits - 1) && leaf_clear(c, m, mid, tb, 0.5 * half_path, splits - 1);
+}
+
+static void certify_node(cert_ctx* c, uint32_t i)
+{
+    const scc_bsh_node* n = &c->bsh->nodes[i];
+    const scc_mesh_motion* mm = c->mm;
+    scc_vec3 x = scc_sdf_frame_point(mm->sdf, c->tm, scc_add(scc_quat_rotate(c->q, n->center), c->p));
+    double half_path = 0.5 * (c->lin + c->ang * (scc_dist(n->center, mm->body->c_local) + n->radius));
+    double low = scc_sdf_eval(c->sdf, x, NULL) - c->lipschitz * (n->radius + half_path);
+    c->evals += 1;
+    if (!(low > c->level) && n->is_leaf && c->dcd) {
+        scc_tri_motion m;
+        scc_mesh_triangle_motion(mm, n->first, &m);
+        if (leaf_clear(c, &m, mm->t0, mm->t1, half_path, CERT_TIME_SPLITS)) low = INFINITY;
+    }
+    if (low > c->level) { /* NaN fails */
+        c->clear[i] = 1;
+        return;
+    }
+    c->clear[i] = 0;
+    if (n->is_leaf) {
+        c->left += 1;
+        return;
+    }
+    certify_node(c, n->first);
+    certify_node(c, n->first + 1);
+}
+
+int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, const scc_params* dcd,
+                        uint8_t* clear, int64_t* io_evals)
+{
+    if (!bsh || !bsh->node_count || !mm->body) return -1;
+    if (mm->sdf && (scc_len2(mm->sdf->v) > 0.0 || scc_len2(mm->sdf->w) > 0.0)) return -1; /* a moving SDF frame */
+    cert_ctx c;
+    c.bsh = bsh;
+    c.mm = mm;
+    c.sdf = sdf;
+    c.dcd = dcd;
+    c.level = level;
+    c.lipschitz = sdf->lipschitz > 0.0 ? sdf->lipschitz : 1.0;
+    double T = fabs(mm->t1 - mm->t0);
+    c.lin = scc_len(mm->body->v) * T;
+    c.ang = scc_len(mm->body->w) * T;
+    c.lin += 1e-12 * (1.0 + c.lin); /* rounding of the poses */
+    c.tm = 0.5 * (mm->t0 + mm->t1);
+    scc_rigid_pose_at(mm->body, c.tm, &c.q, &c.p);
+    c.clear = clear;
+    c.evals = 0;
+    c.left = 0;
+    certify_node(&c, 0);
+    *io_evals += c.evals;
+    return c.left;
 }

@@ -93,4 +93,21 @@ typedef int scc_bsh_visit_fn(void* user, uint32_t triangle, double t_candidate, 
 int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_mesh_query_in* in, double t_end,
                      scc_bsh_visit_fn* visit, void* user, scc_bsh_stats* stats);
 
+/* The guard's certificate (no CCD): for a rigid motion over [mm->t0, mm->t1] (T long) against a
+ * static SDF (or one whose frame does not move), every point of the body moves at a speed of at most
+ * |v| + |w| d (d its distance from the centre of rotation), so within T/2 of the middle time tm it
+ * stays within h = (|v| T + |w| T d) / 2 of where it is at tm. Node i of `bsh` (centre c, radius r)
+ * is therefore proven clear of phi <= level at every time of the interval when
+ *     phi(c(tm)) - K (r + h) > level,   d = |c - centre of rotation| + r,
+ * K the field's Lipschitz bound. With `dcd` (not NULL), a leaf that fails gets a second stage: its
+ * triangle's deepest point at tm by DCD (params `dcd`), phi_min, and it is clear when
+ * phi_min - K h > level (as sure as that local search, like the CCD it replaces); where that fails
+ * with phi_min > level, each half of the interval is tried the same way (h halves), twice deep. Writes clear[i] = 1
+ * for each node so proven, whose subtree is then skipped, and 0 for the others; returns the number
+ * of leaves not proven clear (the triangles the CCD must still check), or -1 when the motion is not
+ * one it applies to (nothing written). Adds its SDF evaluations (one per node, plus the DCDs) to
+ * *io_evals. */
+int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, const scc_params* dcd,
+                        uint8_t* clear, int64_t* io_evals);
+
 #endif

@@ -125,6 +125,10 @@ typedef struct scc_mesh_motion {
      * with; -INFINITY leaves the triangle out. Used by the guard (guard.c); the FWGSS vertex traces are
      * then kept per triangle, since a vertex's neighbours may have different levels. */
     const double* tri_margin;
+    /* Optional per-node flags of mesh->bsh (NULL: none): a node flagged 1 is proven clear of every
+     * level of the query over the whole motion (scc_bsh_certify, bsh.h), so the broad phase skips it
+     * and its subtree. Only read when the broad phase runs on mesh->bsh. */
+    const uint8_t* node_clear;
 } scc_mesh_motion;
 
 /* The inputs of one mesh query: the field, the mesh's motion, the parameters and the scratch

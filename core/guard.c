@@ -11,6 +11,7 @@
  * level -tolerance. The CCD is local, so a triangle can still report a contact at t0 at its lowered
  * level; it is lowered again to what the query saw, and after GUARD_ROUNDS such rounds left out. */
 #include "guard.h"
+#include "bsh.h"
 
 #include <string.h>
 
@@ -110,6 +111,185 @@ int scc_guard(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p
     scc_sdf_eval(sdf, out->point, &out->normal);
     out->normal = scc_normalize_or(out->normal, first->normal);
     out->triangle = first->triangle;
+    memcpy(out->bary, first->bary, sizeof out->bary);
+    out->level = lv;
     out->state = SCC_GUARD_ROLLED_BACK;
     return 1;
+}
+
+/* A point of the mesh at or below `level` at time t by the discrete query (its first contact in *c). */
+static int deep_at(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, double t, double level, scc_workspace* ws,
+                   scc_contact* c, int* found, int64_t* evals)
+{
+    scc_mesh_motion m = *mm;
+    m.tri_margin = NULL;
+    m.t1 = t; /* the rigid pose at t */
+    scc_params dp = *p;
+    dp.method = SCC_METHOD_DCD;
+    dp.margin = level;
+    dp.contact_slop = 0.0;
+    dp.subdivision = 0; /* a yes/no question: the deepest point per triangle is enough */
+    scc_query_summary s;
+    if (!scc_query_mesh_ws(sdf, &m, &dp, ws, c, 1, &s)) return 0;
+    *evals += s.evals;
+    *found = s.hit && s.contacts_written > 0;
+    return 1;
+}
+
+int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, double tolerance, scc_workspace* ws,
+                   scc_guard_out* out)
+{
+    scc_mesh_motion run = *mm;
+    run.node_clear = NULL;
+    memset(out, 0, sizeof *out);
+    out->min_gap_start = INFINITY;
+    out->toi = mm->t1;
+    out->state = SCC_GUARD_CLEAR;
+    out->uncertified = -1;
+    const int sdf_still = !mm->sdf || (scc_len2(mm->sdf->v) == 0.0 && scc_len2(mm->sdf->w) == 0.0);
+    if (!mm->body) return 0;
+    if (sdf_still && scc_len2(mm->body->v) == 0.0 && scc_len2(mm->body->w) == 0.0) {
+        out->certified = 1;
+        return 1;
+    }
+    const scc_bsh* bsh = mm->mesh->bsh;
+    uint8_t* flags = NULL;
+    if (bsh && p->broad_phase) {
+        flags = scc_ws_get(ws, SCC_WS_CERTIFIED, bsh->node_count);
+        if (!flags) return 0;
+        int64_t evals = 0;
+        out->uncertified = scc_bsh_certify(bsh, &run, sdf, -0.5 * tolerance, p, flags, &evals);
+        if (out->uncertified == 0) {
+            out->evals = evals;
+            out->certified = 1;
+            return 1;
+        }
+        if (out->uncertified > 0) run.node_clear = flags;
+        out->evals = evals;
+    }
+    const int64_t cert_evals = out->evals;
+    const int64_t uncertified = out->uncertified;
+    if (!scc_guard(sdf, &run, p, tolerance, ws, out)) return 0;
+    out->evals += cert_evals;
+    out->uncertified = uncertified;
+    if (out->state == SCC_GUARD_INSIDE_AT_START) return 1; /* left to the contacts */
+    double check_level = -tolerance;
+    if (out->state == SCC_GUARD_ROLLED_BACK && out->toi > mm->t0) {
+        scc_contact first;
+        memset(&first, 0, sizeof first);
+        first.triangle = out->triangle;
+        memcpy(first.bary, out->bary, sizeof first.bary);
+        first.toi = out->toi;
+        const double speed = scc_mesh_speed_bound(&run);
+        const double time_tol = speed > 0.0 ? fmin(p->time_tol, 0.1 * tolerance / speed) : p->time_tol;
+        /* The first time a point was at -tolerance/2: the check at half the tolerance over [t0, toi]
+         * (the CCD), else the first point's own time at that level. */
+        scc_mesh_motion h = run;
+        h.t1 = first.toi;
+        scc_guard_out half;
+        if (!scc_guard(sdf, &h, p, 0.5 * tolerance, ws, &half)) return 0;
+        out->evals += half.evals;
+        out->queries += half.queries;
+        if (half.state == SCC_GUARD_ROLLED_BACK) {
+            out->toi = half.toi;
+            out->triangle = half.triangle;
+            memcpy(out->bary, half.bary, sizeof out->bary);
+        } else {
+            out->toi = safe_time(sdf, &run, &first, out->level + 0.5 * tolerance, time_tol, &out->evals);
+        }
+        scc_tri_motion m;
+        scc_mesh_triangle_motion(&run, out->triangle, &m);
+        out->point = scc_tri_point_at(&m, out->bary, out->toi, NULL);
+        out->evals += 1;
+        scc_sdf_eval(sdf, out->point, &out->normal);
+        check_level = -0.5 * tolerance;
+    }
+    scc_contact c;
+    int found = 0;
+    if (!deep_at(sdf, &run, p, out->toi, check_level, ws, &c, &found, &out->evals)) return 0;
+    if (found) {
+        out->bisections = 1;
+        out->state = SCC_GUARD_ROLLED_BACK;
+        out->point = c.point;
+        out->normal = c.normal;
+        out->triangle = c.triangle;
+        double lo = mm->t0, hi = out->toi;
+        /* Already deeper than half the tolerance at t0 (a body the contacts hold slightly deep): no
+         * later time can be shown safe by this check; the body stays at its start. */
+        if (!deep_at(sdf, &run, p, mm->t0, -0.5 * tolerance, ws, &c, &found, &out->evals)) return 0;
+        if (found) {
+            out->point = c.point;
+            out->normal = c.normal;
+            out->triangle = c.triangle;
+            hi = lo;
+        }
+        for (int it = 0; it < 12 && hi > lo; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            if (!deep_at(sdf, &run, p, mid, -0.5 * tolerance, ws, &c, &found, &out->evals)) return 0;
+            if (found) {
+                hi = mid;
+                out->point = c.point;
+                out->normal = c.normal;
+                out->triangle = c.triangle;
+            } else {
+                lo = mid;
+            }
+        }
+        out->toi = lo;
+    }
+    if (out->state == SCC_GUARD_ROLLED_BACK) out->normal = scc_normalize_or(out->normal, scc_v3(0, 1, 0));
+    out->pinned = out->state == SCC_GUARD_ROLLED_BACK && !(out->toi > mm->t0);
+    return 1;
+}
+
+static scc_vec3 mat_mul(const double m[9], scc_vec3 a)
+{
+    return scc_v3(m[0] * a.x + m[1] * a.y + m[2] * a.z, m[3] * a.x + m[4] * a.y + m[5] * a.z, m[6] * a.x + m[7] * a.y + m[8] * a.z);
+}
+
+/* Velocity of the body's material point at world x. */
+static scc_vec3 point_velocity(const scc_body_state* b, scc_vec3 x)
+{
+    return scc_add(b->v, scc_cross(b->w, scc_sub(x, b->center)));
+}
+
+/* Impulse j (world) at world point x. */
+static void apply_impulse(scc_body_state* b, scc_vec3 j, scc_vec3 x)
+{
+    b->v = scc_madd(b->v, j, b->inv_mass);
+    b->w = scc_add(b->w, mat_mul(b->inv_inertia, scc_cross(scc_sub(x, b->center), j)));
+}
+
+/* The inverse effective mass of the body at x along unit direction d. */
+static double inv_effective_mass(const scc_body_state* b, scc_vec3 x, scc_vec3 d)
+{
+    scc_vec3 r = scc_sub(x, b->center);
+    return b->inv_mass + scc_dot(d, scc_cross(mat_mul(b->inv_inertia, scc_cross(r, d)), r));
+}
+
+void scc_guard_response(scc_vec3 point, scc_vec3 normal, int pinned, int repeated, const scc_body_state* sdf_body, double mu,
+                        scc_body_state* body)
+{
+    if (pinned) {
+        body->v = sdf_body ? point_velocity(sdf_body, body->center) : scc_v3(0, 0, 0);
+        body->w = sdf_body ? sdf_body->w : scc_v3(0, 0, 0);
+        return;
+    }
+    if (!repeated) return;
+    const scc_vec3 n = normal;
+    const scc_vec3 vs = sdf_body ? point_velocity(sdf_body, point) : scc_v3(0, 0, 0);
+    const double vc = scc_dot(scc_sub(body->v, vs), n);
+    if (vc < 0.0) body->v = scc_madd(body->v, n, -vc);
+    const double vn = scc_dot(scc_sub(point_velocity(body, point), vs), n);
+    const double k = inv_effective_mass(body, point, n);
+    if (!(vn < 0.0) || !(k > 0.0)) return;
+    const double j = -vn / k;
+    apply_impulse(body, scc_scale(n, j), point);
+    scc_vec3 u = scc_sub(point_velocity(body, point), vs);
+    u = scc_madd(u, n, -scc_dot(u, n));
+    const double ul = scc_len(u);
+    if (!(ul > 1e-12) || !(mu > 0.0)) return;
+    const scc_vec3 t = scc_scale(u, 1.0 / ul);
+    const double kt = inv_effective_mass(body, point, t);
+    if (kt > 0.0) apply_impulse(body, scc_scale(t, -fmin(mu * j, ul / kt)), point);
 }

@@ -200,6 +200,8 @@ int main(void)
     OFF(sdfccd_GuardResult, query_state);
     OFF(sdfccd_GuardResult, queries);
     OFF(sdfccd_GuardResult, sdf_evaluations);
+    OFF(sdfccd_GuardResult, pinned);
+    OFF(sdfccd_GuardResult, certified);
     SIZE(sdfccd_ContactPoint);
     OFF(sdfccd_ContactPoint, point);
     OFF(sdfccd_ContactPoint, surface_point);

@@ -38,7 +38,7 @@ static fall_out fall(const scc_sdf* sdf, const scc_mesh* mesh, const scc_params*
     double t = 0.0;
     for (int step = 0; step < 60; ++step) {
         body.t0 = t;
-        scc_mesh_motion mm = { mesh, &body, NULL, NULL, NULL, t, t + DT, NULL };
+        scc_mesh_motion mm = { mesh, &body, NULL, NULL, NULL, t, t + DT, NULL, NULL };
         scc_query_summary s;
         ck_assert(scc_query_mesh(sdf, &mm, p, &k_alloc, out, 64, &s));
         fo.steps = step + 1;

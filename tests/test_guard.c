@@ -695,6 +695,233 @@ START_TEST(test_no_allocation_after_warm_up)
 }
 END_TEST
 
+/* ---- sdfccd_guard_step_rigid: the engine's step (certificate, safe time, discrete check) ---- */
+
+static sdfccd_GuardResult guard_step(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                     const sdfccd_RigidMotion* m, const sdfccd_GuardParams* gp)
+{
+    sdfccd_GuardResult r;
+    ck_assert_msg(sdfccd_guard_step_rigid(ws, sdf, sdf_motion, mesh, m, 0.0, DT, gp, &r) == SDFCCD_OK, "%s", sdfccd_last_error());
+    return r;
+}
+
+/* The rod spun through the thin wall by an applied spin: put back before its TOI (closed form, as in
+ * spin_through_wall), where its first point was half the tolerance higher: no point of the safe pose
+ * deeper than TOL / 2 (brute force), and not more than a few time tolerances before that time. */
+START_TEST(test_step_spun_through_wall)
+{
+    box_mesh rod = make_box(ROD_R, ROD_A, ROD_A, 10, 1, 1);
+    sdfccd_SdfId wall = box_at(v3(0.45, 0.005, 1), v3(0.55, WALL_H + 0.005, 0));
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.angular_velocity = v3(0, 0, 1.5 / DT);
+    const double R = hypot(ROD_R, ROD_A);
+    const double t_full = (asin((WALL_H + TOL) / R) - atan2(ROD_A, ROD_R)) / (1.5 / DT);
+    const double t_half = (asin((WALL_H + 0.5 * TOL) / R) - atan2(ROD_A, ROD_R)) / (1.5 / DT);
+    sdfccd_GuardResult r = guard_step(ws, wall, NULL, rod.id, &m, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    ck_assert_int_eq(r.pinned, 0);
+    ck_assert_int_eq(r.certified, 0);
+    REPORT("%s: toi - half-level time %.3g s, evals %lld\n", __func__, r.toi - t_half, (long long)r.sdf_evaluations);
+    ck_assert_msg(r.toi < t_full && r.toi <= t_half && r.toi >= t_half - 3e-7, "toi %.12g, half-level time %.12g", r.toi, t_half);
+    assert_pose_near(r.safe_pose, pose_at(&m, r.toi), 1e-12);
+    double depth = min_phi_at(wall, &rod, r.safe_pose);
+    ck_assert_msg(depth >= -0.5 * TOL && depth <= -0.4 * TOL, "min phi at the safe pose %.9g", depth);
+    ck_assert_double_near(r.normal.y, -1.0, 1e-9);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    free_box(&rod);
+}
+END_TEST
+
+/* Moving away: CLEAR at the end pose; not moving at all: CLEAR at no cost (certified); sliding 1 cm
+ * above a ground: CLEAR by the certificate alone, with far fewer evaluations than the CCD's check. */
+START_TEST(test_step_clear_and_certified)
+{
+    box_mesh rod = make_box(ROD_R, ROD_A, ROD_A, 10, 1, 1);
+    sdfccd_SdfId wall = box_at(v3(1, 0.005, 1), v3(0, WALL_H + 0.005, 0));
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    sdfccd_Pose start = sdfccd_pose_identity(), end;
+    start.position = v3(0, 0.09 - ROD_A, 0);
+    end.position = v3(0.3, -0.5, 0.1);
+    end.orientation = axis_angle(v3(0.2, 0.1, 1), 2.0);
+    sdfccd_RigidMotion m;
+    ck_assert_int_eq(sdfccd_rigid_motion_from_poses(&start, &end, v3(0, 0, 0), 0.0, DT, &m), SDFCCD_OK);
+    sdfccd_GuardResult r = guard_step(ws, wall, NULL, rod.id, &m, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_CLEAR);
+    ck_assert(r.toi == DT && r.pinned == 0);
+    assert_pose_near(r.safe_pose, end, 1e-12);
+    /* no motion, even touching the wall */
+    sdfccd_RigidMotion still = sdfccd_default_rigid_motion();
+    still.pose.position = v3(0, WALL_H - ROD_A, 0);
+    r = guard_step(ws, wall, NULL, rod.id, &still, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_CLEAR);
+    ck_assert_int_eq(r.certified, 1);
+    ck_assert_int_eq(r.sdf_evaluations, 0);
+    /* sliding along the wall 1 cm below it, turning slowly */
+    sdfccd_RigidMotion slide = sdfccd_default_rigid_motion();
+    slide.pose.position = v3(0, WALL_H - ROD_A - 0.01, 0);
+    slide.linear_velocity = v3(0.6, 0, 0.3);
+    slide.angular_velocity = v3(0, 0.5, 0);
+    r = guard_step(ws, wall, NULL, rod.id, &slide, &gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_CLEAR);
+    ck_assert_int_eq(r.certified, 1);
+    sdfccd_GuardResult full = guard(ws, wall, NULL, rod.id, &slide, &gp);
+    ck_assert_int_eq(full.state, SDFCCD_GUARD_CLEAR);
+    REPORT("%s: sliding: certificate %lld evaluations, CCD check %lld\n", __func__, (long long)r.sdf_evaluations,
+           (long long)full.sdf_evaluations);
+    ck_assert_int_lt(r.sdf_evaluations, full.sdf_evaluations);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
+    free_box(&rod);
+}
+END_TEST
+
+/* Already inside: left to the contacts (INSIDE_AT_START, end pose). Starting 0.3 mm deep (between
+ * TOL / 2 and TOL) and sinking 1 mm: no later time passes the discrete check, pinned at t0. */
+START_TEST(test_step_inside_and_pinned)
+{
+    inside_scene s;
+    inside_setup(&s);
+    s.m.linear_velocity = v3(0.06, 0, 0);
+    sdfccd_GuardResult r = guard_step(s.ws, s.ground, NULL, s.cube.id, &s.m, &s.gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_INSIDE_AT_START);
+    ck_assert(r.toi == DT && r.pinned == 0);
+    assert_pose_near(r.safe_pose, pose_at(&s.m, DT), 1e-12);
+    s.m.pose.position = v3(0, 0.05 - 0.0003, 0);
+    s.m.linear_velocity = v3(0, -0.06, 0);
+    r = guard_step(s.ws, s.ground, NULL, s.cube.id, &s.m, &s.gp);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    ck_assert_int_eq(r.pinned, 1);
+    ck_assert(r.toi == 0.0 && r.fraction == 0.0);
+    assert_pose_near(r.safe_pose, s.m.pose, 1e-12);
+    ck_assert_double_near(r.normal.y, 1.0, 1e-9);
+    inside_teardown(&s);
+}
+END_TEST
+
+/* The certificate against brute force: random motions of a tumbling box near a sphere; whenever the
+ * step says CLEAR, no point (vertices and a barycentric grid, 21 times in the step) went deeper than
+ * TOL; whenever it rolls back, the safe pose has no point deeper than TOL. Both outcomes and both
+ * kinds of CLEAR (certified and not) must occur. */
+START_TEST(test_step_certificate_brute_force)
+{
+    box_mesh cube = make_box(0.05, 0.02, 0.03, 3, 2, 2);
+    sdfccd_SdfId ball;
+    ck_assert_int_eq(sdfccd_create_sphere(0.5, &ball), SDFCCD_OK);
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    uint64_t seed = 12345;
+    int certified = 0, clear_ccd = 0, rolled = 0;
+    for (int k = 0; k < 100; ++k) {
+        double u[9];
+        for (int i = 0; i < 9; ++i) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            u[i] = (double)(seed >> 11) / 9007199254740992.0;
+        }
+        sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+        const double h = 0.5 + 0.066 + 0.01 * (u[0] - 0.3); /* the centre 6 to 7 cm above the surface */
+        m.pose.position = v3(0, h, 0);
+        m.pose.orientation = axis_angle(v3(u[1] - 0.5, u[2] - 0.5, u[3] - 0.5 + 1e-3), 6 * u[4]);
+        m.linear_velocity = v3(3 * (u[5] - 0.5), -3 * u[6], 3 * (u[7] - 0.5));
+        m.angular_velocity = v3(0, 0, 60 * (u[8] - 0.5));
+        if (!(min_phi_grid(ball, &cube, m.pose, 6) > 0.0)) continue; /* starts clear of the surface */
+        sdfccd_GuardResult r = guard_step(ws, ball, NULL, cube.id, &m, &gp);
+        if (r.state == SDFCCD_GUARD_CLEAR) {
+            double lo = INFINITY;
+            for (int i = 0; i <= 20; ++i) lo = fmin(lo, min_phi_grid(ball, &cube, pose_at(&m, DT * i / 20.0), 3));
+            ck_assert_msg(lo > -TOL, "motion %d: CLEAR (certified %d) but a point reached %.9g", k, r.certified, lo);
+            if (r.certified) ++certified;
+            else ++clear_ccd;
+        } else if (r.state == SDFCCD_GUARD_ROLLED_BACK) {
+            ++rolled;
+            double depth = min_phi_at(ball, &cube, r.safe_pose);
+            ck_assert_msg(depth > -TOL, "motion %d: safe pose %.9g deep", k, depth);
+        }
+    }
+    REPORT("%s: certified %d, clear by the CCD %d, rolled back %d\n", __func__, certified, clear_ccd, rolled);
+    ck_assert_int_gt(certified, 10);
+    ck_assert_int_gt(clear_ccd, 0);
+    ck_assert_int_gt(rolled, 10);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(ball), SDFCCD_OK);
+    free_box(&cube);
+}
+END_TEST
+
+/* ---- sdfccd_guard_response: hand-computed impulses ---- */
+
+static sdfccd_BodyState unit_body(void)
+{
+    sdfccd_BodyState b;
+    memset(&b, 0, sizeof b);
+    b.inverse_mass = 1.0;
+    b.inverse_inertia[0] = b.inverse_inertia[4] = b.inverse_inertia[8] = 1.0;
+    return b;
+}
+
+START_TEST(test_response)
+{
+    sdfccd_GuardResult r;
+    memset(&r, 0, sizeof r);
+    r.state = SDFCCD_GUARD_ROLLED_BACK;
+    r.point = v3(1, 0, 0);
+    r.normal = v3(0, 1, 0);
+    /* unit mass and inertia at the origin, spinning about -z: the point (1, 0, 0) moves at (0, -2, 0).
+     * k = 1 + n.((r x n) x r) = 2, j = 1: v = (0, 1, 0), w = (0, 0, -1), the point at rest. */
+    sdfccd_BodyState b = unit_body();
+    b.angular_velocity = v3(0, 0, -2);
+    ck_assert_int_eq(sdfccd_guard_response(&r, 1, NULL, 0.0, &b), SDFCCD_OK);
+    ck_assert_double_near(b.linear_velocity.y, 1.0, 1e-15);
+    ck_assert_double_near(b.angular_velocity.z, -1.0, 1e-15);
+    ck_assert(b.linear_velocity.x == 0 && b.linear_velocity.z == 0 && b.angular_velocity.x == 0 && b.angular_velocity.y == 0);
+    /* sliding along x as well, friction 0.5: the tangential impulse is min(0.5 j, |u| / kt) = 0.5 */
+    b = unit_body();
+    b.angular_velocity = v3(0, 0, -2);
+    b.linear_velocity = v3(1, 0, 0);
+    ck_assert_int_eq(sdfccd_guard_response(&r, 1, NULL, 0.5, &b), SDFCCD_OK);
+    ck_assert_double_near(b.linear_velocity.x, 0.5, 1e-15);
+    ck_assert_double_near(b.linear_velocity.y, 1.0, 1e-15);
+    ck_assert_double_near(b.angular_velocity.z, -1.0, 1e-15);
+    /* falling at its centre: first the centre's velocity into the surface goes */
+    b = unit_body();
+    b.linear_velocity = v3(0.2, -3, 0);
+    ck_assert_int_eq(sdfccd_guard_response(&r, 1, NULL, 0.0, &b), SDFCCD_OK);
+    ck_assert(b.linear_velocity.x == 0.2 && b.linear_velocity.y == 0.0);
+    /* the first rollback keeps the velocity */
+    b = unit_body();
+    b.linear_velocity = v3(0.2, -3, 0);
+    ck_assert_int_eq(sdfccd_guard_response(&r, 0, NULL, 0.0, &b), SDFCCD_OK);
+    ck_assert(b.linear_velocity.y == -3.0);
+    /* pinned on a moving, turning SDF body: the body takes its motion (at its centre (0, 0, 0)) */
+    sdfccd_BodyState sdf = unit_body();
+    sdf.center = v3(0, -1, 0);
+    sdf.linear_velocity = v3(1, 0, 0);
+    sdf.angular_velocity = v3(0, 0, 2); /* at (0, 0, 0): (1, 0, 0) + (0, 0, 2) x (0, 1, 0) = (-1, 0, 0) */
+    r.pinned = 1;
+    b = unit_body();
+    b.linear_velocity = v3(5, 5, 5);
+    ck_assert_int_eq(sdfccd_guard_response(&r, 0, &sdf, 0.3, &b), SDFCCD_OK);
+    ck_assert_double_near(b.linear_velocity.x, -1.0, 1e-15);
+    ck_assert(b.linear_velocity.y == 0 && b.linear_velocity.z == 0 && b.angular_velocity.z == 2.0);
+    /* not rolled back: unchanged; bad input refused */
+    r.state = SDFCCD_GUARD_CLEAR;
+    b = unit_body();
+    b.linear_velocity = v3(0, -1, 0);
+    ck_assert_int_eq(sdfccd_guard_response(&r, 1, NULL, 0.0, &b), SDFCCD_OK);
+    ck_assert(b.linear_velocity.y == -1.0);
+    ck_assert_int_eq(sdfccd_guard_response(&r, 1, NULL, -1.0, &b), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_response(NULL, 1, NULL, 0.0, &b), SDFCCD_INVALID_ARGUMENT);
+    b.inverse_mass = NAN;
+    ck_assert_int_eq(sdfccd_guard_response(&r, 1, NULL, 0.0, &b), SDFCCD_INVALID_ARGUMENT);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("guard");
@@ -716,6 +943,11 @@ int main(void)
     tcase_add_test(tc, test_shuriken_battery);
     tcase_add_test(tc, test_motion_from_poses);
     tcase_add_test(tc, test_bad_input);
+    tcase_add_test(tc, test_step_spun_through_wall);
+    tcase_add_test(tc, test_step_clear_and_certified);
+    tcase_add_test(tc, test_step_inside_and_pinned);
+    tcase_add_test(tc, test_step_certificate_brute_force);
+    tcase_add_test(tc, test_response);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

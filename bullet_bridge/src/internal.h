@@ -188,17 +188,8 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported);
 // removed by unregister().
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world);
 void guardDetach(BridgeImpl* impl);
-// The outcome of the guarantee's check of one part against one SDF.
-struct GuardOut {
-    bool rolled_back = false;
-    bool pinned = false; // put back to the very start by the discrete check
-    double toi = 0, fraction = 1;
-    sdfccd_Vec3 point = { 0, 0, 0 }, normal = { 0, 0, 1 };
-};
 // The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
 sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out);
-// The frame of a rigid motion at time t.
-btTransform poseAt(const sdfccd_RigidMotion& m, double t);
 // soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones.
 void softRegister(BridgeImpl* impl, btCollisionDispatcher* d);
 void softAttach(BridgeImpl* impl, btCollisionWorld* world);
@@ -247,9 +238,6 @@ public:
     void guardStep(btCollisionWorld* world, double dt);
     // The step's start poses, once per step (the first narrow-phase call).
     void snapshotStartPoses(const btCollisionWorld* world);
-    // One part's executed motion `mm` over [0, dt] against `sdf` (moving with `sm`, NULL: static).
-    sdfccd_Status guardRigid(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sm, sdfccd_MeshId mesh, const sdfccd_RigidMotion& mm, double dt,
-                             detail::GuardOut& out);
 
     Config cfg;
     Stats stats;

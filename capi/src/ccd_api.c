@@ -358,7 +358,7 @@ static sdfccd_Status query_mesh(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, c
     sdfccd__mesh* m = sdfccd__mesh_acquire(mesh);
     if (!m) return SDFCCD_INVALID_HANDLE;
     if ((st = sdfccd__check_mesh_bounds(m, fn))) return st;
-    scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1, NULL };
+    scc_mesh_motion mm = { &m->mesh, &body, NULL, NULL, q.sdf_motion_ptr, t0, t1, NULL, NULL };
     if (workspace) return run_mesh(&q, &mm, &workspace->ws, out_contacts, capacity, out_result, fn);
     scc_workspace tmp;
     scc_ws_init(&tmp, sdfccd__allocator());
@@ -427,7 +427,7 @@ static sdfccd_Status query_mesh_linear(sdfccd_Workspace* workspace, sdfccd_SdfId
         scc_ws_release(&tmp);
         return st;
     }
-    scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1, NULL };
+    scc_mesh_motion mm = { &m->mesh, NULL, v, v + nv, q.sdf_motion_ptr, t0, t1, NULL, NULL };
     st = run_mesh(&q, &mm, ws, out_contacts, capacity, out_result, fn);
     scc_ws_release(&tmp);
     return st;

@@ -135,14 +135,15 @@ static sdfccd_Status setup_linear(const sdfccd_Vec3* start, const sdfccd_Vec3* e
 }
 
 static sdfccd_Status run_guard(sdfccd_Workspace* ws, const step_setup* q, const scc_mesh_motion* mm, const sdfccd_GuardParams* params,
-                               sdfccd_GuardResult* out, const char* fn)
+                               sdfccd_GuardResult* out, const char* fn, int step)
 {
     scc_params p;
     double tol = 0.0;
     sdfccd_Status st;
     if ((st = convert_guard_params(params, fn, &p, &tol))) return st;
     scc_guard_out g;
-    if (!scc_guard(q->sdf->sdf, mm, &p, tol, &ws->ws, &g)) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    if (!(step ? scc_guard_step : scc_guard)(q->sdf->sdf, mm, &p, tol, &ws->ws, &g))
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
     const double t0 = mm->t0, t1 = mm->t1;
     sdfccd_GuardResult r;
     memset(&r, 0, sizeof r);
@@ -167,23 +168,27 @@ static sdfccd_Status run_guard(sdfccd_Workspace* ws, const step_setup* q, const 
     r.query_state = sdfccd__public_state(g.query_state);
     r.queries = g.queries;
     r.sdf_evaluations = g.evals;
+    r.pinned = step ? g.pinned : 0;
+    r.certified = step ? g.certified : 0;
     *out = r;
     return SDFCCD_OK;
 }
 
 static sdfccd_Status guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
                                  const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
-                                 sdfccd_GuardResult* out)
+                                 sdfccd_GuardResult* out, int step)
 {
-    static const char fn[] = "sdfccd_guard_rigid";
+    const char* fn = step ? "sdfccd_guard_step_rigid" : "sdfccd_guard_rigid";
     sdfccd_Status st;
     step_setup q;
     scc_rigid body;
-    if ((st = sdfccd__check_ptr(out, "sdfccd_guard_rigid: out")) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
+    char what[64];
+    snprintf(what, sizeof what, "%s: out", fn);
+    if ((st = sdfccd__check_ptr(out, what)) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
         (st = setup_rigid(executed, t0, t1, &q, fn, &body)))
         return st;
-    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, t0, t1, NULL };
-    return run_guard(ws, &q, &mm, params, out, fn);
+    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, t0, t1, NULL, NULL };
+    return run_guard(ws, &q, &mm, params, out, fn, step);
 }
 
 static sdfccd_Status guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
@@ -198,8 +203,8 @@ static sdfccd_Status guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const 
         (st = setup_linear(start, end, ws, &q, fn, &v)))
         return st;
     const uint32_t nv = q.mesh->mesh.vertex_count;
-    scc_mesh_motion mm = { &q.mesh->mesh, NULL, v, v + nv, q.smp, t0, t1, NULL };
-    if ((st = run_guard(ws, &q, &mm, params, out, fn))) return st;
+    scc_mesh_motion mm = { &q.mesh->mesh, NULL, v, v + nv, q.smp, t0, t1, NULL, NULL };
+    if ((st = run_guard(ws, &q, &mm, params, out, fn, 0))) return st;
     if (out_positions) {
         const double s = out->fraction;
         for (uint32_t i = 0; i < nv; ++i) out_positions[i] = sdfccd__pv(scc_lerp(v[i], v[nv + i], s));
@@ -211,7 +216,7 @@ sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const s
                                  const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
                                  sdfccd_GuardResult* out)
 {
-    SDFCCD__HELD_CALL(guard_rigid(ws, sdf, sdf_motion, mesh, executed, t0, t1, params, out));
+    SDFCCD__HELD_CALL(guard_rigid(ws, sdf, sdf_motion, mesh, executed, t0, t1, params, out, 0));
 }
 
 sdfccd_Status sdfccd_guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
@@ -289,7 +294,7 @@ static sdfccd_Status generate_contacts(sdfccd_Workspace* ws, sdfccd_SdfId sdf, c
     if ((st = sdfccd__check_ptr(out_set, "sdfccd_generate_contacts: out_set")) || (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) ||
         (st = setup_rigid(motion, t0, t1, &q, fn, &body)))
         return st;
-    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, t0, t1, NULL };
+    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, t0, t1, NULL, NULL };
     return run_contacts(ws, &q, &mm, params, out_points, capacity, out_set, fn);
 }
 
@@ -306,7 +311,7 @@ static sdfccd_Status generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId
         (st = setup_step(ws, sdf, sdf_motion, mesh, t0, t1, fn, &q)) || (st = setup_linear(start, end, ws, &q, fn, &v)))
         return st;
     const uint32_t nv = q.mesh->mesh.vertex_count;
-    scc_mesh_motion mm = { &q.mesh->mesh, NULL, v, v + nv, q.smp, t0, t1, NULL };
+    scc_mesh_motion mm = { &q.mesh->mesh, NULL, v, v + nv, q.smp, t0, t1, NULL, NULL };
     return run_contacts(ws, &q, &mm, params, out_points, capacity, out_set, fn);
 }
 
@@ -380,4 +385,60 @@ sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points, int32_t c
     *out_count = (int32_t)scc_cover(points, (size_t)count, public_item, chosen, (size_t)chosen_count, tilt, depth,
                                     same_place_distance, (size_t)capacity, out_indices);
     return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_guard_step_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
+                                      const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
+                                      sdfccd_GuardResult* out)
+{
+    SDFCCD__HELD_CALL(guard_rigid(ws, sdf, sdf_motion, mesh, executed, t0, t1, params, out, 1));
+}
+
+/* A body state (checked) in the core's form. */
+static sdfccd_Status body_state(const sdfccd_BodyState* in, const char* what, scc_body_state* out)
+{
+    sdfccd_Status st;
+    char w[96];
+    snprintf(w, sizeof w, "sdfccd_guard_response: %s", what);
+    if ((st = sdfccd__check_ptr(in, w)) || (st = sdfccd__check_vec(in->center, w)) || (st = sdfccd__check_vec(in->linear_velocity, w)) ||
+        (st = sdfccd__check_vec(in->angular_velocity, w)))
+        return st;
+    if (!isfinite(in->inverse_mass) || !(in->inverse_mass >= 0.0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_mass must be finite and >= 0", w);
+    for (int i = 0; i < 9; ++i) {
+        if (!isfinite(in->inverse_inertia[i])) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_inertia is not finite", w);
+        out->inv_inertia[i] = in->inverse_inertia[i];
+    }
+    out->center = sdfccd__v(in->center);
+    out->v = sdfccd__v(in->linear_velocity);
+    out->w = sdfccd__v(in->angular_velocity);
+    out->inv_mass = in->inverse_mass;
+    return SDFCCD_OK;
+}
+
+static sdfccd_Status guard_response(const sdfccd_GuardResult* result, int32_t repeated, const sdfccd_BodyState* sdf_body, double friction,
+                                    sdfccd_BodyState* body)
+{
+    sdfccd_Status st;
+    scc_body_state b, s;
+    if ((st = sdfccd__check_ptr(result, "sdfccd_guard_response: result")) || (st = body_state(body, "body", &b)) ||
+        (sdf_body && (st = body_state(sdf_body, "sdf_body", &s))))
+        return st;
+    if (!isfinite(friction) || !(friction >= 0.0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_guard_response: friction must be finite and >= 0 (got %g)", friction);
+    if (result->state != SDFCCD_GUARD_ROLLED_BACK) return SDFCCD_OK;
+    if ((st = sdfccd__check_vec(result->point, "sdfccd_guard_response: result->point")) ||
+        (st = sdfccd__check_vec(result->normal, "sdfccd_guard_response: result->normal")))
+        return st;
+    scc_guard_response(sdfccd__v(result->point), scc_normalize_or(sdfccd__v(result->normal), scc_v3(0, 0, 0)), result->pinned != 0,
+                       repeated != 0, sdf_body ? &s : NULL, friction, &b);
+    body->linear_velocity = sdfccd__pv(b.v);
+    body->angular_velocity = sdfccd__pv(b.w);
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_guard_response(const sdfccd_GuardResult* result, int32_t repeated, const sdfccd_BodyState* sdf_body, double friction,
+                                    sdfccd_BodyState* body)
+{
+    SDFCCD__HELD_CALL(guard_response(result, repeated, sdf_body, friction, body));
 }

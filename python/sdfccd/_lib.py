@@ -273,6 +273,8 @@ class GuardResult(C.Structure):
         ("query_state", C.c_int32),
         ("queries", C.c_int32),
         ("sdf_evaluations", C.c_int64),
+        ("pinned", C.c_int32),
+        ("certified", C.c_int32),
     ]
 
 

@@ -130,8 +130,8 @@ struct Config {
      * checks the executed motion of every dynamic body whose swept box meets an SDF's: from its
      * pose at the start of the step to the pose the solver produced (constant velocities, shortest
      * rotation), every compound child and convex shape as its triangles. If any point went deeper
-     * than this below an SDF's surface (sdfccd_guard_rigid, then a discrete check of the pose it
-     * keeps), the body goes back along that motion to where it was within half of this (the paper's
+     * than this below an SDF's surface (sdfccd_guard_step_rigid: a certificate, the CCD, a discrete
+     * check of the pose it keeps), the body goes back along that motion to where it was within half of this (the paper's
      * rule: never advance past a time of impact). Its velocity: the first time, kept, for the next
      * step's contacts, which start at the time of impact and respond with every point and friction;
      * rolled back again in the next step, it loses its velocity into the surface (its centre's, then
@@ -187,10 +187,9 @@ struct Stats {
     int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
     int64_t guard_queries = 0;         /**< Executed motions checked by the guarantee (one per body part and SDF). */
     int64_t rollbacks = 0;             /**< Bodies the guarantee put back at their time of impact. */
-    int64_t guard_skipped = 0;         /**< Checks the guarantee skipped: the step's narrow phase saw the body's
-                                            start clear by more than its executed motion could close. */
-    int64_t guard_bisections = 0;      /**< Poses the CCD let through that the guarantee's discrete check found
-                                            deeper than its tolerance (put back by bisection). */
+    int64_t guard_skipped = 0;         /**< Checks the guarantee settled without a CCD: bodies that did not move,
+                                            and motions sdfccd_guard_step_rigid's certificate proved clear. */
+    int64_t guard_bisections = 0;      /**< Unused since the guarantee's discrete check moved into the core (0). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (SdfShape::setFeatureSize). */
     int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
                                             they are counted in queries, end_pose_queries and sdf_evaluations too. */

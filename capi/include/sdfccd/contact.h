@@ -99,6 +99,10 @@ typedef struct sdfccd_GuardResult {
                                     budget ran out, so CLEAR is not proven (ROLLED_BACK still is a real contact). */
     int32_t queries;           /**< Mesh queries run: 1, more when part of the body started deep. */
     int64_t sdf_evaluations;   /**< SDF evaluations, all queries. */
+    int32_t pinned;            /**< sdfccd_guard_step_rigid(): 1 when no time after t0 is safe (the body stays at its
+                                    start pose); 0 otherwise and from sdfccd_guard_rigid(). */
+    int32_t certified;         /**< sdfccd_guard_step_rigid(): 1 when the motion was proven clear without a CCD (or
+                                    did not move relative to a static SDF). */
 } sdfccd_GuardResult;
 
 /** The guarantee: checks the executed motion of a rigid mesh against one SDF (itself possibly moving
@@ -115,6 +119,64 @@ typedef struct sdfccd_GuardResult {
 SDFCCD_API sdfccd_Status sdfccd_guard_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
                                             sdfccd_MeshId mesh, const sdfccd_RigidMotion* executed, double t0, double t1,
                                             const sdfccd_GuardParams* params, sdfccd_GuardResult* out);
+
+/** The guarantee as an engine applies it after a step: where to put the body. The same check as
+ * sdfccd_guard_rigid() (same params; rigid motion; `sdf_motion` NULL or the SDF's motion), with:
+ *  - a certificate first, which proves most of a motion clear without a CCD: phi is K-Lipschitz (the
+ *    SDF's bound), so along a point path of length L from phi0 to phi1 the minimum is at least
+ *    (phi0 + phi1 - K L) / 2; with every point's speed bounded by |v| + |w| d (d its distance from
+ *    the centre of rotation), a point stays within h = (|v| + |w| d) T / 2 of where it is at the
+ *    middle of the step. Each sphere of the mesh's bounding-sphere hierarchy (centre c, radius r)
+ *    is evaluated once, at c at the middle time: where phi(c) - K (r + h) > -tolerance/2 the sphere
+ *    is clear at every time of the step, and the CCD and the discrete checks below skip it. A leaf
+ *    that fails is tried with its triangle's deepest point at the middle time (DCD) less K h, and
+ *    where that fails above the level, on each half of the step the same way (twice deep): that
+ *    stage is as sure as the DCD's local search, the same kind of search as the CCD it replaces.
+ *    Only the triangles near the surface that move (a sliding body's contact) reach the CCD. A
+ *    motion that does not move relative to a static SDF (a sleeping body) is ::SDFCCD_GUARD_CLEAR at
+ *    no cost. The certificate
+ *    applies when the SDF does not move (`sdf_motion` NULL or with zero velocities); its first stage
+ *    is exact, as sure as the SDF's Lipschitz bound;
+ *  - the safe time: when a point reaches -tolerance, the body goes back further, to the first time
+ *    a point reached -tolerance/2 (so that the next step starts shallower than the tolerance);
+ *  - a discrete check of the pose at that time (the deepest point of every triangle the certificate
+ *    left, DCD): if a point is deeper than the tolerance there (half the tolerance after a rollback;
+ *    what the CCD's local search missed), the body stays at its start pose when that pose already
+ *    has a point deeper than tolerance/2, else the safe time is bisected (12 halvings of [t0, toi])
+ *    to the last time that check finds no point deeper than tolerance/2. `out->pinned` is 1 when
+ *    the safe time is t0.
+ * Tolerance semantics: CLEAR: no point went below -tolerance at any time of the step (a triangle
+ * that starts deeper: below its own level, see ::sdfccd_GuardResult), as far as the certificate (exact
+ * up to its DCD stage), the CCD and the discrete check at t1 can see. ROLLED_BACK: no point went
+ * below -tolerance before `toi`, and at `safe_pose` the discrete check finds no point below
+ * -tolerance/2, except when pinned at a start pose that already had one. A body that starts deep
+ * (::SDFCCD_GUARD_INSIDE_AT_START) is left to the contacts. Errors: as sdfccd_guard_rigid(). */
+SDFCCD_API sdfccd_Status sdfccd_guard_step_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                                 sdfccd_MeshId mesh, const sdfccd_RigidMotion* executed, double t0, double t1,
+                                                 const sdfccd_GuardParams* params, sdfccd_GuardResult* out);
+
+/** A rigid body's velocity state (world frame), for sdfccd_guard_response(). */
+typedef struct sdfccd_BodyState {
+    sdfccd_Vec3 center;            /**< Centre of mass (m), at the safe pose. */
+    sdfccd_Vec3 linear_velocity;   /**< Of the centre of mass (m/s). */
+    sdfccd_Vec3 angular_velocity;  /**< rad/s. */
+    double inverse_mass;           /**< 1/kg, >= 0 (0: immovable). */
+    double inverse_inertia[9];     /**< World inverse inertia tensor, row-major (symmetric, positive semi-definite). */
+} sdfccd_BodyState;
+
+/** The velocity a body leaves with after sdfccd_guard_step_rigid() rolled it back (`result`; any
+ * other state leaves `body` unchanged). The SDF's body `sdf_body` (NULL: static) counts as
+ * infinitely heavy. Pinned: the body takes the SDF body's motion (at rest relative to it).
+ * Otherwise, when `repeated` is nonzero (the body was rolled back in the previous step too: its
+ * contacts did not stop it), it loses its velocity into the surface at `result->point` along
+ * `result->normal`: first its centre's, then, if that point still approaches (a spin), an inelastic
+ * impulse there along the normal makes the approach zero, with Coulomb friction (`friction` >= 0)
+ * reducing the point's tangential velocity by at most friction times that impulse. A body rolled
+ * back for the first time keeps its velocity: the next step starts in contact and its contacts take
+ * the impact. Errors (::SDFCCD_INVALID_ARGUMENT): NULL result or body, non-finite values, a negative
+ * friction or inverse mass. */
+SDFCCD_API sdfccd_Status sdfccd_guard_response(const sdfccd_GuardResult* result, int32_t repeated, const sdfccd_BodyState* sdf_body,
+                                               double friction, sdfccd_BodyState* body);
 
 /** Which feature of the mesh a contact point lies on (from its barycentric weights, 1e-6). */
 typedef enum sdfccd_FeatureKind {
