@@ -208,24 +208,37 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
     int found = 0;
     if (!deep_at(sdf, &run, p, out->toi, check_level, ws, &c, &found, &out->evals)) return 0;
     if (found) {
+        const int ccd_rolled_back = out->state == SCC_GUARD_ROLLED_BACK;
         out->bisections = 1;
         out->state = SCC_GUARD_ROLLED_BACK;
         out->point = c.point;
         out->normal = c.normal;
         out->triangle = c.triangle;
-        double lo = mm->t0, hi = out->toi;
-        /* Already deeper than half the tolerance at t0 (a body the contacts hold slightly deep): no
-         * later time can be shown safe by this check; the body stays at its start. */
-        if (!deep_at(sdf, &run, p, mm->t0, -0.5 * tolerance, ws, &c, &found, &out->evals)) return 0;
+        const double end_depth = c.distance;
+        double lo = mm->t0, hi = out->toi, level = -0.5 * tolerance;
+        /* Already deeper than half the tolerance at t0 (a body the contacts hold slightly deep): it
+         * may keep any pose no deeper than its start's deepest point (left to the contacts, as a
+         * triangle that starts inside is in the CCD); only sinking further is rolled back. */
+        if (!deep_at(sdf, &run, p, mm->t0, level, ws, &c, &found, &out->evals)) return 0;
         if (found) {
+            level = c.distance;
+            if (end_depth >= level) { /* not sinking: the CCD's time of impact (if any) stands */
+                out->bisections = 0;
+                if (!ccd_rolled_back) {
+                    out->state = SCC_GUARD_INSIDE_AT_START;
+                    out->toi = mm->t1;
+                }
+                out->pinned = out->state == SCC_GUARD_ROLLED_BACK && !(out->toi > mm->t0);
+                if (out->state == SCC_GUARD_ROLLED_BACK) out->normal = scc_normalize_or(out->normal, scc_v3(0, 1, 0));
+                return 1;
+            }
             out->point = c.point;
             out->normal = c.normal;
             out->triangle = c.triangle;
-            hi = lo;
         }
         for (int it = 0; it < 12 && hi > lo; ++it) {
             const double mid = 0.5 * (lo + hi);
-            if (!deep_at(sdf, &run, p, mid, -0.5 * tolerance, ws, &c, &found, &out->evals)) return 0;
+            if (!deep_at(sdf, &run, p, mid, level, ws, &c, &found, &out->evals)) return 0;
             if (found) {
                 hi = mid;
                 out->point = c.point;

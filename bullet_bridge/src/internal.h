@@ -249,7 +249,6 @@ public:
     std::unique_ptr<btActionInterface> guard;
     std::vector<std::pair<const btCollisionObject*, btTransform>> start_poses;
     int64_t guard_step = 0, snapshot_step = -1;
-    std::unordered_map<const btCollisionObject*, int64_t> last_rollback; // the step each body was last put back
     // Per (mesh object, SDF object): the step and the smallest gap at its start the narrow phase saw
     // (a top-level pair; the margin when the pair was proven clear).
     struct PairHash {
