@@ -781,6 +781,30 @@ START_TEST(test_step_clear_and_certified)
 }
 END_TEST
 
+/* Resting 0.3 mm deep on the ground (deeper than TOL / 2, not TOL) and sliding 6 cm into a wall 5 cm
+ * away, rising 0.1 mm: put back where it meets the wall (half the tolerance into it), not frozen at
+ * its start although every pose after t0 is deeper than TOL / 2 on the ground. At the safe pose no
+ * point is deeper than it started (brute force against ground and wall). */
+START_TEST(test_step_inside_slides_into_wall)
+{
+    inside_scene s;
+    inside_setup(&s);
+    s.m.pose.position = v3(0, 0.05 - 0.0003, 0);
+    s.m.linear_velocity = v3(0.06 / DT, 0.0001 / DT, 0);
+    const double start = min_phi_at(s.both, &s.cube, s.m.pose);
+    sdfccd_GuardResult r = guard_step(s.ws, s.both, NULL, s.cube.id, &s.m, &s.gp);
+    REPORT("%s: state %d toi/DT %.6g pinned %d\n", __func__, (int)r.state, r.toi / DT, (int)r.pinned);
+    ck_assert_int_eq(r.state, SDFCCD_GUARD_ROLLED_BACK);
+    ck_assert_int_eq(r.pinned, 0);
+    ck_assert_msg(r.toi >= (0.05 / 0.06) * DT && r.toi <= (0.05 + 0.5 * TOL) / 0.06 * DT, "toi/DT %.9g", r.toi / DT);
+    assert_pose_near(r.safe_pose, pose_at(&s.m, r.toi), 1e-12);
+    const double depth = min_phi_at(s.both, &s.cube, r.safe_pose);
+    ck_assert_msg(depth >= start - 1e-9, "min phi at the safe pose %.9g, at the start %.9g", depth, start);
+    ck_assert_msg(min_phi_at(s.wall, &s.cube, r.safe_pose) >= -0.5 * TOL, "into the wall at the safe pose");
+    inside_teardown(&s);
+}
+END_TEST
+
 /* Already inside: left to the contacts (INSIDE_AT_START, end pose). Starting 0.3 mm deep (between
  * TOL / 2 and TOL) and sinking 1 mm: no later time passes the discrete check, pinned at t0. */
 START_TEST(test_step_inside_and_pinned)
@@ -946,6 +970,7 @@ int main(void)
     tcase_add_test(tc, test_step_spun_through_wall);
     tcase_add_test(tc, test_step_clear_and_certified);
     tcase_add_test(tc, test_step_inside_and_pinned);
+    tcase_add_test(tc, test_step_inside_slides_into_wall);
     tcase_add_test(tc, test_step_certificate_brute_force);
     tcase_add_test(tc, test_response);
     suite_add_tcase(s, tc);
