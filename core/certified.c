@@ -18,6 +18,7 @@
  * tangential contacts far sooner than the Lipschitz ball. */
 #include "ccd.h"
 #include "min_heap.h"
+#include "sdf_analytic.h"
 
 typedef struct region {
     double ta, tb;
@@ -26,13 +27,42 @@ typedef struct region {
 
 SCC_MIN_HEAP(region_heap, region, ta)
 
+/* Whether phi is convex on `box`: the field's own answer or, for CSG (ours, issue 20), where one
+ * operand decides phi on the whole box (the operands evaluated at its centre, their Lipschitz bounds
+ * over its half-diagonal), that operand's answer: a cube minus a ball is the cube's convex distance
+ * away from the carved ball, which lets the first-order bound prune sliding contacts there. */
+static int convex_on(const scc_sdf* sdf, const scc_aabb* box, int64_t* evals)
+{
+    if (scc_sdf_convex_in(sdf, box)) return 1;
+    if (sdf->kind != SCC_SDF_CSG) return 0;
+    const scc_sdf_csg* s = (const scc_sdf_csg*)sdf;
+    const scc_vec3 c = scc_scale(scc_add(box->lo, box->hi), 0.5);
+    const double h = 0.5 * scc_dist(box->lo, box->hi);
+    double a = scc_sdf_eval(s->a, c, NULL), b = scc_sdf_eval(s->b, c, NULL);
+    *evals += 2;
+    const double ra = scc_sdf_lipschitz(s->a, box) * h, rb = scc_sdf_lipschitz(s->b, box) * h;
+    if (s->op == SCC_CSG_DIFFERENCE) b = -b; /* max(a, -b) */
+    if (s->op == SCC_CSG_UNION) { /* min(a, b) */
+        if (a + ra < b - rb) return scc_sdf_convex_in(s->a, box);
+        if (b + rb < a - ra) return scc_sdf_convex_in(s->b, box);
+        return 0;
+    }
+    if (a - ra > b + rb) return scc_sdf_convex_in(s->a, box);
+    if (s->op == SCC_CSG_INTERSECTION && b - rb > a + ra) return scc_sdf_convex_in(s->b, box);
+    return 0;
+}
+
 static scc_vec3 corner(const scc_tri_state* st, double u, double v)
 {
     return scc_add(scc_add(scc_scale(st->x[0], u), scc_scale(st->x[1], v)), scc_scale(st->x[2], 1.0 - u - v));
 }
 
-int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                  const scc_allocator* alloc, scc_tri_hit* out)
+/* The search. `seed_t` (INFINITY: none) is a known contact (weights seed_b) that is the initial upper
+ * bound: while no earlier witness turns up, the search stops once the bracket is `seed_tol` wide;
+ * after one, at the certified time tolerance. At most `max_evals` evaluations. */
+static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                            const scc_allocator* alloc, double seed_t, const double seed_b[3], double seed_tol, int64_t max_evals,
+                            scc_tri_hit* out)
 {
     /* The region store never holds more than cert_max_bytes (0: no limit); when it is full the
      * search stops like at the other caps: NOT_CONVERGED, the earliest witness so far, and the
@@ -47,15 +77,17 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
     }
     const double speed = scc_tri_speed_bound(m);
     const double accel = scc_tri_accel_bound(m);
-    double hi = INFINITY, lo = ta;
+    double hi = seed_t, lo = ta;
     double hit_b[3] = { 1, 0, 0 };
+    if (isfinite(seed_t))
+        for (int j = 0; j < 3; ++j) hit_b[j] = seed_b[j];
     int64_t processed = 0, evals = 0;
     while (h.n) {
         region r = region_heap_pop(&h);
         lo = r.ta;
         if (r.ta >= hi) { lo = hi; break; }
-        if (hi - lo <= p->cert_time_tol) break;
-        if (processed >= p->cert_max_regions || evals >= p->max_evals) { capped = 1; break; }
+        if (hi - lo <= (hi == seed_t ? seed_tol : p->cert_time_tol)) break;
+        if (processed >= p->cert_max_regions || evals >= max_evals) { capped = 1; break; }
         ++processed;
         scc_tri_state st;
         scc_tri_state_at(m, r.ta, &st);
@@ -80,7 +112,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
         /* Which part of the bound's slack to refine: the Lipschitz ball's spatial and temporal
          * radii, or, for a convex phi, the spatial and temporal parts of the first-order bound. */
         double slack_space = rs, slack_time = rt;
-        if (scc_sdf_convex_in(sdf, &box)) {
+        if (convex_on(sdf, &box, &evals)) {
             /* First-order bound of a convex phi: phi(x) >= phi(c) + g.(x - c). Over the region,
              * x(b, ta + s) - c = sum_i b_i (x_i(ta) - c + s v_i(ta)) + e with |e| <= A s^2 / 2, and
              * the bilinear part is smallest at a corner and at s = 0 or s = tb - ta. Tangential
@@ -181,5 +213,51 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
         out->state = capped ? SCC_NOT_CONVERGED : SCC_NO_HIT;
     }
     out->evals = evals;
+    return 1;
+}
+
+int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                  const scc_allocator* alloc, scc_tri_hit* out)
+{
+    const double none[3] = { 1, 0, 0 };
+    return certified_search(sdf, m, ta, tb, p, alloc, INFINITY, none, 0.0, p->max_evals, out);
+}
+
+/* Whether FWGSS's answer on this field is checked by the certified search (ours, issue 20): fields
+ * whose gradient may jump (box and cylinder edges, CSG seams, cone tips, grid cells, unknown user
+ * fields), where the descents' local steps can stop at a later contact. Smooth fields are not. */
+int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p)
+{
+    if (p->fwgss_kink_guard <= 0) return 0;
+    switch (sdf->kind) {
+    case SCC_SDF_SPHERE: case SCC_SDF_TORUS: case SCC_SDF_CAPSULE: case SCC_SDF_ROUNDED_BOX: case SCC_SDF_HALF_SPACE: return 0;
+    case SCC_SDF_GRID: return 0; /* the Lipschitz bounds of a grid's cells make it far too slow (median 10^5 evaluations) */
+    default: return 1;
+    }
+}
+
+int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                     const scc_allocator* alloc, scc_tri_hit* io)
+{
+    if (!scc_fwgss_verified(sdf, p) || (io->hit && !(io->toi > ta))) return 1;
+    int64_t budget = p->max_evals - io->evals;
+    if (budget > SCC_VERIFY_MAX_EVALS) budget = SCC_VERIFY_MAX_EVALS;
+    if (budget <= 0) return 1;
+    scc_tri_hit c;
+    const double seed_t = io->hit ? io->toi : INFINITY;
+    if (!certified_search(sdf, m, ta, io->hit ? io->toi : tb, p, alloc, seed_t, io->bary, fmax(p->time_tol, SCC_VERIFY_TOL), budget, &c)) return 0;
+    io->evals += c.evals;
+    io->iterations += c.iterations;
+    if (c.hit && c.toi < seed_t) {
+        /* an earlier contact: the certified witness replaces FWGSS's */
+        const int64_t evals = io->evals, iterations = io->iterations;
+        *io = c;
+        io->evals = evals;
+        io->iterations = iterations;
+        io->toi_lower = io->toi;
+        if (io->state == SCC_NOT_CONVERGED) io->state = io->toi <= ta ? SCC_PENETRATING : SCC_HIT;
+    } else if (c.state != SCC_NOT_CONVERGED && io->hit && io->state == SCC_NOT_CONVERGED) {
+        io->state = SCC_HIT; /* proven: no contact more than SCC_VERIFY_TOL before the witness */
+    }
     return 1;
 }

@@ -53,7 +53,10 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
             sp.max_evals = p->max_evals - evals;
             double sb = k + 1 == segments ? tb : ta + (tb - ta) * (k + 1) / segments;
             scc_tri_hit seg;
-            if (p->method == SCC_METHOD_FWGSS) scc_fwgss(sdf, m, sa, sb, &sp, &seg);
+            if (p->method == SCC_METHOD_FWGSS) {
+                scc_fwgss(sdf, m, sa, sb, &sp, &seg);
+                if (!scc_fwgss_verify(sdf, m, sa, sb, &sp, alloc, &seg)) return 0;
+            }
             else if (p->method == SCC_METHOD_FW) scc_fw(sdf, m, sa, sb, &sp, &seg);
             else if (!scc_certified(sdf, m, sa, sb, &sp, alloc, &seg)) return 0;
             evals += seg.evals;

@@ -527,7 +527,7 @@ static void exp_kinds(const options* o)
     };
     m[1].p.fwgss_kink_guard = 0; /* FWGSS before issue 20 */
     m[2].p.fwgss_kink_guard = 2; /* the guard on every grid query too */
-    int nm = o->baseline ? 6 : 4;
+    int nm = o->baseline ? 6 : (getenv("SDFCCD_BENCH_FWGSS_ONLY") ? 1 : 4); /* the variable: quick runs of the defaults only */
     run_result* rr = calloc((size_t)ks.n_per_kind, sizeof *rr);
     printf("method,id,kind,hit,state,toi,gt_hit,gt_state,gt_lower,gt_toi,micros,sdf_evals,gt_regions\n");
     for (int j = 0; j < nm; ++j)
