@@ -240,6 +240,8 @@ int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, dou
                      const scc_allocator* alloc, scc_tri_hit* io)
 {
     if (!scc_fwgss_verified(sdf, p) || (io->hit && !(io->toi > ta))) return 1;
+    /* No hit with no descent run: FWGSS's conservative no-contact proof (fwgss_clear_proof) held */
+    if (!io->hit && io->state == SCC_NO_HIT && io->iterations == 0) return 1;
     int64_t budget = p->max_evals - io->evals;
     if (budget > SCC_VERIFY_MAX_EVALS) budget = SCC_VERIFY_MAX_EVALS;
     if (budget <= 0) return 1;
