@@ -210,11 +210,12 @@ END_TEST
  * tangent plane, dipping by up to 0.1 rad, the centre passing 0-4 cm above it), the others coming
  * in within 60 degrees of the normal; a travel of 0.5-2.5 triangle sizes (5 cm) per step; spins up
  * to 300 rad/s. The certified method is the reference (it is checked against brute force above);
- * per kind, FWGSS reports no false positive, misses no more with the kink guard than without it,
- * and either meets issue 20's target (at most 0.1 % of the certified hits missed, mean distance from
- * the certified bracket within 1e-8 s) or stays at the misses measured with the guard (the target is
- * not met on the plate and the CSG kinds yet). FWGSS with the guard off (today's before issue 20)
- * fails that bound on all three. */
+ * per kind, FWGSS (the defaults: the kink guard, and on these analytic fields the certified check of
+ * its answer, scc_fwgss_verify) reports no false positive, misses no more with the kink guard than
+ * without it, and meets issue 20's target: at most 0.1 % of the certified hits missed (here: none),
+ * mean distance from the certified bracket within 1e-8 s. Before the check (main at 8578f59) the
+ * plate missed 1, csg-difference 3 and csg-intersection 2 of about 200 hits; FWGSS with the guard
+ * off misses 5, 33 and 3. */
 #define KINDS 4
 #define CASES_PER_KIND 250
 
@@ -295,8 +296,6 @@ START_TEST(test_kinds_sweep)
     sdfccd_destroy_sdf(b2);
     const sdfccd_Vec3 tri[3] = { { 0.0, 0.055, 0.0 }, { -0.047631397208144133, -0.0275, 0.0 }, { 0.047631397208144133, -0.0275, 0.0 } };
     test_rng rng = { 20251126u };
-    int not_met = 0;
-    const int max_misses[KINDS] = { 1, 3, 2, 0 }; /* measured with the kink guard (fwgss_kink_guard 1) */
     for (int k = 0; k < KINDS; ++k) {
         method_stats st = { 0 }, off = { 0 };
         int start_in_contact = 0, unresolved = 0;
@@ -316,11 +315,12 @@ START_TEST(test_kinds_sweep)
             ck_assert_int_eq(sdfccd_query_triangle(sdfs[k], NULL, tri, &m, 0.0, DT, &p, NULL, 0, &r), SDFCCD_OK);
             int before = st.misses;
             compare(&st, &ref, &r);
+            if (st.misses > before)
+                fprintf(stderr, "%s case %d: FWGSS hit %d toi %.9g (state %d, %lld evaluations), certified [%.9g, %.9g]\n", names[k], c, r.hit, r.toi,
+                        (int)r.state, (long long)r.sdf_evaluations, ref.toi_lower, ref.toi);
             p.fwgss_kink_guard = 0; /* FWGSS before issue 20 */
             ck_assert_int_eq(sdfccd_query_triangle(sdfs[k], NULL, tri, &m, 0.0, DT, &p, NULL, 0, &r), SDFCCD_OK);
             compare(&off, &ref, &r);
-            if (st.misses > before)
-                fprintf(stderr, "%s case %d: FWGSS hit %d toi %.9g, certified [%.9g, %.9g]\n", names[k], c, r.hit, r.toi, ref.toi_lower, ref.toi);
         }
         const double mean_out = st.compared ? st.sum_outside / st.compared : 0.0;
         printf("kinds: %-16s %d cases (%d in contact at the start, %d certified unresolved), %d certified hits: FWGSS misses %d (%.2f%%), "
@@ -334,18 +334,11 @@ START_TEST(test_kinds_sweep)
         ck_assert_int_le(unresolved, CASES_PER_KIND / 50);
         ck_assert_msg(st.false_positives == 0, "%s: FWGSS reported %d false positives", names[k], st.false_positives);
         ck_assert_msg(st.misses <= off.misses, "%s: the kink guard misses %d, more than without it (%d)", names[k], st.misses, off.misses);
-        if (st.misses * 1000 > st.hits || mean_out > 1e-8) {
-            /* Issue 20's target (<= 0.1 % misses, mean <= 1e-8 s) is not met on these kinds yet: they are held at
-             * the figures measured with the guard at its introduction (the guard off: plate 5, csg-difference 32,
-             * csg-intersection 3 misses of these cases; the rounded box, a smooth field, meets it either way). */
-            ++not_met;
-            ck_assert_msg(st.misses <= max_misses[k], "%s: FWGSS missed %d of %d certified hits (at most %d measured with the kink guard)",
-                          names[k], st.misses, st.hits, max_misses[k]);
-        }
+        ck_assert_msg(st.misses * 1000 <= st.hits, "%s: FWGSS missed %d of %d certified hits (issue 20: at most 0.1 %%)", names[k], st.misses,
+                      st.hits);
+        ck_assert_msg(mean_out <= 1e-8, "%s: FWGSS's mean distance from the certified bracket %.3g s (issue 20: at most 1e-8 s)", names[k],
+                      mean_out);
     }
-    printf("kinds: issue 20's target (<= 0.1 %% misses, mean distance <= 1e-8 s) met on %d of %d kinds\n", KINDS - not_met, KINDS);
-    fflush(stdout);
-    ck_assert_msg(not_met < KINDS, "the target is met on no kind");
     for (int k = 0; k < KINDS; ++k) sdfccd_destroy_sdf(sdfs[k]);
 }
 END_TEST
