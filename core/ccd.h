@@ -90,11 +90,13 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
 
 /* FWGSS's answer checked on a field whose gradient may jump (issue 20; certified.c): the certified
  * search over [ta, toi] (no hit: [ta, tb]) seeded with FWGSS's witness, stopped once no contact is
- * proven more than max(time_tol, SCC_VERIFY_TOL) before it, or after SCC_VERIFY_MAX_EVALS evaluations
- * (half the default budget; then the answer stands, unless an earlier contact was witnessed). An
- * earlier contact found replaces it, bracketed to the certified time tolerance. Returns 0 on
- * allocation failure. */
+ * proven more than max(time_tol, SCC_VERIFY_TOL) before it, or after SCC_VERIFY_FACTOR x FWGSS's
+ * evaluations + SCC_VERIFY_BASE_EVALS (at most SCC_VERIFY_MAX_EVALS; then the answer stands, unless an
+ * earlier contact was witnessed). An earlier contact found replaces it, bracketed to the certified
+ * time tolerance. Returns 0 on allocation failure. */
 #define SCC_VERIFY_TOL 1e-7
+#define SCC_VERIFY_FACTOR 128
+#define SCC_VERIFY_BASE_EVALS 16384
 #define SCC_VERIFY_MAX_EVALS 1000000
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                      const scc_allocator* alloc, scc_tri_hit* io);

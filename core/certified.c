@@ -57,6 +57,29 @@ static scc_vec3 corner(const scc_tri_state* st, double u, double v)
     return scc_add(scc_add(scc_scale(st->x[0], u), scc_scale(st->x[1], v)), scc_scale(st->x[2], 1.0 - u - v));
 }
 
+/* The region store starts in a buffer on the stack (ours): a search that never holds more regions
+ * than it does allocates nothing, so a mesh or guard query through a warm workspace whose checks of
+ * FWGSS (scc_fwgss_verify) stay within it allocates nothing (test_guard). The heap grows by
+ * allocating the new array, copying, then freeing the old one, so a request that fits is given the
+ * same buffer again (the copy is onto itself); larger ones go to the caller's allocator. */
+#define STACK_REGIONS 1024 /* 64 KB */
+typedef struct stack_store {
+    region buf[STACK_REGIONS];
+    const scc_allocator* next;
+} stack_store;
+
+static void* stack_alloc(size_t size, void* user)
+{
+    stack_store* st = user;
+    return size <= sizeof st->buf ? st->buf : scc_alloc(st->next, size);
+}
+
+static void stack_free(void* mem, size_t size, void* user)
+{
+    stack_store* st = user;
+    if (mem != (void*)st->buf) scc_free(st->next, mem, size);
+}
+
 /* The search. `seed_t` (INFINITY: none) is a known contact (weights seed_b) that is the initial upper
  * bound: while no earlier witness turns up, the search stops once the bracket is `seed_tol` wide;
  * after one, at the certified time tolerance. At most `max_evals` evaluations. */
@@ -67,7 +90,10 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
     /* The region store never holds more than cert_max_bytes (0: no limit); when it is full the
      * search stops like at the other caps: NOT_CONVERGED, the earliest witness so far, and the
      * popped region's start as the proven lower bound. */
-    region_heap h = { NULL, 0, 0, alloc, 0, 0 };
+    stack_store store;
+    store.next = alloc;
+    const scc_allocator stack_alloc_hooks = { stack_alloc, stack_free, &store };
+    region_heap h = { NULL, 0, 0, &stack_alloc_hooks, 0, 0 };
     if (p->cert_max_bytes > 0) h.max_bytes = (uint64_t)p->cert_max_bytes > SIZE_MAX ? SIZE_MAX : (size_t)p->cert_max_bytes;
     region root = { ta, tb, { 1, 0, 0 }, { 0, 1, 0 } };
     int capped = 0, ok = 1;
@@ -190,7 +216,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         }
     }
     if (!h.n && ok && !capped) lo = isfinite(hi) ? hi : tb;
-    scc_free(alloc, h.a, h.cap * sizeof *h.a);
+    scc_free(&stack_alloc_hooks, h.a, h.cap * sizeof *h.a);
     if (!ok) return 0;
 
     out->iterations = processed;
@@ -243,6 +269,11 @@ int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, dou
     /* No hit with no descent run: FWGSS's conservative no-contact proof (fwgss_clear_proof) held */
     if (!io->hit && io->state == SCC_NO_HIT && io->iterations == 0) return 1;
     int64_t budget = p->max_evals - io->evals;
+    /* at most SCC_VERIFY_FACTOR times FWGSS's own evaluations plus SCC_VERIFY_BASE_EVALS: a triangle
+     * resting at the contact level (a guard's per-triangle levels) keeps every region borderline, and
+     * the check would otherwise spend 10^5 evaluations there (test_guard) */
+    const int64_t cap = SCC_VERIFY_FACTOR * io->evals + SCC_VERIFY_BASE_EVALS;
+    if (budget > cap) budget = cap;
     if (budget > SCC_VERIFY_MAX_EVALS) budget = SCC_VERIFY_MAX_EVALS;
     if (budget <= 0) return 1;
     scc_tri_hit c;
