@@ -233,7 +233,8 @@ static void section_kinds(FILE* md, const char* dir, const table* t, const table
                 "search seeded with FWGSS's witness, at most 10^6 evaluations, and on convex ones without the guard's searches; on grids "
                 "the guard only when phi bends sharply at the earliest contact, no check); FWGSS-before: the defaults of the commit in "
                 "`kinds_machine.txt` (when present: main before the check); FWGSS-guard-off: FWGSS before issue 20 (`fwgss_kink_guard` "
-                "0: no guard, no check); FWGSS-guard-2: the guard on every grid query too. Rates are per "
+                "0: no guard, no check); FWGSS-guard-2: the guard on every grid query too; FWGSS-baseline and "
+                "FWGSS-paper keep `fwgss_kink_guard` 1, so the check too. Rates are per "
                 "certified hit. Issue 20's target: misses and false positives <= 0.1 %% and mean |ΔTOI| <= 1e-8 s on every kind.\n\n");
     fprintf(md, "| method | kind | cases | certified hits | misses | false pos. | mean \\|ΔTOI\\| (s) | ΔTOI max | µs/query | SDF evals/query | budget stops | other caps |\n");
     fprintf(md, "|---|---|---|---|---|---|---|---|---|---|---|---|\n");

@@ -139,8 +139,14 @@ typedef struct sdfccd_QueryParams {
                                         smooth shapes: at 1 a grid query gets the extra starts and the check only when
                                         the gradient turns by more than 0.2 rad within 1 mm of the earliest contact; at 2
                                         every grid query gets the whole guard. Smooth analytic fields (sphere, torus,
-                                        capsule, rounded box, half-space) are unaffected. Per-kind data set
-                                        (samples/report, section 2b) and costs: README. 0 = off, 1 (default) or 2. */
+                                        capsule, rounded box, half-space) are unaffected. At 1 and 2, on the analytic
+                                        fields with kinks, FWGSS's answer is then checked by the certified method's
+                                        search over [t0, TOI] (no hit: the whole interval) seeded with its witness: it
+                                        stops once no contact is proven more than max(time_tolerance, 1e-7 s) before
+                                        the witness, or after 128 x FWGSS's evaluations + 16384 (at most 10^6), and an
+                                        earlier contact it finds replaces the answer; on the convex ones (box,
+                                        cylinder) the golden-section searches and the 1 us check are left to it. Per-kind
+                                        data set (samples/report, section 2b) and costs: README. 0 = off, 1 (default) or 2. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
