@@ -68,6 +68,7 @@ void scc_grid_destroy(scc_grid* g)
     scc_free(&al, g->blocks, (size_t)g->block_count * sizeof(double));
     scc_free(&al, g->block_lipschitz, (size_t)((g->res[0] + 3) / 4) * ((g->res[1] + 3) / 4) * ((g->res[2] + 3) / 4) * sizeof(float));
     scc_free(&al, g->vertex_block, (size_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1) * sizeof(uint32_t));
+    scc_free(&al, g->axis_coef, 2 * ((size_t)g->res[0] + g->res[1] + g->res[2]) * sizeof(double));
     scc_free(&al, g->fields, (size_t)g->field_count * sizeof *g->fields);
     scc_free(&al, g, sizeof *g);
 }
@@ -85,6 +86,7 @@ size_t scc_grid_memory(const scc_grid* g)
     b += (size_t)g->block_count * sizeof(double);
     if (g->block_lipschitz) b += (size_t)((g->res[0] + 3) / 4) * ((g->res[1] + 3) / 4) * ((g->res[2] + 3) / 4) * sizeof(float);
     if (g->vertex_block) b += (size_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1) * sizeof(uint32_t);
+    if (g->axis_coef) b += 2 * ((size_t)g->res[0] + g->res[1] + g->res[2]) * sizeof(double);
     return b;
 }
 
@@ -271,9 +273,14 @@ static double eval_inside(const scc_grid* g, scc_vec3 p, scc_vec3* out_grad)
     const scc_grid_field* fd = &g->fields[0];
     uint32_t ijk[3];
     const uint64_t l = locate(g, p, ijk);
-    const uint32_t c = fd->map[l];
     double v;
-    if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f && interpolate_cell(g, fd, c, ijk, p, &v, out_grad)) return v;
+    if (g->direct) {
+        /* dense, every cell valued: no map or bound to read before the values */
+        interpolate_cell_checked(g, fd, (uint32_t)l, ijk, p, &v, out_grad, 0);
+        return v;
+    }
+    const uint32_t c = fd->map[l];
+    if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f && interpolate_cell_checked(g, fd, c, ijk, p, &v, out_grad, 0)) return v;
     return eval_hole(g, l, ijk, p, out_grad);
 }
 

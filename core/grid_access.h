@@ -62,27 +62,44 @@ static inline uint64_t locate(const scc_grid* g, scc_vec3 p, uint32_t ijk[3])
     return ijk[0] + (uint64_t)g->res[0] * (ijk[1] + (uint64_t)g->res[1] * ijk[2]);
 }
 
-/* Interpolates stored cell c (whose full-grid position is ijk) at p. Returns 0 when a node is
- * not sampled. */
-static inline int interpolate_cell(const scc_grid* g, const scc_grid_field* fd, uint32_t c, const uint32_t ijk[3], scc_vec3 p,
-                                   double* out_value, scc_vec3* out_grad)
+/* Local coordinates of p in the cell at ijk, xi_d = c0_d p_d - c1_d, with the per-cell
+ * coefficients of axis_coef (the same numbers the per-query formula of Discregrid and Bullet
+ * gives: 2/(hi - lo) and (hi + lo)/(hi - lo) of the cell box). */
+static inline scc_vec3 cell_local(const scc_grid* g, const uint32_t ijk[3], scc_vec3 p, double c0[3])
 {
-    const scc_aabb b = cell_box(g, ijk);
-    const double den[3] = { b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z };
-    const double c0[3] = { 2.0 / den[0], 2.0 / den[1], 2.0 / den[2] };
-    const double c1[3] = { (b.hi.x + b.lo.x) / den[0], (b.hi.y + b.lo.y) / den[1], (b.hi.z + b.lo.z) / den[2] };
-    const scc_vec3 xi = scc_v3(c0[0] * p.x - c1[0], c0[1] * p.y - c1[1], c0[2] * p.z - c1[2]);
+    const double* tx = g->axis_coef + 2 * (size_t)ijk[0];
+    const double* ty = g->axis_coef + 2 * ((size_t)g->res[0] + ijk[1]);
+    const double* tz = g->axis_coef + 2 * ((size_t)g->res[0] + g->res[1] + ijk[2]);
+    c0[0] = tx[0]; c0[1] = ty[0]; c0[2] = tz[0];
+    return scc_v3(tx[0] * p.x - tx[1], ty[0] * p.y - ty[1], tz[0] * p.z - tz[1]);
+}
+
+/* Interpolates stored cell c (whose full-grid position is ijk) at p. Returns 0 when a node is
+ * not sampled (checked only when `check`: field 0's cells with a bound >= 0 have every value). */
+static inline int interpolate_cell_checked(const scc_grid* g, const scc_grid_field* fd, uint32_t c, const uint32_t ijk[3], scc_vec3 p,
+                                           double* out_value, scc_vec3* out_grad, int check)
+{
+    double c0[3];
+    const scc_vec3 xi = cell_local(g, ijk, p, c0);
     /* Gather the 32 values first: independent loads let the memory accesses overlap. A dense
      * field 0 reads them from 8 vertex blocks (see scc_grid_dense_block_index). */
     double v[32];
-    int missing = 0;
     gather_cell(g, fd, c, ijk, v);
-    for (int a = 0; a < 32; ++a) missing |= v[a] == SCC_GRID_NO_VALUE;
-    if (missing) return 0;
+    if (check) {
+        int missing = 0;
+        for (int a = 0; a < 32; ++a) missing |= v[a] == SCC_GRID_NO_VALUE;
+        if (missing) return 0;
+    }
     double gr[3];
     scc_cell_eval(v, xi, out_value, out_grad ? gr : NULL);
     if (out_grad) *out_grad = scc_v3(gr[0] * c0[0], gr[1] * c0[1], gr[2] * c0[2]);
     return 1;
+}
+
+static inline int interpolate_cell(const scc_grid* g, const scc_grid_field* fd, uint32_t c, const uint32_t ijk[3], scc_vec3 p,
+                                   double* out_value, scc_vec3* out_grad)
+{
+    return interpolate_cell_checked(g, fd, c, ijk, p, out_value, out_grad, 1);
 }
 
 static inline scc_vec3 clamp_box(scc_vec3 p, const scc_aabb* b)
