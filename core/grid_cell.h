@@ -89,17 +89,24 @@ SCC_CELL_INLINE void scc_cell_eval_at(const double* const c[8], const double* co
     const double x[3] = { xi.x, xi.y, xi.z };
     double L[3][2];
     for (int d = 0; d < 3; ++d) { L[d][0] = 1.0 - x[d]; L[d][1] = 1.0 + x[d]; }
-    const double v0 = *c[0], v1 = *c[1], v2 = *c[2], v3 = *c[3], v4 = *c[4], v5 = *c[5], v6 = *c[6], v7 = *c[7];
-    /* trilinear form of the corner values (slot di + 2 dj + 4 dk) and its derivatives */
-    const double a00 = v0 * L[0][0] + v1 * L[0][1], a10 = v2 * L[0][0] + v3 * L[0][1];
-    const double a01 = v4 * L[0][0] + v5 * L[0][1], a11 = v6 * L[0][0] + v7 * L[0][1];
-    const double y0z0 = L[1][0] * L[2][0], y1z0 = L[1][1] * L[2][0], y0z1 = L[1][0] * L[2][1], y1z1 = L[1][1] * L[2][1];
-    const double S = a00 * y0z0 + a10 * y1z0 + a01 * y0z1 + a11 * y1z1;
+    /* trilinear form of the corner values (slot di + 2 dj + 4 dk) and its derivatives, the
+     * corners paired along y: lanes (dj = 0, dj = 1) */
+    const scc_d2 v02 = scc_d2_pair(*c[0], *c[2]), v13 = scc_d2_pair(*c[1], *c[3]);
+    const scc_d2 v46 = scc_d2_pair(*c[4], *c[6]), v57 = scc_d2_pair(*c[5], *c[7]);
+    /* (a00, a10) and (a01, a11): a_jk = v(0,j,k) (1 - x) + v(1,j,k) (1 + x) */
+    const scc_d2 A0 = scc_d2_add(scc_d2_muls(v02, L[0][0]), scc_d2_muls(v13, L[0][1]));
+    const scc_d2 A1 = scc_d2_add(scc_d2_muls(v46, L[0][0]), scc_d2_muls(v57, L[0][1]));
+    const double a00 = scc_d2_lane(A0, 0), a10 = scc_d2_lane(A0, 1), a01 = scc_d2_lane(A1, 0), a11 = scc_d2_lane(A1, 1);
+    const scc_d2 Yz0 = scc_d2_muls(scc_d2_pair(L[1][0], L[1][1]), L[2][0]), Yz1 = scc_d2_muls(scc_d2_pair(L[1][0], L[1][1]), L[2][1]);
+    const scc_d2 P0 = scc_d2_mul(A0, Yz0), P1 = scc_d2_mul(A1, Yz1);
+    const double S = scc_d2_lane(P0, 0) + scc_d2_lane(P0, 1) + scc_d2_lane(P1, 0) + scc_d2_lane(P1, 1);
     double Sx = 0.0, Sy = 0.0, Sz = 0.0;
     if (out_grad) {
-        Sx = (v1 - v0) * y0z0 + (v3 - v2) * y1z0 + (v5 - v4) * y0z1 + (v7 - v6) * y1z1;
+        const scc_d2 Q0 = scc_d2_mul(scc_d2_sub(v13, v02), Yz0), Q1 = scc_d2_mul(scc_d2_sub(v57, v46), Yz1);
+        Sx = scc_d2_lane(Q0, 0) + scc_d2_lane(Q0, 1) + scc_d2_lane(Q1, 0) + scc_d2_lane(Q1, 1);
         Sy = (a10 - a00) * L[2][0] + (a11 - a01) * L[2][1];
-        Sz = (a01 - a00) * L[1][0] + (a11 - a10) * L[1][1];
+        const scc_d2 Z = scc_d2_mul(scc_d2_sub(A1, A0), scc_d2_pair(L[1][0], L[1][1]));
+        Sz = scc_d2_lane(Z, 0) + scc_d2_lane(Z, 1);
     }
     const double q = 9.0 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) - 19.0;
     double phi = (1.0 / 64.0) * q * S;
