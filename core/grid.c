@@ -267,6 +267,24 @@ static double eval_hole(const scc_grid* g, uint64_t l, const uint32_t ijk[3], sc
     return s * lb;
 }
 
+/* Field 0 of a direct grid (dense, every cell valued) in full-grid cell l at ijk: no map or
+ * bound to read before the values, which come straight from the 8 vertex blocks (the numbers
+ * interpolate_cell gives). */
+SCC_CELL_INLINE double eval_direct(const scc_grid* g, uint64_t l, const uint32_t ijk[3], scc_vec3 p, scc_vec3* out_grad)
+{
+    (void)l;
+    double v, c0[3], gr[3];
+    const scc_vec3 xi = cell_local(g, ijk, p, c0);
+    const double* b[8];
+    cell_blocks_of(g, ijk, b);
+    const double* const ex[4] = { b[0] + 1, b[4] + 1, b[2] + 1, b[6] + 1 };
+    const double* const ey[4] = { b[0] + 3, b[1] + 3, b[4] + 3, b[5] + 3 };
+    const double* const ez[4] = { b[0] + 5, b[2] + 5, b[1] + 5, b[3] + 5 };
+    scc_cell_eval_at(b, ex, ey, ez, xi, &v, out_grad ? gr : NULL);
+    if (out_grad) *out_grad = scc_v3(gr[0] * c0[0], gr[1] * c0[1], gr[2] * c0[2]);
+    return v;
+}
+
 /* Field 0 at p inside the (closed) domain box. */
 static double eval_inside(const scc_grid* g, scc_vec3 p, scc_vec3* out_grad)
 {
@@ -274,20 +292,7 @@ static double eval_inside(const scc_grid* g, scc_vec3 p, scc_vec3* out_grad)
     uint32_t ijk[3];
     const uint64_t l = locate(g, p, ijk);
     double v;
-    if (g->direct) {
-        /* dense, every cell valued: no map or bound to read before the values, which come
-         * straight from the 8 vertex blocks (the numbers interpolate_cell gives) */
-        double c0[3], gr[3];
-        const scc_vec3 xi = cell_local(g, ijk, p, c0);
-        const double* b[8];
-        cell_blocks_of(g, ijk, b);
-        const double* const ex[4] = { b[0] + 1, b[4] + 1, b[2] + 1, b[6] + 1 };
-        const double* const ey[4] = { b[0] + 3, b[1] + 3, b[4] + 3, b[5] + 3 };
-        const double* const ez[4] = { b[0] + 5, b[2] + 5, b[1] + 5, b[3] + 5 };
-        scc_cell_eval_at(b, ex, ey, ez, xi, &v, out_grad ? gr : NULL);
-        if (out_grad) *out_grad = scc_v3(gr[0] * c0[0], gr[1] * c0[1], gr[2] * c0[2]);
-        return v;
-    }
+    if (g->direct) return eval_direct(g, l, ijk, p, out_grad);
     const uint32_t c = fd->map[l];
     if (c != SCC_GRID_NO_CELL && g->cell_lipschitz[c] >= 0.0f && interpolate_cell_checked(g, fd, c, ijk, p, &v, out_grad, 0)) return v;
     return eval_hole(g, l, ijk, p, out_grad);
@@ -297,7 +302,14 @@ double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
 {
     const scc_grid* g = (const scc_grid*)self;
     /* inside the closed domain box (NaN fails the test): the common case, straight to the cell */
-    if (p.x >= g->lo.x && p.x <= g->hi.x && p.y >= g->lo.y && p.y <= g->hi.y && p.z >= g->lo.z && p.z <= g->hi.z) return eval_inside(g, p, out_grad);
+    if (p.x >= g->lo.x && p.x <= g->hi.x && p.y >= g->lo.y && p.y <= g->hi.y && p.z >= g->lo.z && p.z <= g->hi.z) {
+        if (g->direct) {
+            uint32_t ijk[3];
+            const uint64_t l = locate(g, p, ijk);
+            return eval_direct(g, l, ijk, p, out_grad);
+        }
+        return eval_inside(g, p, out_grad);
+    }
     if (!scc_vfinite(p)) {
         if (out_grad) *out_grad = scc_v3(0, 0, 1);
         return INFINITY;
