@@ -27,7 +27,7 @@ void scc_cell_bernstein(double out[64][32]);
  * has them (GCC and Clang vector extensions; plain C otherwise). Each lane does the scalar
  * formula's operations in the scalar formula's order, so both builds give the same bits. */
 
-#if defined(__GNUC__) || defined(__clang__)
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(SCC_CELL_PLAIN_C) /* SCC_CELL_PLAIN_C: test the fallback */
 #define SCC_CELL_INLINE static inline __attribute__((always_inline))
 typedef double scc_d2 __attribute__((vector_size(16)));
 static inline scc_d2 scc_d2_load(const double* p) { scc_d2 r; __builtin_memcpy(&r, p, sizeof r); return r; }
