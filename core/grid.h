@@ -77,6 +77,12 @@ typedef struct scc_grid {
     uint64_t block_count;      /* doubles in blocks */
     uint32_t* vertex_block;    /* narrow band built in-tree: per grid vertex, its block in `blocks`
                                   (only vertices of kept cells have one); NULL when dense */
+    double* axis_coef;         /* (scc_grid_finalize) per axis d, per cell m along it, the pair
+                                  c0 = 2/(hi-lo), c1 = (hi+lo)/(hi-lo) of the cell's interval exactly as
+                                  Discregrid and Bullet compute them per query: 2 (res[0]+res[1]+res[2])
+                                  doubles, axis 0 first; spares six divisions per evaluation */
+    int direct;                /* field 0 dense in vertex blocks, identity map, every cell valued:
+                                  evaluation goes from the cell straight to its 8 blocks */
     scc_allocator allocator;   /* what freed the arrays (copied at creation) */
 } scc_grid;
 

@@ -9,6 +9,9 @@
 #include "grid_access.h"
 
 #include <string.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 /* ------------------------------------------------------------------------------------------
  * Finalisation: per-cell gradient bounds and hole sources.
@@ -105,6 +108,54 @@ static int boundary_cell(const scc_grid* g, uint64_t l, uint32_t ijk[3], int lo_
         any |= lo_face[d] | hi_face[d];
     }
     return any;
+}
+
+/* Job 0: the per-cell coefficients of the map to local coordinates (axis_coef in grid.h), from
+ * the cell box exactly as cell_box and the per-query formula compute it. */
+static scc_grid_status axis_tables(scc_grid* g)
+{
+    const size_t n = 2 * ((size_t)g->res[0] + g->res[1] + g->res[2]);
+    if (!g->axis_coef) g->axis_coef = scc_alloc(&g->allocator, n * sizeof(double));
+    if (!g->axis_coef) return SCC_GRID_OUT_OF_MEMORY;
+    const double lo[3] = { g->lo.x, g->lo.y, g->lo.z }, h[3] = { g->h.x, g->h.y, g->h.z };
+    double* t = g->axis_coef;
+    for (int d = 0; d < 3; ++d)
+        for (uint32_t m = 0; m < g->res[d]; ++m, t += 2) {
+            const double a = lo[d] + (double)m * h[d], b = a + h[d], den = b - a;
+            t[0] = 2.0 / den;
+            t[1] = (b + a) / den;
+        }
+    return SCC_GRID_OK;
+}
+
+/* Large value arrays are read at random cells (a cell's 8 vertex blocks lie on 4 rows, up to 4
+ * pages apart): where the system has transparent huge pages, ask for them on the whole 2 MB pages
+ * inside a fresh copy (before it is touched), so a query costs no TLB misses (dense grids of 4 MB
+ * or more; the copy briefly doubles the blocks at load). Advisory only: a
+ * refusal changes nothing. */
+static void advise_huge_pages(void* p, size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    const uintptr_t huge = (uintptr_t)2 << 20;
+    const uintptr_t lo = ((uintptr_t)p + huge - 1) & ~(huge - 1), hi = ((uintptr_t)p + bytes) & ~(huge - 1);
+    if (hi > lo) (void)madvise((void*)lo, hi - lo, MADV_HUGEPAGE);
+#else
+    (void)p;
+    (void)bytes;
+#endif
+}
+
+static scc_grid_status blocks_on_huge_pages(scc_grid* g)
+{
+    const size_t bytes = (size_t)g->block_count * sizeof(double);
+    if (!g->blocks || g->vertex_block || bytes < ((size_t)4 << 20)) return SCC_GRID_OK;
+    double* copy = scc_alloc(&g->allocator, bytes);
+    if (!copy) return SCC_GRID_OK; /* keep the blocks where they are */
+    advise_huge_pages(copy, bytes);
+    memcpy(copy, g->blocks, bytes);
+    scc_free(&g->allocator, g->blocks, bytes);
+    g->blocks = copy;
+    return SCC_GRID_OK;
 }
 
 /* Job 1, layout: a field 0 loaded in Discregrid's dense layout (identity map, tables equal to the
@@ -324,7 +375,9 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     const scc_allocator* a = &g->allocator;
     if (g->n_cells > 0x7FFFFFFEu) return SCC_GRID_TOO_LARGE;
     g->band = band > 0.0 && isfinite(band) ? band : 0.0;
-    scc_grid_status st = adopt_dense_layout(g);
+    scc_grid_status st = axis_tables(g);
+    if (st == SCC_GRID_OK) st = adopt_dense_layout(g);
+    if (st == SCC_GRID_OK) st = blocks_on_huge_pages(g);
     if (st != SCC_GRID_OK) return st;
     bern_tables* bt = scc_alloc(a, sizeof *bt);
     if (!bt) return SCC_GRID_OUT_OF_MEMORY;
@@ -333,6 +386,10 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
         for (int q = 0; q < 64; ++q) bt->by_node[k][q] = bt->val[q][k];
     st = compute_cell_bounds(g, bt, parallel_for, parallel_user);
     if (st == SCC_GRID_OK) st = count_valued_cells(g);
+    if (st == SCC_GRID_OK && g->dense_layout && g->valued_cells == g->n_cells) {
+        g->direct = 1;
+        for (uint64_t l = 0; l < g->n_cells && g->direct; ++l) g->direct = g->fields[0].map[l] == l;
+    }
     if (st == SCC_GRID_OK) st = find_hole_sources(g);
     if (st == SCC_GRID_OK) st = compute_block_bounds(g);
     if (st == SCC_GRID_OK) {

@@ -85,61 +85,9 @@ void scc_cell_shape(scc_vec3 xi, double N[32], double dN[32][3])
     }
 }
 
-/* One edge family of the factored element: e[4 dp + 2 dr + t] are the values of the edge
- * nodes along axis d (at -1/3, +1/3 for t = 0, 1); Lp, Lr the linear factors of the outer and
- * inner axes. Adds the family's value to *phi and its derivatives to g[d], g[p], g[r]. */
-static inline void edge_family(const double e[8], double xd, const double Lp[2], const double Lr[2], double* phi, double* g, int d, int p, int r)
-{
-    const double w = 1.0 - xd * xd;
-    const double m0 = 1.0 - 3.0 * xd, m1 = 1.0 + 3.0 * xd;
-    const double l00 = Lp[0] * Lr[0], l01 = Lp[0] * Lr[1], l10 = Lp[1] * Lr[0], l11 = Lp[1] * Lr[1];
-    const double B0 = e[0] * l00 + e[2] * l01 + e[4] * l10 + e[6] * l11;
-    const double B1 = e[1] * l00 + e[3] * l01 + e[5] * l10 + e[7] * l11;
-    const double m = m0 * B0 + m1 * B1;
-    *phi += (9.0 / 64.0) * w * m;
-    if (g) {
-        /* d/dx_p of Lp[dp] is -1, +1; d/dx_r of Lr[dr] likewise */
-        const double Bp0 = (e[4] - e[0]) * Lr[0] + (e[6] - e[2]) * Lr[1], Bp1 = (e[5] - e[1]) * Lr[0] + (e[7] - e[3]) * Lr[1];
-        const double Br0 = (e[2] - e[0]) * Lp[0] + (e[6] - e[4]) * Lp[1], Br1 = (e[3] - e[1]) * Lp[0] + (e[7] - e[5]) * Lp[1];
-        g[d] += (9.0 / 64.0) * (-2.0 * xd * m + w * 3.0 * (B1 - B0));
-        g[p] += (9.0 / 64.0) * w * (m0 * Bp0 + m1 * Bp1);
-        g[r] += (9.0 / 64.0) * w * (m0 * Br0 + m1 * Br1);
-    }
-}
-
 void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double out_grad[3])
 {
-    /* The same interpolant as sum_a v[a] N_a, factored: the corner part is
-     * (9 r^2 - 19)/64 times the trilinear form S of the corner values, and each edge family is
-     * (9/64)(1 - x_d^2) times a cubic factor in x_d times a bilinear form in the other two. */
-    const double x[3] = { xi.x, xi.y, xi.z };
-    double L[3][2];
-    for (int d = 0; d < 3; ++d) { L[d][0] = 1.0 - x[d]; L[d][1] = 1.0 + x[d]; }
-    /* trilinear form of the corner values (slot di + 2 dj + 4 dk) and its derivatives */
-    const double a00 = v[0] * L[0][0] + v[1] * L[0][1], a10 = v[2] * L[0][0] + v[3] * L[0][1];
-    const double a01 = v[4] * L[0][0] + v[5] * L[0][1], a11 = v[6] * L[0][0] + v[7] * L[0][1];
-    const double y0z0 = L[1][0] * L[2][0], y1z0 = L[1][1] * L[2][0], y0z1 = L[1][0] * L[2][1], y1z1 = L[1][1] * L[2][1];
-    const double S = a00 * y0z0 + a10 * y1z0 + a01 * y0z1 + a11 * y1z1;
-    double Sx = 0.0, Sy = 0.0, Sz = 0.0;
-    if (out_grad) {
-        Sx = (v[1] - v[0]) * y0z0 + (v[3] - v[2]) * y1z0 + (v[5] - v[4]) * y0z1 + (v[7] - v[6]) * y1z1;
-        Sy = (a10 - a00) * L[2][0] + (a11 - a01) * L[2][1];
-        Sz = (a01 - a00) * L[1][0] + (a11 - a10) * L[1][1];
-    }
-    const double q = 9.0 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) - 19.0;
-    double phi = (1.0 / 64.0) * q * S;
-    double g[3] = { 0.0, 0.0, 0.0 };
-    if (out_grad) {
-        g[0] = (1.0 / 64.0) * (q * Sx + 18.0 * x[0] * S);
-        g[1] = (1.0 / 64.0) * (q * Sy + 18.0 * x[1] * S);
-        g[2] = (1.0 / 64.0) * (q * Sz + 18.0 * x[2] * S);
-    }
-    /* edge families: x (outer y, inner z), y (outer z, inner x), z (outer x, inner y) */
-    edge_family(v + 8, x[0], L[1], L[2], &phi, out_grad ? g : NULL, 0, 1, 2);
-    edge_family(v + 16, x[1], L[2], L[0], &phi, out_grad ? g : NULL, 1, 2, 0);
-    edge_family(v + 24, x[2], L[0], L[1], &phi, out_grad ? g : NULL, 2, 0, 1);
-    *out_value = phi;
-    if (out_grad) { out_grad[0] = g[0]; out_grad[1] = g[1]; out_grad[2] = g[2]; }
+    scc_cell_eval_inline(v, xi, out_value, out_grad);
 }
 
 /* out[s][a]: the Bernstein coefficient s = i + 4j + 16k (degree 3 per axis on [-1,1]^3) of

@@ -2,19 +2,35 @@
  * sdfccd core: rigid (Eq. 14), per-vertex linear and relative motion (Section 4.1). */
 #include "motion.h"
 
-void scc_rigid_pose_at(const scc_rigid* r, double t, scc_quat* out_q, scc_vec3* out_p)
+/* Centre of rotation at t. */
+static inline scc_vec3 center_at(const scc_rigid* r, double t)
 {
-    double tau = t - r->t0;
-    scc_quat q = scc_quat_mul(scc_quat_from_rotvec(scc_scale(r->w, tau)), r->q0);
-    scc_vec3 g = scc_rigid_center_at(r, t);
+    scc_vec3 g0 = scc_add(r->p0, scc_quat_rotate(r->q0, r->c_local));
+    return scc_madd(g0, r->v, t - r->t0);
+}
+
+/* Pose (q, p) and centre g at t, the centre computed once (every query sample needs all three).
+ * A body that does not spin keeps q0 (no rotation vector to turn into a quaternion: the product
+ * with the identity would give the same numbers, up to the sign of a zero). */
+static inline void pose_center_at(const scc_rigid* r, double t, scc_quat* out_q, scc_vec3* out_p, scc_vec3* out_g)
+{
+    const int spins = r->w.x != 0.0 || r->w.y != 0.0 || r->w.z != 0.0;
+    const scc_quat q = spins ? scc_quat_mul(scc_quat_from_rotvec(scc_scale(r->w, t - r->t0)), r->q0) : r->q0;
+    const scc_vec3 g = center_at(r, t);
     *out_q = q;
     *out_p = scc_sub(g, scc_quat_rotate(q, r->c_local));
+    *out_g = g;
+}
+
+void scc_rigid_pose_at(const scc_rigid* r, double t, scc_quat* out_q, scc_vec3* out_p)
+{
+    scc_vec3 g;
+    pose_center_at(r, t, out_q, out_p, &g);
 }
 
 scc_vec3 scc_rigid_center_at(const scc_rigid* r, double t)
 {
-    scc_vec3 g0 = scc_add(r->p0, scc_quat_rotate(r->q0, r->c_local));
-    return scc_madd(g0, r->v, t - r->t0);
+    return center_at(r, t);
 }
 
 /* World position and velocity of a body-local point. */
@@ -32,8 +48,7 @@ static sdf_frame frame_at(const scc_rigid* sdf, double t)
     sdf_frame f;
     f.moving = sdf != NULL;
     if (sdf) {
-        scc_rigid_pose_at(sdf, t, &f.q, &f.p);
-        f.g = scc_rigid_center_at(sdf, t);
+        pose_center_at(sdf, t, &f.q, &f.p, &f.g);
     } else {
         f.q = scc_quat_identity();
         f.p = f.g = scc_v3(0, 0, 0);
@@ -59,8 +74,8 @@ void scc_tri_state_at(const scc_tri_motion* m, double t, scc_tri_state* out)
     if (m->kind == SCC_TRI_RIGID) {
         scc_quat q;
         scc_vec3 p;
-        scc_rigid_pose_at(m->body, t, &q, &p);
-        scc_vec3 g = scc_rigid_center_at(m->body, t);
+        scc_vec3 g;
+        pose_center_at(m->body, t, &q, &p, &g);
         for (int i = 0; i < 3; ++i) {
             out->x[i] = rigid_point(m->body, q, p, g, m->local[i], &out->v[i]);
             out->x[i] = to_sdf(m->sdf, &f, out->x[i], &out->v[i]);
@@ -84,8 +99,8 @@ scc_vec3 scc_tri_point_at(const scc_tri_motion* m, const double b[3], double t, 
         scc_vec3 local = scc_add(scc_add(scc_scale(m->local[0], b[0]), scc_scale(m->local[1], b[1])), scc_scale(m->local[2], b[2]));
         scc_quat q;
         scc_vec3 p;
-        scc_rigid_pose_at(m->body, t, &q, &p);
-        scc_vec3 g = scc_rigid_center_at(m->body, t);
+        scc_vec3 g;
+        pose_center_at(m->body, t, &q, &p, &g);
         x = rigid_point(m->body, q, p, g, local, &v);
     } else {
         double span = m->t1 - m->t0;

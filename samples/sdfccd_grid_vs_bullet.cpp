@@ -3,24 +3,27 @@
 // own evaluator (btSdfCollisionShape::queryPoint, the double build), in one process, on the same
 // points. Prints CSV: grid,resolution,pattern,evaluator,ns_per_point (median of the repeats),
 // ratio (Bullet / this evaluator, from the same repeat), max_abs_diff (value against Bullet).
+// Times are the thread's CPU time (CLOCK_THREAD_CPUTIME_ID), the evaluators taking turns on chunks.
 //
 //   sdfccd_grid_vs_bullet [--points N] [--repeats R] [--data DIR]
 //
 // Grids: the concave box of pybullet's example (data/sdf/concave_box_r32.cdf, 32^3) and a 64^3 torus
-// (R 0.1, r 0.05; Table 4's), baked in process and saved to a temporary .cdf that both load. Patterns: `random` (uniform
+// (R 0.1, r 0.05), baked in process and saved to a temporary .cdf that both load. Patterns: `random` (uniform
 // points in the domain: a random cell each time) and `walk` (a random walk of quarter-cell steps,
 // coherent like the samples of a moving triangle). sdfccd is measured per point through the ABI
 // (sdfccd_sdf_eval, one handle lookup each) and in batches of 256 (sdfccd_sdf_eval_batch).
 #include <BulletCollision/CollisionShapes/btSdfCollisionShape.h>
 
 #include <algorithm>
-#include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
+
+#include <time.h>
 
 #include "sdfccd/sdfccd.h"
 
@@ -42,9 +45,12 @@ struct Rng {
     }
 };
 
+// This thread's CPU time (the machine is shared: time spent descheduled is not the evaluator's).
 double now()
 {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 std::vector<char> read_all(const std::string& path)
@@ -122,26 +128,37 @@ void compare(const char* name, const std::string& path, int npoints, int repeats
         std::vector<double> t_abi, t_batch, t_bullet, r_abi, r_batch;
         double sink = 0;
         for (int r = 0; r < repeats; ++r) {
-            // interleaved so a change of the machine's load hits all three alike
-            double t = now();
-            for (size_t i = 0; i < pts.size(); ++i) {
-                btScalar dist = 0;
-                btVector3 normal(0, 0, 0);
-                shape.queryPoint(btVector3(pts[i].x, pts[i].y, pts[i].z), dist, normal);
-                theirs[i] = dist;
-                sink += normal.x();
+            // The three evaluators take turns on chunks of 2048 points, so a change of the machine's
+            // load hits all three alike (the machine is shared); at each turn they work on chunks a
+            // third of the points apart, so none finds the cells another just brought into the cache.
+            double bullet = 0, abi = 0, batch = 0;
+            const size_t chunk = 2048, nchunks = (pts.size() + chunk - 1) / chunk;
+            for (size_t k = 0; k < nchunks; ++k) {
+                size_t c0 = k * chunk, c1 = std::min(pts.size(), c0 + chunk);
+                double t = now();
+                for (size_t i = c0; i < c1; ++i) {
+                    btScalar dist = 0;
+                    btVector3 normal(0, 0, 0);
+                    shape.queryPoint(btVector3(pts[i].x, pts[i].y, pts[i].z), dist, normal);
+                    theirs[i] = dist;
+                    sink += normal.x();
+                }
+                bullet += now() - t;
+                c0 = ((k + nchunks / 3) % nchunks) * chunk;
+                c1 = std::min(pts.size(), c0 + chunk);
+                t = now();
+                for (size_t i = c0; i < c1; ++i)
+                    if (sdfccd_sdf_eval(grid, pts[i], &values[i], &grads[i]) != SDFCCD_OK) die("eval");
+                abi += now() - t;
+                c0 = ((k + 2 * nchunks / 3) % nchunks) * chunk;
+                c1 = std::min(pts.size(), c0 + chunk);
+                t = now();
+                for (size_t i = c0; i < c1; i += 256) {
+                    const int32_t n = (int32_t)std::min<size_t>(256, c1 - i);
+                    if (sdfccd_sdf_eval_batch(grid, &pts[i], n, &values[i], &grads[i]) != SDFCCD_OK) die("eval batch");
+                }
+                batch += now() - t;
             }
-            const double bullet = now() - t;
-            t = now();
-            for (size_t i = 0; i < pts.size(); ++i)
-                if (sdfccd_sdf_eval(grid, pts[i], &values[i], &grads[i]) != SDFCCD_OK) die("eval");
-            const double abi = now() - t;
-            t = now();
-            for (size_t i = 0; i < pts.size(); i += 256) {
-                const int32_t n = (int32_t)std::min<size_t>(256, pts.size() - i);
-                if (sdfccd_sdf_eval_batch(grid, &pts[i], n, &values[i], &grads[i]) != SDFCCD_OK) die("eval batch");
-            }
-            const double batch = now() - t;
             const double per = 1e9 / (double)pts.size();
             t_bullet.push_back(bullet * per);
             t_abi.push_back(abi * per);
