@@ -39,6 +39,7 @@ typedef struct scc_params {
     int fwgss_clear_budget; /* FWGSS: evaluations of the no-contact proof tried before the descents (0: off) */
     double fwgss_gap_tol;   /* FWGSS: line searches far from the surface stop early by this fraction of the gap */
     int fwgss_deriv_spatial; /* FWGSS: spatial line searches at full precision use the gradient (scc_deriv_minimize) */
+    int fwgss_verify;       /* FWGSS on analytic kinked fields: the answer checked by scc_fwgss_verify */
     int fwgss_kink_guard;   /* FWGSS on fields with gradient jumps (0 off, 1 grids after a check, 2 grids always): golden section, more starts, the 1 us probe */
     int fwgss_restart_at_witness; /* FWGSS: restarts begin at the earliest witness's time (else at ts) */
     int64_t max_evals;      /* SDF evaluation budget of this call (> 0); solvers stop at it (NOT_CONVERGED) */
@@ -101,10 +102,8 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                      const scc_allocator* alloc, scc_tri_hit* io);
 /* Whether scc_fwgss_verify checks FWGSS on this field: analytic fields with gradient jumps and
- * fwgss_kink_guard on (grids are not: their cells' Lipschitz bounds make it far too slow). */
+ * fwgss_kink_guard and fwgss_verify on (grids are not: their cells' Lipschitz bounds make it far too slow). */
 int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p);
-int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                     const scc_allocator* alloc, scc_tri_hit* io);
 
 /* ---- adaptive triangle subdivision at the TOI (Section 4.5) ----
  * `tri` is the triangle at the TOI, `primary` the weights of the first contact. Writes up to

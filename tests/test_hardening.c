@@ -121,6 +121,10 @@ START_TEST(test_budget_shared_by_segments)
         p.fwgss_kink_guard = bad_guard[k];
         ck_assert_int_eq(sdfccd_query_triangle(s, NULL, k_tri, &m, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
         ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "fwgss_kink_guard"));
+        p = sdfccd_default_query_params();
+        p.fwgss_verify = bad_guard[k] < 0 ? -1 : 2; /* fwgss_verify is 0 or 1 */
+        ck_assert_int_eq(sdfccd_query_triangle(s, NULL, k_tri, &m, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
+        ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "fwgss_verify"));
     }
     sdfccd_destroy_sdf(s);
 }

@@ -142,6 +142,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         sdfccd_GuardParams gp = sdfccd_default_guard_params();
         gp.tolerance = cfg.guard_tolerance;
         gp.query.fwgss_restarts = cfg.query.fwgss_restarts; // the bridge's (0): the core's discrete check backs it
+        gp.query.fwgss_verify = cfg.query.fwgss_verify;
         // The SDFs and the boxes they sweep in the step.
         struct SdfObject { // the SDF's motion: a static one still has its pose (NULL would mean the world origin)
             const btCollisionObject* co;

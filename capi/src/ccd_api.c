@@ -77,6 +77,9 @@ sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* f
     if (in->fwgss_kink_guard < 0 || in->fwgss_kink_guard > 2)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_kink_guard must be 0, 1 or 2 (got %d)", fn, in->fwgss_kink_guard);
     out->fwgss_kink_guard = in->fwgss_kink_guard;
+    if (in->fwgss_verify != 0 && in->fwgss_verify != 1)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->fwgss_verify must be 0 or 1 (got %d)", fn, in->fwgss_verify);
+    out->fwgss_verify = in->fwgss_verify;
     return SDFCCD_OK;
 }
 

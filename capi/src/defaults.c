@@ -36,6 +36,7 @@ sdfccd_QueryParams sdfccd_default_query_params(void)
     p.fwgss_derivative_spatial = 1;
     p.fwgss_restart_at_witness = 1;
     p.fwgss_kink_guard = 1;
+    p.fwgss_verify = 1;
     return p;
 }
 

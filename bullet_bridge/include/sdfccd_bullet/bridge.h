@@ -162,10 +162,12 @@ struct Config {
     int batch_threads = 1;
     /** Query parameters passed to sdfccd_query_mesh (margin is replaced by contact_margin): the
      * library's defaults except fwgss_restarts (0): the bridge's discrete query over every
-     * feature within the step's travel catches what a restart would correct. */
+     * feature within the step's travel catches what a restart would correct; and fwgss_verify (0):
+     * the certified check costs thousands of evaluations per resting triangle every step, and the
+     * guarantee puts back what a late time of impact lets through. */
     sdfccd_QueryParams query;
     /** The defaults stated above. */
-    Config() : query(sdfccd_default_query_params()) { query.fwgss_restarts = 0; }
+    Config() : query(sdfccd_default_query_params()) { query.fwgss_restarts = 0; query.fwgss_verify = 0; }
 };
 
 /** Counters for measurements (all since construction or resetStats()). */

@@ -147,6 +147,12 @@ typedef struct sdfccd_QueryParams {
                                         earlier contact it finds replaces the answer; on the convex ones (box,
                                         cylinder) the golden-section searches and the 1 us check are left to it. Per-kind
                                         data set (samples/report, section 2b) and costs: README. 0 = off, 1 (default) or 2. */
+    int32_t fwgss_verify;          /**< FWGSS: where fwgss_kink_guard applies to an analytic field with gradient jumps,
+                                        the answer is checked by the certified search seeded with FWGSS's witness
+                                        (an earlier contact found replaces it; at most 128x FWGSS's evaluations
+                                        + 16384). 0 = no check (the guard's searches instead), as before issue 20.
+                                        Default 1. The Bullet bridge sets 0: a triangle resting at its contact level
+                                        keeps the check busy at every step, and its guarantee backs the answer. */
 } sdfccd_QueryParams;
 
 /** Default of sdfccd_QueryParams::max_sdf_evaluations. */
