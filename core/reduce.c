@@ -180,18 +180,20 @@ size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, do
     /* the first point: given, or the deepest; among equally deep ones (a face landing flat) the one
      * farthest from their centre, a corner, so the polygon grows to the region's corners */
     long best = first >= 0 && (size_t)first < n ? first : -1;
+    long deepest = -1; /* the smallest gap, the lower index on ties */
+    for (size_t i = 0; best < 0 && i < n; ++i)
+        if (deepest < 0 || item(&r, i).gap < item(&r, (size_t)deepest).gap) deepest = (long)i;
+    /* weighted: distances on the plane of the deepest point's normal from the start */
+    const int plane = best < 0 && depth_scale > 0.0;
+    if (plane) r.nref = scc_normalize_or(item(&r, (size_t)deepest).n, scc_v3(0, 0, 1));
     if (best < 0) {
-        double g0 = INFINITY;
-        for (size_t i = 0; i < n; ++i) g0 = fmin(g0, item(&r, i).gap);
-        /* weighted (a step's candidates, with gaps from a float engine): equal within a thousandth
-           of tol, and the farthest wins only by more than tol (rounding never flips the choice
-           from step to step) */
+        const double g0 = item(&r, (size_t)deepest).gap;
         const double same = fmax(1e-9 * fmax(1.0, fabs(g0)), depth_scale > 0.0 ? 1e-3 * tol : 0.0);
         scc_vec3 c = scc_v3(0, 0, 0);
         double cnt = 0.0;
         for (size_t i = 0; i < n; ++i) {
             scc_reduce_item it = item(&r, i);
-            if (it.gap <= g0 + same) { c = scc_add(c, it.p); cnt += 1.0; }
+            if (it.gap <= g0 + same) { c = scc_add(c, plane ? flat(&r, it.p) : it.p); cnt += 1.0; }
         }
         c = scc_scale(c, 1.0 / cnt);
         double bs = 0.0;
@@ -199,13 +201,13 @@ size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, do
         for (size_t i = 0; i < n; ++i) {
             scc_reduce_item it = item(&r, i);
             if (!(it.gap <= g0 + same)) continue;
-            double s = scc_dist(it.p, c);
-            if (depth_scale > 0.0 ? (best < 0 || s > bs + tol) : beats(s, &it, i, bs, &bit, best)) { best = (long)i; bs = s; bit = it; }
+            double s = scc_dist(plane ? flat(&r, it.p) : it.p, c);
+            if (plane ? (best < 0 || s > bs + tol) : beats(s, &it, i, bs, &bit, best)) { best = (long)i; bs = s; bit = it; }
         }
     }
     out[r.m++] = (int32_t)best;
     r.gap0 = item(&r, (size_t)best).gap;
-    r.nref = scc_normalize_or(item(&r, (size_t)best).n, scc_v3(0, 0, 1));
+    if (!plane) r.nref = scc_normalize_or(item(&r, (size_t)best).n, scc_v3(0, 0, 1));
     if (r.mind) {
         for (size_t i = 0; i < n; ++i) r.mind[i] = INFINITY;
         chosen(&r, (size_t)best);

@@ -40,7 +40,8 @@ size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol,
  * then, among the points scoring at least SCC_REDUCE_SHARE of the best (and more than tol), the one
  * with the smallest gap (then smaller id, lower index) is chosen. The first point: gaps within
  * 1e-3 tol count as equal, and among those the first in index order farther than tol beyond the
- * ones before it from their centre (rounding in the gaps does not flip it from step to step).
+ * ones before it from their centre (rounding in the gaps does not flip it from step to step); the
+ * contact plane is the deepest point's (smallest gap, lower index), distances measured on it.
  * depth_scale 0: scc_reduce. */
 size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, long first, size_t k,
                            int32_t* out, double* scratch);

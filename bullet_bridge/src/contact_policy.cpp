@@ -36,8 +36,6 @@
 SDFCCD_BULLET_NAMESPACE_BEGIN
 namespace detail {
 
-// Among points giving at least this share of the best spread, the one with the smallest gap wins.
-static const double kSpreadShare = 0.95;
 // The reduction's depth scale: a tenth of the mesh's radius, at most 0.3 m (a body's far features
 // count less than those about to touch, in proportion to its size).
 static const double kSpreadDepthFraction = 0.1, kSpreadDepthMax = 0.3;
@@ -50,97 +48,6 @@ static const double kDiscreteSubdivisionScale = 0.1;
 // The face search splits faces down to regions with edges at most this share of the SDF's feature
 // size (SdfShape::setFeatureSize).
 static const double kFaceRegionShare = 0.4;
-
-// Adds points to `out` (up to k) maximising the spread of the projected points P.
-static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>& P, const btVector3& nref, int k, double tol,
-                   double depth_scale, std::vector<double>& score, std::vector<int>& out)
-{
-    const int n = (int)c.size();
-    score.assign((size_t)n, 0.0);
-    while ((int)out.size() < k) {
-        const size_t m = out.size();
-        const btVector3& a0 = P[out[0]];
-        double orient = 1;
-        if (m == 3) orient = (P[out[1]] - a0).cross(P[out[2]] - a0).dot(nref) >= 0 ? 1.0 : -1.0;
-        double best = 0;
-        for (int i = 0; i < n; ++i) {
-            score[i] = -1;
-            const btVector3& q = P[i];
-            bool dup = false;
-            for (int j : out) dup |= (double)(q - P[j]).length() <= tol;
-            if (dup) continue;
-            double sc;
-            if (m == 1) {
-                sc = (double)(q - a0).length();
-            } else if (m == 2) {
-                sc = 0.5 * (double)(P[out[1]] - a0).cross(q - a0).length();
-            } else {
-                // Area the point adds outside the triangle (0 inside it).
-                sc = 0;
-                for (int e = 0; e < 3; ++e) {
-                    const btVector3& a = P[out[e]];
-                    const btVector3& b = P[out[(e + 1) % 3]];
-                    const double sa = 0.5 * orient * (double)(b - a).cross(q - a).dot(nref);
-                    if (sa < 0) sc -= sa;
-                }
-            }
-            // A point far from the surface (a feature that may reach it late in the step) counts
-            // less than one about to touch.
-            if (depth_scale > 0) sc *= std::exp(-(c[i].d - c[out[0]].d) / depth_scale);
-            score[i] = sc;
-            best = std::max(best, sc);
-        }
-        // Nothing adds spread: one point, a segment, or everything inside the triangle.
-        double scale;
-        if (m == 1) scale = tol;
-        else if (m == 2) scale = 0.5 * tol * (double)(P[out[1]] - a0).length();
-        else scale = 0.5 * tol * (double)std::max((P[out[1]] - a0).length(), (P[out[2]] - a0).length());
-        if (!(best > scale)) break;
-        int pick = -1;
-        for (int i = 0; i < n; ++i)
-            if (score[i] >= kSpreadShare * best && (pick < 0 || c[i].d < c[pick].d)) pick = i;
-        out.push_back(pick);
-    }
-}
-
-void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, PairScratch& w, std::vector<int>& out)
-{
-    out.clear();
-    if (c.empty() || k <= 0) return;
-    int first = 0;
-    for (int i = 1; i < (int)c.size(); ++i)
-        if (c[i].d < c[first].d) first = i;
-    // Spread is measured between the points on the SDF's surface, projected on the plane of the
-    // deepest point's normal (the contact plane, as in Box2D's manifolds): two features of the
-    // mesh above one another (a bottom and a top corner) constrain the same place, and only the
-    // one with the smaller gap matters.
-    const btVector3 nref = c[first].n0;
-    std::vector<btVector3>& P = w.flat;
-    P.resize(c.size());
-    for (size_t i = 0; i < c.size(); ++i) P[i] = c[i].pB0 - nref * nref.dot(c[i].pB0);
-    // Several points equally deep (a face landing flat): start from the one farthest from their
-    // centre, a corner of the region, so the polygon grows to the region's corners.
-    const double d0 = c[first].d, same = 1e-3 * tol; // equal up to rounding
-    btVector3 centre(0, 0, 0);
-    int m = 0;
-    for (size_t i = 0; i < c.size(); ++i)
-        if (c[i].d <= d0 + same) {
-            centre += P[i];
-            ++m;
-        }
-    centre /= btScalar(m);
-    double far = -1;
-    for (int i = 0; i < (int)c.size(); ++i) {
-        if (!(c[i].d <= d0 + same)) continue;
-        const double r = (double)(P[i] - centre).length();
-        if (r > far + tol) {
-            far = r;
-            first = i;
-        }
-    }
-    out.push_back(first);
-    spread(c, P, nref, k, tol, depth_scale, w.score, out);
-}
 
 namespace {
 
@@ -690,7 +597,7 @@ namespace {
 // the first manifold gains its first point and ended when it empties (the first manifold speaks
 // for the pair: the others never fire started or ended).
 void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, const std::vector<Candidate>& cands,
-                    const std::vector<int>& pick, int first, const btCollisionObjectWrapper* mw,
+                    const std::vector<int32_t>& pick, int first, const btCollisionObjectWrapper* mw,
                     const btCollisionObjectWrapper* sw, PairScratch& w, Stats& stats)
 {
     const int per = (int)MANIFOLD_CACHE_SIZE;
@@ -799,8 +706,22 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     if (!closest && dt > 0) snapshotStartPoses(guard_world);
     const double tol = std::max(1e-6, 1e-3 * radius);
     const double depth_scale = std::min(kSpreadDepthMax, kSpreadDepthFraction * radius);
-    pick.clear();
-    if (any) reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, work, pick);
+    // The candidates as the core's contact points (surface point, normal, gap), reduced to the
+    // manifold's points: deepest first, then the area, far points weighted down.
+    cover_set.resize(scratch.size());
+    for (size_t i = 0; i < scratch.size(); ++i) {
+        sdfccd_ContactPoint& p = cover_set[i];
+        std::memset(&p, 0, sizeof p);
+        p.surface_point = v3(scratch[i].pB0);
+        p.normal = v3(scratch[i].n0);
+        p.gap = scratch[i].d;
+    }
+    pick.resize((size_t)std::max(0, cfg.max_contacts));
+    int32_t count = 0;
+    if (!any || sdfccd_reduce_contacts_weighted(cover_set.data(), (int32_t)scratch.size(), tol, depth_scale, pick.data(),
+                                                (int32_t)pick.size(), &count) != SDFCCD_OK)
+        count = 0;
+    pick.resize((size_t)count);
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;
@@ -810,18 +731,10 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     // deeper than the guarantee's tolerance while the points held so far stay out, for any rotation
     // of the body (relative to the SDF) about an axis in the contact plane up to its angular speed.
     const int extra_limit = (manifold_count - 1) * (int)MANIFOLD_CACHE_SIZE;
-    if (any && !pick.empty() && extra_limit > 0) {
+    if (!pick.empty() && extra_limit > 0) {
         const btVector3& n = scratch[pick[0]].n0;
         const double slope = dt * (double)(w - n * n.dot(w)).length();
         const double cover = cfg.guard_tolerance > 0 ? cfg.guard_tolerance : Config().guard_tolerance;
-        cover_set.resize(scratch.size());
-        for (size_t i = 0; i < scratch.size(); ++i) {
-            sdfccd_ContactPoint& p = cover_set[i];
-            std::memset(&p, 0, sizeof p);
-            p.surface_point = v3(scratch[i].pB0);
-            p.normal = v3(scratch[i].n0);
-            p.gap = scratch[i].d;
-        }
         pick.resize((size_t)(first + extra_limit));
         int32_t added = 0;
         if (sdfccd_cover_contacts(cover_set.data(), (int32_t)scratch.size(), pick.data(), first, slope, cover, tol, pick.data() + first,

@@ -99,20 +99,8 @@ struct Candidate {
     bool speculative; // from an impact later in the step (restitution 0)
 };
 
-/** Reduction of a contact set to at most k points (Bullet/Box2D style): the deepest point (smallest
- * gap; among equally deep ones the outermost), then the point farthest from it, then the one
- * maximising the triangle's area, then the one adding most area to the polygon; distances and
- * areas between the SDF surface points, projected on the plane of the deepest point's normal,
- * each weighted by exp(-(gap - deepest gap) / depth_scale). Points closer than `tol` to a chosen
- * one are never chosen (no duplicates). Ties go to the smaller gap, then to the lower index:
- * deterministic for a given input. Writes into `out` (cleared; no allocation once it has grown). */
-struct PairScratch;
-void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, PairScratch& w, std::vector<int>& out);
-
 // Storage the contact policy reuses from pair to pair and step to step (no allocation once grown).
 struct PairScratch {
-    std::vector<btVector3> flat;                  // reduction: surface points on the contact plane
-    std::vector<double> score;                    // reduction: each candidate's spread
     std::vector<std::pair<uint32_t, double>> tris; // triangles of the CCD's contacts and their TOI
     std::vector<uint32_t> pose_tris;              // triangles of a discrete query's contacts
     std::vector<std::pair<uint32_t, uint32_t>> pose_vertices;                 // (vertex, triangle)
@@ -248,9 +236,9 @@ public:
     int64_t guard_step = 0, snapshot_step = -1;
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
-    std::vector<int> pick;                      // the chosen candidates
+    std::vector<int32_t> pick;                  // the chosen candidates
     detail::PairScratch work;
-    std::vector<sdfccd_ContactPoint> cover_set; // the candidates for sdfccd_cover_contacts
+    std::vector<sdfccd_ContactPoint> cover_set; // the candidates for the reduction and the cover points
     std::vector<sdfccd_Contact> contacts, start_contacts;
     sdfccd_Workspace* workspace = nullptr; // the queries' scratch storage (no allocation per query)
     // Config::batch_threads: the world whose pair cache the batch reads (registerWith(world)) and

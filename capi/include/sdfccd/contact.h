@@ -245,7 +245,8 @@ SDFCCD_API sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points
  * smallest gap is chosen (then the smaller id, the lower index). The first point: gaps within a
  * thousandth of same_place_distance count as equally deep (rounding of an engine's float gaps), and
  * among those the farthest from their centre, a later point only by more than same_place_distance
- * (so the choice does not flip from step to step). `depth_scale` (m, finite, >= 0; 0: sdfccd_reduce_contacts()). Same guarantees:
+ * (so the choice does not flip from step to step); the contact plane is the deepest point's (the
+ * smallest gap, the lower index), and these distances are measured on it too. `depth_scale` (m, finite, >= 0; 0: sdfccd_reduce_contacts()). Same guarantees:
  * deterministic, never two points within `same_place_distance`, never a prefix of the set.
  * Errors: as sdfccd_reduce_contacts(), and a negative or non-finite depth_scale. */
 SDFCCD_API sdfccd_Status sdfccd_reduce_contacts_weighted(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
