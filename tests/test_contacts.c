@@ -357,6 +357,19 @@ START_TEST(test_reduce_weighted_rounding)
 }
 END_TEST
 
+START_TEST(test_reduce_weighted_contact_plane)
+{
+    /* three equally deep points of a curved surface, the first (the deepest by index) with normal +z:
+     * on its contact plane the centre is (-0.00667, 0) and the farthest is the one at x = -0.12
+     * (0.1133 against 0.1067), though in space the one at height 0.5 is farther (0.35) */
+    sdfccd_ContactPoint c[3] = { cp(0.0, 0.0, 0.0, -0.001, 1), cp(0.1, 0.0, 0.5, -0.001, 2), cp(-0.12, 0.0, 0.0, -0.001, 3) };
+    c[1].normal = (sdfccd_Vec3){ 0.6, 0.0, 0.8 };
+    int32_t idx[1];
+    ck_assert_int_eq(reduce_w(c, 3, 0.01, 1, idx), 1);
+    ck_assert_int_eq(idx[0], 2);
+}
+END_TEST
+
 START_TEST(test_reduce_weighted_bad_input)
 {
     sdfccd_ContactPoint c[2] = { cp(0, 0, 0, 0, 1), cp(1, 0, 0, 0, 2) };
@@ -1096,6 +1109,7 @@ int main(void)
     tcase_add_test(tc, test_reduce_weighted_small_sets);
     tcase_add_test(tc, test_reduce_weighted_thousand_points);
     tcase_add_test(tc, test_reduce_weighted_rounding);
+    tcase_add_test(tc, test_reduce_weighted_contact_plane);
     tcase_add_test(tc, test_reduce_weighted_bad_input);
     tcase_add_test(tc, test_cover_no_tilt);
     tcase_add_test(tc, test_cover_tilt_closed_form);
