@@ -32,8 +32,7 @@ static int push(cand_buf* b, const scc_contact_point* c)
     return 1;
 }
 
-/* Vertex, edge or face, from the barycentric weights; with its stable id. */
-static void classify(const scc_mesh* mesh, uint32_t t, const double b[3], scc_contact_point* c)
+void scc_classify_feature(const scc_mesh* mesh, uint32_t t, const double b[3], scc_contact_point* c)
 {
     const double eps = 1e-6;
     int zeros = 0, zero = 0, one = 0;
@@ -68,7 +67,7 @@ static int add(cand_buf* b, const scc_mesh* mesh, uint32_t t, const double bary[
     c.surface = scc_sub(x0, scc_scale(n, c.gap));
     c.toi = toi;
     for (int k = 0; k < 3; ++k) c.bary[k] = bary[k];
-    classify(mesh, t, bary, &c);
+    scc_classify_feature(mesh, t, bary, &c);
     return push(b, &c);
 }
 

@@ -37,6 +37,10 @@ typedef struct scc_contact_params {
     double same_place;       /* the reduction's same-place distance */
 } scc_contact_params;
 
+/* The feature (vertex, edge or face) of triangle t at barycentric weights b, and its stable id,
+ * into c's triangle, kind, feature and id. */
+void scc_classify_feature(const scc_mesh* mesh, uint32_t t, const double b[3], scc_contact_point* c);
+
 /* Candidates of the step [mm->t0, mm->t1] (rigid or per-vertex linear motion) reduced to at most
  * `capacity` points in out. Returns 0 on allocation failure. */
 int scc_generate_contacts(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_contact_params* cp, scc_workspace* ws,

@@ -22,6 +22,8 @@ typedef struct reducer {
     size_t hull_n;             /* 2: a segment hull[0]-hull[1] */
     double* mind;              /* optional, n: distance on the plane to the nearest chosen point, -1 when
                                   within tol of one (taken); NULL: recomputed from the chosen points */
+    double depth_scale;        /* > 0: scores weighted by exp(-(gap - first gap) / depth_scale) */
+    double gap0;               /* the first point's gap */
 } reducer;
 
 static scc_reduce_item item(const reducer* r, size_t i)
@@ -133,7 +135,36 @@ static void chosen(reducer* r, size_t j)
     }
 }
 
+/* The score of unchosen item i (`it`): its distance to the chosen points (first choice after the
+ * first point, or `fill`), else the area it adds (`along`: the length it extends a segment by);
+ * weighted by depth when depth_scale > 0. */
+static double score(const reducer* r, size_t i, const scc_reduce_item* it, int along, int fill)
+{
+    scc_vec3 q = flat(r, it->p);
+    double s;
+    if (r->m == 1 || fill) {
+        if (r->mind) {
+            s = r->mind[i];
+        } else {
+            s = INFINITY;
+            for (size_t j = 0; j < r->m; ++j) s = fmin(s, scc_dist(flat(r, item(r, (size_t)r->chosen[j]).p), q));
+        }
+    } else {
+        s = gain(r, q, along);
+    }
+    /* a point far from the surface (that may reach it late in the step) counts less than one
+       about to touch */
+    if (r->depth_scale > 0.0) s *= exp(-(it->gap - r->gap0) / r->depth_scale);
+    return s;
+}
+
 size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out, double* scratch)
+{
+    return scc_reduce_weighted(set, n, get, tol, 0.0, first, k, out, scratch);
+}
+
+size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, long first, size_t k,
+                           int32_t* out, double* scratch)
 {
     if (n == 0 || k == 0) return 0;
     reducer r;
@@ -145,18 +176,24 @@ size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol,
     r.nref = scc_v3(0, 0, 1);
     r.chosen = out;
     r.mind = scratch;
+    r.depth_scale = depth_scale;
     /* the first point: given, or the deepest; among equally deep ones (a face landing flat) the one
      * farthest from their centre, a corner, so the polygon grows to the region's corners */
     long best = first >= 0 && (size_t)first < n ? first : -1;
+    long deepest = -1; /* the smallest gap, the lower index on ties */
+    for (size_t i = 0; best < 0 && i < n; ++i)
+        if (deepest < 0 || item(&r, i).gap < item(&r, (size_t)deepest).gap) deepest = (long)i;
+    /* weighted: distances on the plane of the deepest point's normal from the start */
+    const int plane = best < 0 && depth_scale > 0.0;
+    if (plane) r.nref = scc_normalize_or(item(&r, (size_t)deepest).n, scc_v3(0, 0, 1));
     if (best < 0) {
-        double g0 = INFINITY;
-        for (size_t i = 0; i < n; ++i) g0 = fmin(g0, item(&r, i).gap);
-        const double same = 1e-9 * fmax(1.0, fabs(g0));
+        const double g0 = item(&r, (size_t)deepest).gap;
+        const double same = fmax(1e-9 * fmax(1.0, fabs(g0)), depth_scale > 0.0 ? 1e-3 * tol : 0.0);
         scc_vec3 c = scc_v3(0, 0, 0);
         double cnt = 0.0;
         for (size_t i = 0; i < n; ++i) {
             scc_reduce_item it = item(&r, i);
-            if (it.gap <= g0 + same) { c = scc_add(c, it.p); cnt += 1.0; }
+            if (it.gap <= g0 + same) { c = scc_add(c, plane ? flat(&r, it.p) : it.p); cnt += 1.0; }
         }
         c = scc_scale(c, 1.0 / cnt);
         double bs = 0.0;
@@ -164,12 +201,13 @@ size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol,
         for (size_t i = 0; i < n; ++i) {
             scc_reduce_item it = item(&r, i);
             if (!(it.gap <= g0 + same)) continue;
-            double s = scc_dist(it.p, c);
-            if (beats(s, &it, i, bs, &bit, best)) { best = (long)i; bs = s; bit = it; }
+            double s = scc_dist(plane ? flat(&r, it.p) : it.p, c);
+            if (plane ? (best < 0 || s > bs + tol) : beats(s, &it, i, bs, &bit, best)) { best = (long)i; bs = s; bit = it; }
         }
     }
     out[r.m++] = (int32_t)best;
-    r.nref = scc_normalize_or(item(&r, (size_t)best).n, scc_v3(0, 0, 1));
+    r.gap0 = item(&r, (size_t)best).gap;
+    if (!plane) r.nref = scc_normalize_or(item(&r, (size_t)best).n, scc_v3(0, 0, 1));
     if (r.mind) {
         for (size_t i = 0; i < n; ++i) r.mind[i] = INFINITY;
         chosen(&r, (size_t)best);
@@ -187,24 +225,22 @@ size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol,
             for (size_t i = 0; i < n; ++i) {
                 scc_reduce_item it = item(&r, i);
                 if (taken(&r, i, it.p)) continue;
-                scc_vec3 q = flat(&r, it.p);
-                double s;
-                if (r.m == 1 || fill) {
-                    if (r.mind) {
-                        s = r.mind[i];
-                    } else {
-                        s = INFINITY;
-                        for (size_t j = 0; j < r.m; ++j) s = fmin(s, scc_dist(flat(&r, item(&r, (size_t)out[j]).p), q));
-                    }
-                } else {
-                    s = gain(&r, q, along);
-                }
+                double s = score(&r, i, &it, along, fill);
                 if (beats(s, &it, i, bs, &bit, pick)) { pick = (long)i; bs = s; bit = it; }
             }
             /* what counts as adding: tol of length, or tol times the segment's length of area */
             double seg = r.hull_n >= 2 ? scc_dist(r.hp[0], r.hp[1]) : 0.0;
             double enough = (r.m == 1 || fill || along) ? tol : tol * seg;
             if (pick >= 0 && !(bs > enough)) pick = -1;
+            /* weighted: among the points within SCC_REDUCE_SHARE of the best, the deepest */
+            if (pick >= 0 && r.depth_scale > 0.0) {
+                const double floor_s = SCC_REDUCE_SHARE * bs;
+                for (size_t i = 0; i < n; ++i) {
+                    scc_reduce_item it = item(&r, i);
+                    if ((long)i == pick || !(it.gap < bit.gap || (it.gap == bit.gap && it.id < bit.id)) || taken(&r, i, it.p)) continue;
+                    if (score(&r, i, &it, along, fill) >= floor_s) { pick = (long)i; bit = it; }
+                }
+            }
         }
         if (pick < 0) {
             if (fill || r.m == 1) break;

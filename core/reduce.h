@@ -32,6 +32,20 @@ typedef void scc_reduce_get_fn(const void* set, size_t i, scc_reduce_item* out);
  * (n doubles, or NULL) makes it O(n) per choice instead of O(n k); the result is the same. */
 size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out, double* scratch);
 
+/* Share of the best weighted score within which the deepest point is chosen instead. */
+#define SCC_REDUCE_SHARE 0.95
+
+/* scc_reduce with every score after the first point (distance, area) multiplied by
+ * exp(-(gap - first gap) / depth_scale) when depth_scale > 0: deeper points win over far ones; and
+ * then, among the points scoring at least SCC_REDUCE_SHARE of the best (and more than tol), the one
+ * with the smallest gap (then smaller id, lower index) is chosen. The first point: gaps within
+ * 1e-3 tol count as equal, and among those the first in index order farther than tol beyond the
+ * ones before it from their centre (rounding in the gaps does not flip it from step to step); the
+ * contact plane is the deepest point's (smallest gap, lower index), distances measured on it.
+ * depth_scale 0: scc_reduce. */
+size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, long first, size_t k,
+                           int32_t* out, double* scratch);
+
 /* Cover points (cover.c): up to k more indices of `set`, none in chosen[0..chosen_count-1], each the
  * point whose end gap could fall furthest below `depth` while every held point (chosen, then picked)
  * stays out, for a turn of `tilt` (m per m) of the body about an axis in the contact plane; a held

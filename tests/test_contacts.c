@@ -27,12 +27,16 @@ static sdfccd_ContactPoint cp(double x, double y, double z, double gap, uint64_t
     return c;
 }
 
-static int32_t reduce(const sdfccd_ContactPoint* c, int32_t n, int32_t cap, int32_t* idx)
+/* sdfccd_reduce_contacts_weighted (scale 0: sdfccd_reduce_contacts), checked: never two at one
+ * place, never one twice, within the room. */
+static int32_t reduce_w(const sdfccd_ContactPoint* c, int32_t n, double scale, int32_t cap, int32_t* idx)
 {
     int32_t count = -1;
-    ck_assert_msg(sdfccd_reduce_contacts(c, n, SAME, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
+    if (scale > 0.0)
+        ck_assert_msg(sdfccd_reduce_contacts_weighted(c, n, SAME, scale, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
+    else
+        ck_assert_msg(sdfccd_reduce_contacts(c, n, SAME, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
     ck_assert(count >= 0 && count <= cap && count <= n);
-    /* never two at one place, never one twice */
     for (int32_t i = 0; i < count; ++i) {
         ck_assert(idx[i] >= 0 && idx[i] < n);
         for (int32_t j = 0; j < i; ++j) {
@@ -42,6 +46,8 @@ static int32_t reduce(const sdfccd_ContactPoint* c, int32_t n, int32_t cap, int3
     }
     return count;
 }
+
+static int32_t reduce(const sdfccd_ContactPoint* c, int32_t n, int32_t cap, int32_t* idx) { return reduce_w(c, n, 0.0, cap, idx); }
 
 static int contains(const int32_t* idx, int32_t count, int32_t want)
 {
@@ -216,6 +222,167 @@ START_TEST(test_reduce_bad_input)
     ck_assert_int_eq(sdfccd_reduce_contacts(c, 2, SAME, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
     ck_assert(strlen(sdfccd_last_error()) > 0);
     ck_assert_int_eq(count, -7); /* not written on error */
+}
+END_TEST
+
+/* ---- the depth-weighted reduction (sdfccd_reduce_contacts_weighted) ---- */
+
+START_TEST(test_reduce_weighted_crossover)
+{
+    /* the deepest point at the origin, a point about to touch at y = 0.3 and a far one (gap 0.5, a
+     * corner that may reach the surface late in the step) at x = D: the far one is second exactly
+     * when 0.95 D exp(-(0.5 - g0) / s) > 0.3 (the weight, and the deeper point within 95 % of the
+     * best score winning) */
+    const double g0 = -0.001, s = 0.1, w = exp(-(0.5 - g0) / s);
+    const double d_cross = 0.3 / (0.95 * w);
+    for (int side = -1; side <= 1; side += 2) {
+        sdfccd_ContactPoint c[3] = { cp(0.0, 0.0, 0.0, g0, 1), cp(0.0, 0.3, 0.0, g0 + 1e-4, 2),
+                                     cp(d_cross * (1.0 + 1e-3 * side), 0.0, 0.0, 0.5, 3) };
+        int32_t idx[2];
+        ck_assert_int_eq(reduce_w(c, 3, s, 2, idx), 2);
+        ck_assert_int_eq(idx[0], 0);
+        ck_assert_int_eq(idx[1], side > 0 ? 2 : 1);
+        /* unweighted (scale 0: sdfccd_reduce_contacts), the far point always wins */
+        ck_assert_int_eq(reduce_w(c, 3, 0.0, 2, idx), 2);
+        ck_assert_int_eq(idx[1], 2);
+    }
+}
+END_TEST
+
+START_TEST(test_reduce_weighted_small_sets)
+{
+    int32_t idx[4];
+    /* single point, and nothing */
+    sdfccd_ContactPoint one = cp(0.1, 0.2, 0.0, 0.3, 7);
+    ck_assert_int_eq(reduce_w(&one, 1, 0.01, 4, idx), 1);
+    ck_assert_int_eq(idx[0], 0);
+    ck_assert_int_eq(reduce_w(NULL, 0, 0.01, 4, idx), 0);
+    /* coincident: ten at one place, one point, the deepest */
+    sdfccd_ContactPoint c[11];
+    for (int i = 0; i < 10; ++i) c[i] = cp(0.3, -0.2, 0.0, -0.001 * ((i * 7) % 10), (uint64_t)i);
+    ck_assert_int_eq(reduce_w(c, 10, 0.01, 4, idx), 1);
+    ck_assert_int_eq(idx[0], 7);
+    /* collinear, the deepest in the middle and one end far from the surface (gap 0.05 m): the
+     * near end (0.56 m x exp(-0.2)), then the point next to the far end (0.45 m x exp(-0.2)) beats
+     * the far end (0.56 m x exp(-5.2)); unweighted, both ends */
+    for (int i = 0; i < 11; ++i) c[i] = cp(0.1 * i, 0.05 * i, 0.0, i == 5 ? -0.002 : i == 10 ? 0.05 : 0.0, (uint64_t)(100 + i));
+    int32_t n = reduce_w(c, 11, 0.01, 3, idx);
+    ck_assert_int_eq(n, 3);
+    ck_assert(idx[0] == 5 && idx[1] == 0 && idx[2] == 9);
+    n = reduce_w(c, 11, 0.0, 3, idx);
+    ck_assert_int_eq(n, 3);
+    ck_assert(idx[0] == 5 && contains(idx, n, 0) && contains(idx, n, 10));
+}
+END_TEST
+
+START_TEST(test_reduce_weighted_thousand_points)
+{
+    enum { N = 1000 };
+    static sdfccd_ContactPoint c[N], shuffled[N];
+    test_rng rng = { 7 };
+    random_set(&rng, c, N);
+    for (int i = 0; i < N; ++i) c[i].gap *= 100.0; /* gaps in [-0.1, 0.1] m */
+    const double s = 0.02;
+    int deepest = 0;
+    for (int i = 1; i < N; ++i)
+        if (c[i].gap < c[deepest].gap) deepest = i;
+    /* the reference for the second point, by brute force: the deepest of the points whose weighted
+     * distance is at least 95 % of the largest */
+    static double sc[N];
+    double best = -1.0;
+    for (int i = 0; i < N; ++i) {
+        double dx = c[i].surface_point.x - c[deepest].surface_point.x, dy = c[i].surface_point.y - c[deepest].surface_point.y;
+        sc[i] = i == deepest ? -1.0 : hypot(dx, dy) * exp(-(c[i].gap - c[deepest].gap) / s);
+        best = fmax(best, sc[i]);
+    }
+    int second = -1;
+    for (int i = 0; i < N; ++i)
+        if (sc[i] >= 0.95 * best && (second < 0 || c[i].gap < c[second].gap)) second = i;
+    int32_t idx[16], idx2[16], plain[16];
+    for (int cap = 1; cap <= 16; cap *= 2) {
+        /* a buffer smaller than the set: the reduction, never the first points */
+        int32_t n = reduce_w(c, N, s, cap, idx);
+        ck_assert_int_eq(n, cap);
+        ck_assert_int_eq(idx[0], deepest);
+        if (cap > 1) ck_assert_int_eq(idx[1], second);
+        /* deeper points win: the kept points are on average deeper than the unweighted choice */
+        int32_t np = reduce(c, N, cap, plain);
+        double gw = 0.0, gp = 0.0;
+        for (int i = 1; i < n; ++i) gw += c[idx[i]].gap;
+        for (int i = 1; i < np; ++i) gp += c[plain[i]].gap;
+        if (cap >= 4) ck_assert(gw < gp);
+        /* the order of the input does not matter (distinct ids) */
+        for (int i = 0; i < N; ++i) shuffled[i] = c[(i * 617 + 13) % N];
+        ck_assert_int_eq(reduce_w(shuffled, N, s, cap, idx2), n);
+        for (int i = 0; i < n; ++i) ck_assert(shuffled[idx2[i]].id == c[idx[i]].id);
+        /* ids persist: the set a step later, moved by less than 1e-8 m */
+        for (int i = 0; i < N; ++i) {
+            shuffled[i] = c[i];
+            shuffled[i].surface_point.x += test_rng_uniform(&rng, -1e-9, 1e-9);
+            shuffled[i].gap += test_rng_uniform(&rng, -1e-12, 1e-12);
+        }
+        ck_assert_int_eq(reduce_w(shuffled, N, s, cap, idx2), n);
+        for (int i = 0; i < n; ++i) ck_assert(shuffled[idx2[i]].id == c[idx[i]].id);
+    }
+    /* scale 0 is sdfccd_reduce_contacts() */
+    int32_t count = -1;
+    ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, N, SAME, 0.0, idx, 16, &count), SDFCCD_OK);
+    ck_assert_int_eq(count, reduce(c, N, 16, plain));
+    for (int i = 0; i < 16; ++i) ck_assert_int_eq(idx[i], plain[i]);
+}
+END_TEST
+
+START_TEST(test_reduce_weighted_rounding)
+{
+    /* a face resting flat, its 25 corner and grid points' gaps computed by a float engine: equal up
+     * to 3e-8 m of rounding that changes from step to step. The points chosen (first the corner
+     * farthest from the centre, then the opposite one) must not change with the rounding: the same
+     * ids over 20 steps (the order of the last two, of equal area, may follow the rounding) */
+    enum { N = 25 };
+    sdfccd_ContactPoint c[N];
+    test_rng rng = { 11 };
+    int32_t first[4] = { -1, -1, -1, -1 }, idx[4];
+    for (int step = 0; step < 20; ++step) {
+        for (int i = 0; i < N; ++i)
+            c[i] = cp(0.01 * (i % 5), 0.01 * (i / 5), 0.0, 0.0005 + test_rng_uniform(&rng, -3e-8, 3e-8), (uint64_t)(500 + i));
+        ck_assert_int_eq(reduce_w(c, N, 0.01, 4, idx), 4);
+        ck_assert_int_eq(idx[0], 0); /* the first corner in index order: all four are equally far */
+        ck_assert_int_eq(idx[1], 24);
+        for (int i = 0; i < 4; ++i) {
+            if (step == 0) first[i] = idx[i];
+            ck_assert(contains(first, 4, idx[i]));
+        }
+        ck_assert(contains(idx, 4, 4) && contains(idx, 4, 20));
+    }
+}
+END_TEST
+
+START_TEST(test_reduce_weighted_contact_plane)
+{
+    /* three equally deep points of a curved surface, the first (the deepest by index) with normal +z:
+     * on its contact plane the centre is (-0.00667, 0) and the farthest is the one at x = -0.12
+     * (0.1133 against 0.1067), though in space the one at height 0.5 is farther (0.35) */
+    sdfccd_ContactPoint c[3] = { cp(0.0, 0.0, 0.0, -0.001, 1), cp(0.1, 0.0, 0.5, -0.001, 2), cp(-0.12, 0.0, 0.0, -0.001, 3) };
+    c[1].normal = (sdfccd_Vec3){ 0.6, 0.0, 0.8 };
+    int32_t idx[1];
+    ck_assert_int_eq(reduce_w(c, 3, 0.01, 1, idx), 1);
+    ck_assert_int_eq(idx[0], 2);
+}
+END_TEST
+
+START_TEST(test_reduce_weighted_bad_input)
+{
+    sdfccd_ContactPoint c[2] = { cp(0, 0, 0, 0, 1), cp(1, 0, 0, 0, 2) };
+    int32_t idx[2], count = -7;
+    ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, 2, SAME, -0.1, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, 2, SAME, NAN, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, 2, SAME, INFINITY, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, 2, -1.0, 0.1, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, 2, SAME, 0.1, idx, 2, NULL), SDFCCD_INVALID_ARGUMENT);
+    c[0].normal.x = NAN;
+    ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, 2, SAME, 0.1, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(strstr(sdfccd_last_error(), "sdfccd_reduce_contacts_weighted") != NULL);
+    ck_assert_int_eq(count, -7);
 }
 END_TEST
 
@@ -534,6 +701,25 @@ START_TEST(test_generate_no_allocation_after_warm_up)
         long before = allocs;
         for (int i = 0; i < 10; ++i)
             for (int k = 0; k < 3; ++k) ck_assert_int_eq(generate(ws, floor, cube, &m[k], c, 8).count, k == 2 ? 0 : 8);
+        /* the face search: a slab on the floor, after a first call */
+        sdfccd_MeshId slab = test_box_mesh((sdfccd_Vec3){ 0.2, 0.2, 0.05 }, 1, 1, 1);
+        sdfccd_Pose pose = sdfccd_pose_identity();
+        pose.position.z = 0.049;
+        sdfccd_QueryParams qp = sdfccd_default_query_params();
+        static sdfccd_ContactPoint fc[1024];
+        sdfccd_FaceSearch fs;
+        ck_assert_int_eq(sdfccd_search_faces(ws, floor, NULL, slab, &pose, 0.1, 0.0, &qp, fc, 1024, &fs), SDFCCD_OK);
+        ck_assert_int_gt(fs.count, 0);
+        before = allocs;
+        for (int i = 0; i < 5; ++i) ck_assert_int_eq(sdfccd_search_faces(ws, floor, NULL, slab, &pose, 0.1, 0.0, &qp, fc, 1024, &fs), SDFCCD_OK);
+        ck_assert_int_eq(allocs - before, 0);
+        ck_assert_int_eq(sdfccd_destroy_mesh(slab), SDFCCD_OK);
+        /* the reductions are pure functions: no allocation at all */
+        int32_t idx[8], count = 0;
+        for (int i = 0; i < 10; ++i) {
+            ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, 8, SAME, 0.01, idx, 4, &count), SDFCCD_OK);
+            ck_assert_int_eq(sdfccd_reduce_contacts(c, 8, SAME, idx, 4, &count), SDFCCD_OK);
+        }
         ck_assert_int_eq(allocs - before, 0);
         sdfccd_destroy_workspace(ws);
         ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
@@ -699,6 +885,148 @@ START_TEST(test_generate_linear_cloth)
 }
 END_TEST
 
+/* ---- the face search (sdfccd_search_faces) ---- */
+
+static double dot3(sdfccd_Vec3 a, sdfccd_Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+/* A 2 m x 2 m slab 0.1 m thick (12 triangles; its bottom face at z = bottom), searched with regions
+ * of 0.1 m; returns the points (at most cap). */
+static sdfccd_FaceSearch search(sdfccd_Workspace* ws, sdfccd_SdfId sdf, sdfccd_MeshId slab, double bottom, double size, double accept,
+                                sdfccd_ContactPoint* out, int32_t cap)
+{
+    sdfccd_Pose pose = sdfccd_pose_identity();
+    pose.position.z = bottom + 0.05;
+    sdfccd_QueryParams qp = sdfccd_default_query_params();
+    sdfccd_FaceSearch fs;
+    ck_assert_msg(sdfccd_search_faces(ws, sdf, NULL, slab, &pose, size, accept, &qp, out, cap, &fs) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert(fs.count == 0 || fs.count == fs.found);
+    ck_assert(fs.found <= cap ? fs.count == fs.found : fs.count == 0);
+    return fs;
+}
+
+/* A sphere of radius 5 cm, the slab and a workspace (the face search tests' set-up). */
+static void faces_setup(sdfccd_SdfId* ball, sdfccd_MeshId* slab, sdfccd_Workspace** ws)
+{
+    ck_assert_int_eq(sdfccd_create_sphere(0.05, ball), SDFCCD_OK);
+    *slab = test_box_mesh((sdfccd_Vec3){ 1, 1, 0.05 }, 1, 1, 1);
+    ck_assert_int_eq(sdfccd_create_workspace(ws), SDFCCD_OK);
+}
+
+START_TEST(test_faces_sphere_cap)
+{
+    /* the slab's bottom face 1 cm into a sphere of radius 5 cm (far smaller than the face): the
+     * deepest point is above the centre, phi -0.01, held at the top of the sphere with normal +z;
+     * every point lies on the bottom face, inside the cap (radius 3 cm) */
+    sdfccd_SdfId ball;
+    sdfccd_MeshId slab;
+    sdfccd_Workspace* ws;
+    faces_setup(&ball, &slab, &ws);
+    static sdfccd_ContactPoint c[256];
+    sdfccd_FaceSearch fs = search(ws, ball, slab, 0.04, 0.1, 0.0, c, 256);
+    ck_assert_int_gt(fs.count, 0);
+    int deepest = 0;
+    for (int32_t i = 0; i < fs.count; ++i) {
+        ck_assert_double_near(c[i].point.z, 0.04, 1e-12);
+        ck_assert(hypot(c[i].point.x, c[i].point.y) <= 0.03 + 1e-9);
+        ck_assert(c[i].gap <= 1e-9);
+        ck_assert(c[i].feature_kind != SDFCCD_FEATURE_VERTEX); /* inside a face or on its diagonal */
+        if (c[i].gap < c[deepest].gap) deepest = i;
+    }
+    ck_assert_double_near(c[deepest].gap, -0.01, 1e-6);
+    ck_assert_double_near(c[deepest].surface_point.z, 0.05, 1e-6);
+    ck_assert_double_near(c[deepest].normal.z, 1.0, 1e-6);
+    REPORT("sphere cap: %d points, %lld regions, %lld evaluations\n", fs.count, (long long)fs.regions, (long long)fs.sdf_evaluations);
+    /* all or nothing: one point less room gives none, and the same search again the same points */
+    static sdfccd_ContactPoint c2[256];
+    sdfccd_FaceSearch f2 = search(ws, ball, slab, 0.04, 0.1, 0.0, c2, fs.found - 1);
+    ck_assert_int_eq(f2.count, 0);
+    ck_assert_int_eq(f2.found, fs.found);
+    f2 = search(ws, ball, slab, 0.04, 0.1, 0.0, c2, fs.found);
+    ck_assert_int_eq(f2.count, fs.count);
+    for (int32_t i = 0; i < fs.count; ++i) ck_assert(c2[i].id == c[i].id && c2[i].gap == c[i].gap);
+    /* faces with no edge longer than the region size are left to the mesh queries */
+    ck_assert_int_eq(search(ws, ball, slab, 0.04, 3.0, 0.0, c, 256).regions, 0);
+    /* far above: every face (all 12 have an edge over 0.1 m) dropped at its first region */
+    f2 = search(ws, ball, slab, 5.0, 0.1, 0.0, c, 256);
+    ck_assert_int_eq(f2.found, 0);
+    ck_assert_int_eq(f2.regions, 12);
+    sdfccd_destroy_workspace(ws);
+    sdfccd_destroy_mesh(slab);
+    sdfccd_destroy_sdf(ball);
+}
+END_TEST
+
+START_TEST(test_faces_ridge)
+{
+    /* a box turned 45 degrees about x: a ridge along x (|x| <= 0.5) at z = 0.1 sqrt 2. The slab's bottom
+     * face lies 1 cm below the ridge; inside the box the field's normal points out of its sides (45
+     * degrees from +z), so each point is pushed up along the face's normal to the ridge's surface:
+     * normal +z, surface z = ridge - |y| (the box's side), gap = point z - surface z = |y| - 0.01
+     * (not the field's (|y| - 0.01) / sqrt 2 along its 45-degree normal) */
+    sdfccd_SdfId bar, ridge;
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.5, 0.1, 0.1 }, &bar), SDFCCD_OK);
+    sdfccd_Pose turn = sdfccd_pose_identity();
+    turn.orientation = (sdfccd_Quat){ cos(M_PI / 8), sin(M_PI / 8), 0, 0 };
+    ck_assert_int_eq(sdfccd_create_transformed(bar, turn, 1.0, &ridge), SDFCCD_OK);
+    const double top = 0.1 * sqrt(2.0);
+    sdfccd_MeshId slab = test_box_mesh((sdfccd_Vec3){ 1, 1, 0.05 }, 1, 1, 1);
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    static sdfccd_ContactPoint c[512];
+    sdfccd_FaceSearch fs = search(ws, ridge, slab, top - 0.01, 0.1, 0.0, c, 512);
+    ck_assert_int_gt(fs.count, 0);
+    double deepest = 0.0;
+    for (int32_t i = 0; i < fs.count; ++i) {
+        REPORT("ridge point %d: (%.5f %.5f %.5f) gap %.6f n (%.3f %.3f %.3f)\n", i, c[i].point.x, c[i].point.y, c[i].point.z, c[i].gap,
+               c[i].normal.x, c[i].normal.y, c[i].normal.z);
+        ck_assert_double_near(c[i].point.z, top - 0.01, 1e-12);
+        ck_assert(c[i].gap <= 1e-9);
+        ck_assert_double_near(c[i].gap, dot3(c[i].normal, c[i].point) - dot3(c[i].normal, c[i].surface_point), 1e-12);
+        if (c[i].gap > -1e-9) continue; /* on the surface (the ridge's end face): held where it is */
+        ck_assert_double_near(c[i].normal.z, 1.0, 1e-12);
+        ck_assert_double_near(c[i].surface_point.z, top - fabs(c[i].point.y), 2e-6);
+        ck_assert_double_near(c[i].gap, c[i].point.z - c[i].surface_point.z, 1e-12);
+        deepest = fmin(deepest, c[i].gap);
+    }
+    ck_assert(deepest < -0.005); /* a point inside was found and pushed up */
+    REPORT("ridge: %d points, deepest %.6f\n", fs.count, deepest);
+    sdfccd_destroy_workspace(ws);
+    sdfccd_destroy_mesh(slab);
+    sdfccd_destroy_sdf(ridge);
+    sdfccd_destroy_sdf(bar);
+}
+END_TEST
+
+START_TEST(test_faces_bad_input)
+{
+    sdfccd_SdfId ball;
+    sdfccd_MeshId slab;
+    sdfccd_Workspace* ws;
+    faces_setup(&ball, &slab, &ws);
+    sdfccd_Pose pose = sdfccd_pose_identity();
+    sdfccd_QueryParams qp = sdfccd_default_query_params();
+    sdfccd_ContactPoint c[4];
+    sdfccd_FaceSearch fs = { -7, -7, -7, -7 };
+    ck_assert_int_eq(sdfccd_search_faces(NULL, ball, NULL, slab, &pose, 0.1, 0.0, &qp, c, 4, &fs), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_search_faces(ws, ball, NULL, slab, NULL, 0.1, 0.0, &qp, c, 4, &fs), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_search_faces(ws, ball, NULL, slab, &pose, 0.0, 0.0, &qp, c, 4, &fs), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_search_faces(ws, ball, NULL, slab, &pose, NAN, 0.0, &qp, c, 4, &fs), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_search_faces(ws, ball, NULL, slab, &pose, 0.1, INFINITY, &qp, c, 4, &fs), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_search_faces(ws, ball, NULL, slab, &pose, 0.1, 0.0, NULL, c, 4, &fs), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_search_faces(ws, ball, NULL, slab, &pose, 0.1, 0.0, &qp, NULL, 4, &fs), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_search_faces(ws, ball, NULL, slab, &pose, 0.1, 0.0, &qp, c, -1, &fs), SDFCCD_INVALID_ARGUMENT);
+    pose.position.x = NAN;
+    ck_assert_int_eq(sdfccd_search_faces(ws, ball, NULL, slab, &pose, 0.1, 0.0, &qp, c, 4, &fs), SDFCCD_INVALID_ARGUMENT);
+    pose.position.x = 0;
+    ck_assert_int_eq(sdfccd_search_faces(ws, (sdfccd_SdfId){ 0, 0 }, NULL, slab, &pose, 0.1, 0.0, &qp, c, 4, &fs), SDFCCD_INVALID_HANDLE);
+    ck_assert(strstr(sdfccd_last_error(), "sdfccd_search_faces") != NULL || strlen(sdfccd_last_error()) > 0);
+    ck_assert_int_eq(fs.count, -7); /* not written on error */
+    sdfccd_destroy_workspace(ws);
+    sdfccd_destroy_mesh(slab);
+    sdfccd_destroy_sdf(ball);
+}
+END_TEST
+
 START_TEST(test_generate_bad_input)
 {
     sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
@@ -764,6 +1092,9 @@ int main(void)
     tcase_add_test(tg, test_generate_fast_plate_thin_wall);
     tcase_add_test(tg, test_generate_linear_cloth);
     tcase_add_test(tg, test_generate_bad_input);
+    tcase_add_test(tg, test_faces_sphere_cap);
+    tcase_add_test(tg, test_faces_ridge);
+    tcase_add_test(tg, test_faces_bad_input);
     suite_add_tcase(s, tg);
     TCase* tc = tcase_create("reduce");
     test_add_memory_fixture(tc);
@@ -774,6 +1105,12 @@ int main(void)
     tcase_add_test(tc, test_reduce_thousand_points);
     tcase_add_test(tc, test_reduce_same_place);
     tcase_add_test(tc, test_reduce_bad_input);
+    tcase_add_test(tc, test_reduce_weighted_crossover);
+    tcase_add_test(tc, test_reduce_weighted_small_sets);
+    tcase_add_test(tc, test_reduce_weighted_thousand_points);
+    tcase_add_test(tc, test_reduce_weighted_rounding);
+    tcase_add_test(tc, test_reduce_weighted_contact_plane);
+    tcase_add_test(tc, test_reduce_weighted_bad_input);
     tcase_add_test(tc, test_cover_no_tilt);
     tcase_add_test(tc, test_cover_tilt_closed_form);
     tcase_add_test(tc, test_cover_order_and_neighbours);

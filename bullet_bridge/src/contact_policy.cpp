@@ -36,8 +36,6 @@
 SDFCCD_BULLET_NAMESPACE_BEGIN
 namespace detail {
 
-// Among points giving at least this share of the best spread, the one with the smallest gap wins.
-static const double kSpreadShare = 0.95;
 // The reduction's depth scale: a tenth of the mesh's radius, at most 0.3 m (a body's far features
 // count less than those about to touch, in proportion to its size).
 static const double kSpreadDepthFraction = 0.1, kSpreadDepthMax = 0.3;
@@ -50,100 +48,6 @@ static const double kDiscreteSubdivisionScale = 0.1;
 // The face search splits faces down to regions with edges at most this share of the SDF's feature
 // size (SdfShape::setFeatureSize).
 static const double kFaceRegionShare = 0.4;
-// The face search keeps the field's normal at a point of a face inside the SDF when it is
-// within about 25 degrees of the face's inward direction (a face on a smooth surface).
-static const double kFaceNormalAgreement = 0.9;
-
-// Adds points to `out` (up to k) maximising the spread of the projected points P.
-static void spread(const std::vector<Candidate>& c, const std::vector<btVector3>& P, const btVector3& nref, int k, double tol,
-                   double depth_scale, std::vector<double>& score, std::vector<int>& out)
-{
-    const int n = (int)c.size();
-    score.assign((size_t)n, 0.0);
-    while ((int)out.size() < k) {
-        const size_t m = out.size();
-        const btVector3& a0 = P[out[0]];
-        double orient = 1;
-        if (m == 3) orient = (P[out[1]] - a0).cross(P[out[2]] - a0).dot(nref) >= 0 ? 1.0 : -1.0;
-        double best = 0;
-        for (int i = 0; i < n; ++i) {
-            score[i] = -1;
-            const btVector3& q = P[i];
-            bool dup = false;
-            for (int j : out) dup |= (double)(q - P[j]).length() <= tol;
-            if (dup) continue;
-            double sc;
-            if (m == 1) {
-                sc = (double)(q - a0).length();
-            } else if (m == 2) {
-                sc = 0.5 * (double)(P[out[1]] - a0).cross(q - a0).length();
-            } else {
-                // Area the point adds outside the triangle (0 inside it).
-                sc = 0;
-                for (int e = 0; e < 3; ++e) {
-                    const btVector3& a = P[out[e]];
-                    const btVector3& b = P[out[(e + 1) % 3]];
-                    const double sa = 0.5 * orient * (double)(b - a).cross(q - a).dot(nref);
-                    if (sa < 0) sc -= sa;
-                }
-            }
-            // A point far from the surface (a feature that may reach it late in the step) counts
-            // less than one about to touch.
-            if (depth_scale > 0) sc *= std::exp(-(c[i].d - c[out[0]].d) / depth_scale);
-            score[i] = sc;
-            best = std::max(best, sc);
-        }
-        // Nothing adds spread: one point, a segment, or everything inside the triangle.
-        double scale;
-        if (m == 1) scale = tol;
-        else if (m == 2) scale = 0.5 * tol * (double)(P[out[1]] - a0).length();
-        else scale = 0.5 * tol * (double)std::max((P[out[1]] - a0).length(), (P[out[2]] - a0).length());
-        if (!(best > scale)) break;
-        int pick = -1;
-        for (int i = 0; i < n; ++i)
-            if (score[i] >= kSpreadShare * best && (pick < 0 || c[i].d < c[pick].d)) pick = i;
-        out.push_back(pick);
-    }
-}
-
-void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, PairScratch& w, std::vector<int>& out)
-{
-    out.clear();
-    if (c.empty() || k <= 0) return;
-    int first = 0;
-    for (int i = 1; i < (int)c.size(); ++i)
-        if (c[i].d < c[first].d) first = i;
-    // Spread is measured between the points on the SDF's surface, projected on the plane of the
-    // deepest point's normal (the contact plane, as in Box2D's manifolds): two features of the
-    // mesh above one another (a bottom and a top corner) constrain the same place, and only the
-    // one with the smaller gap matters.
-    const btVector3 nref = c[first].n0;
-    std::vector<btVector3>& P = w.flat;
-    P.resize(c.size());
-    for (size_t i = 0; i < c.size(); ++i) P[i] = c[i].pB0 - nref * nref.dot(c[i].pB0);
-    // Several points equally deep (a face landing flat): start from the one farthest from their
-    // centre, a corner of the region, so the polygon grows to the region's corners.
-    const double d0 = c[first].d, same = 1e-3 * tol; // equal up to rounding
-    btVector3 centre(0, 0, 0);
-    int m = 0;
-    for (size_t i = 0; i < c.size(); ++i)
-        if (c[i].d <= d0 + same) {
-            centre += P[i];
-            ++m;
-        }
-    centre /= btScalar(m);
-    double far = -1;
-    for (int i = 0; i < (int)c.size(); ++i) {
-        if (!(c[i].d <= d0 + same)) continue;
-        const double r = (double)(P[i] - centre).length();
-        if (r > far + tol) {
-            far = r;
-            first = i;
-        }
-    }
-    out.push_back(first);
-    spread(c, P, nref, k, tol, depth_scale, w.score, out);
-}
 
 namespace {
 
@@ -215,95 +119,25 @@ struct Gatherer {
             addFromStart(local, (int)vt[i].second);
         }
     }
-    // The face search (SdfShape::setFeatureSize): the mesh's triangles with an edge longer than
-    // `size` at pose (Mx, Sx), split into 4 at their edge midpoints down to regions with no edge
-    // longer than `size`; a region whose centroid is farther from the surface than `lipschitz`
-    // times its radius plus `accept` has no point within `accept` and is dropped; each remaining
-    // leaf's deepest point (the library's DCD on the leaf) within `accept` is a candidate,
-    // constrained by its own closest surface point at that pose. The library's queries give one
-    // point per triangle and subdivide only around a point in contact: a face over features
-    // smaller than itself (the spike grid's tips) can have every vertex and every point they
-    // find clear of the surface while tips between them pierce it. Returns the regions visited.
-    int64_t searchFaces(double size, const btTransform& Mx, const btTransform& Sx, double accept, double lipschitz,
-                        const sdfccd_QueryParams& base)
+    // The face search (SdfShape::setFeatureSize; sdfccd_search_faces) at pose (Mx, Sx) within
+    // `accept`, its points constrained from the start of the step. Returns the regions visited.
+    int64_t searchFaces(sdfccd_Workspace* ws, double size, const btTransform& Mx, const btTransform& Sx, double accept,
+                        const sdfccd_QueryParams& params)
     {
-        sdfccd_QueryParams p = base;
-        p.method = SDFCCD_METHOD_DCD;
-        p.margin = accept;
-        p.subdivision = 0;
-        sdfccd_RigidMotion mm = sdfccd_default_rigid_motion(), sm = sdfccd_default_rigid_motion();
-        mm.pose = toPose(Mx);
-        sm.pose = toPose(Sx);
-        const btTransform rel = Sx.inverseTimes(Mx); // mesh frame -> SDF frame
-        const btMatrix3x3 sdf_basis_t = Sx.getBasis().transpose();
-        const double size2 = size * size;
-        typedef FaceRegion Region;
-        std::vector<Region>& stack = w->regions;
-        int64_t visited = 0;
-        const size_t nt = me->indices.size() / 3;
-        for (size_t t = 0; t < nt; ++t) {
-            Region r;
-            for (int j = 0; j < 3; ++j) {
-                const double* v = &me->vertices[3 * (size_t)me->indices[3 * t + j]];
-                r.c[j] = btVector3((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
-            }
-            auto longest2 = [](const Region& q) {
-                return (double)std::max((q.c[1] - q.c[0]).length2(), std::max((q.c[2] - q.c[1]).length2(), (q.c[0] - q.c[2]).length2()));
-            };
-            if (!(longest2(r) > size2)) continue; // the library's queries cover it
-            stack.assign(1, r);
-            while (!stack.empty()) {
-                const Region q = stack.back();
-                stack.pop_back();
-                ++visited;
-                const btVector3 mid = (q.c[0] + q.c[1] + q.c[2]) / btScalar(3);
-                const double rad = (double)std::max((q.c[0] - mid).length(), std::max((q.c[1] - mid).length(), (q.c[2] - mid).length()));
-                double phi = 0;
-                ++evals;
-                if (sdfccd_sdf_eval(sdf, v3(rel * mid), &phi, nullptr) != SDFCCD_OK || !(phi - lipschitz * rad <= accept)) continue;
-                if (longest2(q) > size2) {
-                    const btVector3 m01 = (q.c[0] + q.c[1]) * btScalar(0.5), m12 = (q.c[1] + q.c[2]) * btScalar(0.5),
-                                    m20 = (q.c[2] + q.c[0]) * btScalar(0.5);
-                    stack.push_back(Region{ { q.c[0], m01, m20 } });
-                    stack.push_back(Region{ { m01, q.c[1], m12 } });
-                    stack.push_back(Region{ { m20, m12, q.c[2] } });
-                    stack.push_back(Region{ { m12, m20, m01 } });
-                    continue;
-                }
-                const sdfccd_Vec3 tri[3] = { v3(q.c[0]), v3(q.c[1]), v3(q.c[2]) };
-                sdfccd_Contact k;
-                sdfccd_QueryResult res;
-                if (sdfccd_query_triangle(sdf, &sm, tri, &mm, 0.0, 0.0, &p, &k, 1, &res) != SDFCCD_OK) continue;
-                evals += res.sdf_evaluations;
-                if (!res.hit || res.contact_count < 1) continue;
-                const btVector3 pt = bt(k.point);
-                const btVector3 nL = sdf_basis_t * bt(k.normal);
-                const btVector3 local = Mx.invXform(pt), qs = Sx.invXform(pt);
-                // A point of the face inside the SDF where the field's normal is far from the
-                // face's (a tip through the face: inside a cone the gradient points out of its
-                // side, mostly sideways) is pushed out along the face's normal instead, to where
-                // that line leaves the SDF (the tip's apex), as a face resting on a vertex is.
-                btVector3 u = -(rel.getBasis() * (r.c[1] - r.c[0]).cross(r.c[2] - r.c[0]));
-                const btScalar ul = u.length();
-                if (k.distance < 0 && ul > btScalar(0) && (u /= ul, (double)nL.dot(u) < kFaceNormalAgreement)) {
-                    btVector3 e = qs;
-                    double ph = k.distance, walked = 0;
-                    for (int it = 0; it < 64 && ph < 0 && walked < 4 * size; ++it) {
-                        const double stepl = std::max(-ph / lipschitz, 1e-7);
-                        e += u * (btScalar)stepl;
-                        walked += stepl;
-                        ++evals;
-                        if (sdfccd_sdf_eval(sdf, v3(e), &ph, nullptr) != SDFCCD_OK) break;
-                    }
-                    if (ph >= -1e-6 && walked < 4 * size) {
-                        add(local, e, u, (int)t);
-                        continue;
-                    }
-                }
-                add(local, qs - nL * (btScalar)k.distance, nL, (int)t);
-            }
+        std::vector<sdfccd_ContactPoint>& buf = w->face_points;
+        const sdfccd_Pose mp = toPose(Mx), sp = toPose(Sx);
+        sdfccd_FaceSearch fs{};
+        for (int pass = 0; pass < 2; ++pass) {
+            if (!ws || sdfccd_search_faces(ws, sdf, &sp, me->id, &mp, size, accept, &params, buf.data(), (int32_t)buf.size(), &fs) != SDFCCD_OK)
+                return 0;
+            if (fs.found <= fs.count) break;
+            buf.resize((size_t)fs.found); // all or nothing: room for every point, and again
         }
-        return visited;
+        evals += fs.sdf_evaluations;
+        const btMatrix3x3 sdf_basis_t = Sx.getBasis().transpose();
+        for (int i = 0; i < fs.count; ++i)
+            add(Mx.invXform(bt(buf[i].point)), Sx.invXform(bt(buf[i].surface_point)), sdf_basis_t * bt(buf[i].normal), (int)buf[i].triangle);
+        return fs.regions;
     }
     // Each contact at its own triangle's time of impact, plus the vertices of that triangle within
     // `accept` of the surface at that time (a face landing flat gives its corners).
@@ -586,7 +420,6 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
         stats.query_errors++;
         return false;
     }
-    last_start_margin = P.start_margin;
     Gatherer G;
     G.me = P.me;
     G.sdf = P.sdf;
@@ -701,11 +534,9 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
     // the CCD query misses them (a face landing flat on tips between its FW points).
     size_t face_found = 0;
     if (dt > 0 && faceSearch(P)) {
-        sdfccd_SdfInfo info;
-        const double lip = sdfccd_sdf_get_info(G.sdf, &info) == SDFCCD_OK && info.lipschitz > 0 ? info.lipschitz : 1.0;
         const double fs = kFaceRegionShare * P.feature_size;
-        stats.face_regions += continuous ? G.searchFaces(fs, G.M.t0, G.S.t0, start_margin, lip, params)
-                                         : G.searchFaces(fs, G.M.t1, G.S.t1, margin, lip, params);
+        stats.face_regions += continuous ? G.searchFaces(workspace, fs, G.M.t0, G.S.t0, start_margin, params)
+                                         : G.searchFaces(workspace, fs, G.M.t1, G.S.t1, margin, params);
         face_found = cands.size();
         for (size_t i = 0; i < face_found && continuous && !starts_touching; ++i) starts_touching = cands[i].d <= margin;
     }
@@ -766,7 +597,7 @@ namespace {
 // the first manifold gains its first point and ended when it empties (the first manifold speaks
 // for the pair: the others never fire started or ended).
 void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, const std::vector<Candidate>& cands,
-                    const std::vector<int>& pick, int first, const btCollisionObjectWrapper* mw,
+                    const std::vector<int32_t>& pick, int first, const btCollisionObjectWrapper* mw,
                     const btCollisionObjectWrapper* sw, PairScratch& w, Stats& stats)
 {
     const int per = (int)MANIFOLD_CACHE_SIZE;
@@ -870,25 +701,27 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     const double margin = closest ? std::max(0.0, (double)out->m_closestPointDistanceThreshold) : cfg.contact_margin;
     double radius = 0;
     btVector3 w(0, 0, 0);
-    const int64_t errors_before = stats.query_errors, skipped_before = stats.queries_skipped;
     const bool any = gather(mw, sw, dt, margin, scratch, &radius, &w);
     // The guarantee's start poses: the world transforms of this step's first pair are the step's start.
     if (!closest && dt > 0) snapshotStartPoses(guard_world);
-    // ... and the body's smallest gap at the start, for the guarantee's free proof (only when the
-    // queries ran without error and with a continuous method; top-level shapes only).
-    if (!closest && dt > 0 && guard_world && stats.query_errors == errors_before && cfg.query.method != SDFCCD_METHOD_DCD &&
-        mw->getCollisionShape() == mw->getCollisionObject()->getCollisionShape() &&
-        mw->getWorldTransform() == mw->getCollisionObject()->getWorldTransform()) {
-        // No candidate: every feature at least the margin away at the start, or, when the start-pose
-        // query's broad phase culled every triangle, at least that query's margin (margin + travel).
-        double d0 = !any && stats.queries_skipped > skipped_before ? last_start_margin : margin;
-        for (const Candidate& c : scratch) d0 = std::min(d0, c.d);
-        start_gaps[std::make_pair(mw->getCollisionObject(), sw->getCollisionObject())] = std::make_pair(guard_step, d0);
-    }
     const double tol = std::max(1e-6, 1e-3 * radius);
     const double depth_scale = std::min(kSpreadDepthMax, kSpreadDepthFraction * radius);
-    pick.clear();
-    if (any) reduceContacts(scratch, cfg.max_contacts, tol, depth_scale, work, pick);
+    // The candidates as the core's contact points (surface point, normal, gap), reduced to the
+    // manifold's points: deepest first, then the area, far points weighted down.
+    cover_set.resize(scratch.size());
+    for (size_t i = 0; i < scratch.size(); ++i) {
+        sdfccd_ContactPoint& p = cover_set[i];
+        std::memset(&p, 0, sizeof p);
+        p.surface_point = v3(scratch[i].pB0);
+        p.normal = v3(scratch[i].n0);
+        p.gap = scratch[i].d;
+    }
+    pick.resize((size_t)std::max(0, cfg.max_contacts));
+    int32_t count = 0;
+    if (!any || sdfccd_reduce_contacts_weighted(cover_set.data(), (int32_t)scratch.size(), tol, depth_scale, pick.data(),
+                                                (int32_t)pick.size(), &count) != SDFCCD_OK)
+        count = 0;
+    pick.resize((size_t)count);
     if (closest) {
         for (int i : pick) out->addContactPoint(scratch[i].n0, scratch[i].pB0, (btScalar)scratch[i].d);
         return;
@@ -898,18 +731,10 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
     // deeper than the guarantee's tolerance while the points held so far stay out, for any rotation
     // of the body (relative to the SDF) about an axis in the contact plane up to its angular speed.
     const int extra_limit = (manifold_count - 1) * (int)MANIFOLD_CACHE_SIZE;
-    if (any && !pick.empty() && extra_limit > 0) {
+    if (!pick.empty() && extra_limit > 0) {
         const btVector3& n = scratch[pick[0]].n0;
         const double slope = dt * (double)(w - n * n.dot(w)).length();
         const double cover = cfg.guard_tolerance > 0 ? cfg.guard_tolerance : Config().guard_tolerance;
-        cover_set.resize(scratch.size());
-        for (size_t i = 0; i < scratch.size(); ++i) {
-            sdfccd_ContactPoint& p = cover_set[i];
-            std::memset(&p, 0, sizeof p);
-            p.surface_point = v3(scratch[i].pB0);
-            p.normal = v3(scratch[i].n0);
-            p.gap = scratch[i].d;
-        }
         pick.resize((size_t)(first + extra_limit));
         int32_t added = 0;
         if (sdfccd_cover_contacts(cover_set.data(), (int32_t)scratch.size(), pick.data(), first, slope, cover, tol, pick.data() + first,

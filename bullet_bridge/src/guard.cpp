@@ -238,9 +238,6 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             stats.last_toi_fraction = best.fraction;
         }
     }
-    for (auto it = start_gaps.begin(); it != start_gaps.end();) // (written by the narrow phase; not read here)
-        if (it->second.first < guard_step) it = start_gaps.erase(it);
-        else ++it;
     ++guard_step;
 }
 

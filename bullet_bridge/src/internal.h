@@ -99,28 +99,13 @@ struct Candidate {
     bool speculative; // from an impact later in the step (restitution 0)
 };
 
-/** Reduction of a contact set to at most k points (Bullet/Box2D style): the deepest point (smallest
- * gap; among equally deep ones the outermost), then the point farthest from it, then the one
- * maximising the triangle's area, then the one adding most area to the polygon; distances and
- * areas between the SDF surface points, projected on the plane of the deepest point's normal,
- * each weighted by exp(-(gap - deepest gap) / depth_scale). Points closer than `tol` to a chosen
- * one are never chosen (no duplicates). Ties go to the smaller gap, then to the lower index:
- * deterministic for a given input. Writes into `out` (cleared; no allocation once it has grown). */
-struct PairScratch;
-void reduceContacts(const std::vector<Candidate>& c, int k, double tol, double depth_scale, PairScratch& w, std::vector<int>& out);
-
 // Storage the contact policy reuses from pair to pair and step to step (no allocation once grown).
-struct FaceRegion {
-    btVector3 c[3];
-};
 struct PairScratch {
-    std::vector<btVector3> flat;                  // reduction: surface points on the contact plane
-    std::vector<double> score;                    // reduction: each candidate's spread
     std::vector<std::pair<uint32_t, double>> tris; // triangles of the CCD's contacts and their TOI
     std::vector<uint32_t> pose_tris;              // triangles of a discrete query's contacts
     std::vector<std::pair<uint32_t, uint32_t>> pose_vertices;                 // (vertex, triangle)
     std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>> toi_vertices; // (vertex, (TOI, triangle))
-    std::vector<FaceRegion> regions;              // the face search's stack
+    std::vector<sdfccd_ContactPoint> face_points;  // the face search's points
     std::vector<btManifoldPoint> old_points, new_points; // a pair's manifold points, last step and this one
     std::vector<char> matched;                    // old points that persist
 };
@@ -249,21 +234,11 @@ public:
     std::unique_ptr<btActionInterface> guard;
     std::vector<std::pair<const btCollisionObject*, btTransform>> start_poses;
     int64_t guard_step = 0, snapshot_step = -1;
-    // Per (mesh object, SDF object): the step and the smallest gap at its start the narrow phase saw
-    // (a top-level pair; the margin when the pair was proven clear).
-    struct PairHash {
-        size_t operator()(const std::pair<const btCollisionObject*, const btCollisionObject*>& k) const
-        {
-            return std::hash<const void*>()(k.first) * 31u + std::hash<const void*>()(k.second);
-        }
-    };
-    std::unordered_map<std::pair<const btCollisionObject*, const btCollisionObject*>, std::pair<int64_t, double>, PairHash> start_gaps;
-    double last_start_margin = 0; // the start-pose query's margin of the last gather()
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
     std::vector<detail::Candidate> scratch;
-    std::vector<int> pick;                      // the chosen candidates
+    std::vector<int32_t> pick;                  // the chosen candidates
     detail::PairScratch work;
-    std::vector<sdfccd_ContactPoint> cover_set; // the candidates for sdfccd_cover_contacts
+    std::vector<sdfccd_ContactPoint> cover_set; // the candidates for the reduction and the cover points
     std::vector<sdfccd_Contact> contacts, start_contacts;
     sdfccd_Workspace* workspace = nullptr; // the queries' scratch storage (no allocation per query)
     // Config::batch_threads: the world whose pair cache the batch reads (registerWith(world)) and

@@ -6,6 +6,7 @@
 #include "../../core/guard.h"
 #include "../../core/reduce.h"
 #include "../../core/contacts.h"
+#include "../../core/faces.h"
 
 #include <stdio.h>
 
@@ -242,6 +243,21 @@ static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, cons
     return SDFCCD_OK;
 }
 
+/* A contact point of the core (SDF frame at time t of smp) in the world frame. */
+static void public_point(const scc_contact_point* c, const scc_rigid* smp, double t, sdfccd_ContactPoint* o)
+{
+    o->point = sdfccd__pv(scc_world_point(smp, t, c->point));
+    o->surface_point = sdfccd__pv(scc_world_point(smp, t, c->surface));
+    o->normal = sdfccd__pv(scc_normalize_or(scc_world_vector(smp, t, c->normal), scc_v3(0, 0, 1)));
+    o->gap = c->gap;
+    o->toi = c->toi;
+    for (int k = 0; k < 3; ++k) o->barycentric[k] = c->bary[k];
+    o->triangle = c->triangle;
+    o->feature_kind = c->kind == SCC_FEATURE_VERTEX ? SDFCCD_FEATURE_VERTEX : c->kind == SCC_FEATURE_EDGE ? SDFCCD_FEATURE_EDGE : SDFCCD_FEATURE_FACE;
+    o->feature = c->feature;
+    o->id = c->id;
+}
+
 static sdfccd_Status run_contacts(sdfccd_Workspace* ws, const step_setup* q, const scc_mesh_motion* mm, const sdfccd_ContactParams* params,
                                   sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_ContactSet* out_set, const char* fn)
 {
@@ -255,21 +271,7 @@ static sdfccd_Status run_contacts(sdfccd_Workspace* ws, const step_setup* q, con
         return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
     scc_contact_set s;
     if (!scc_generate_contacts(q->sdf->sdf, mm, &cp, &ws->ws, c, capacity, &s)) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
-    const double t0 = mm->t0;
-    for (size_t i = 0; i < s.written; ++i) {
-        sdfccd_ContactPoint* o = &out_points[i];
-        o->point = sdfccd__pv(scc_world_point(q->smp, t0, c[i].point));
-        o->surface_point = sdfccd__pv(scc_world_point(q->smp, t0, c[i].surface));
-        o->normal = sdfccd__pv(scc_normalize_or(scc_world_vector(q->smp, t0, c[i].normal), scc_v3(0, 0, 1)));
-        o->gap = c[i].gap;
-        o->toi = c[i].toi;
-        for (int k = 0; k < 3; ++k) o->barycentric[k] = c[i].bary[k];
-        o->triangle = c[i].triangle;
-        o->feature_kind = c[i].kind == SCC_FEATURE_VERTEX ? SDFCCD_FEATURE_VERTEX : c[i].kind == SCC_FEATURE_EDGE ? SDFCCD_FEATURE_EDGE
-                                                                                                              : SDFCCD_FEATURE_FACE;
-        o->feature = c[i].feature;
-        o->id = c[i].id;
-    }
+    for (size_t i = 0; i < s.written; ++i) public_point(&c[i], q->smp, mm->t0, &out_points[i]);
     sdfccd_ContactSet r;
     memset(&r, 0, sizeof r);
     r.count = (int32_t)s.written;
@@ -330,6 +332,54 @@ sdfccd_Status sdfccd_generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId
     SDFCCD__HELD_CALL(generate_contacts_linear(ws, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_points, capacity, out_set));
 }
 
+/* ---- the face search ---- */
+
+static sdfccd_Status search_faces(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_Pose* sdf_pose, sdfccd_MeshId mesh, const sdfccd_Pose* pose,
+                                  double region_size, double accept, const sdfccd_QueryParams* params, sdfccd_ContactPoint* out_points,
+                                  int32_t capacity, sdfccd_FaceSearch* out)
+{
+    static const char fn[] = "sdfccd_search_faces";
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(out, "sdfccd_search_faces: out")) || (st = sdfccd__check_ptr(pose, "sdfccd_search_faces: pose")) ||
+        (st = sdfccd__check_ptr(params, "sdfccd_search_faces: params")))
+        return st;
+    if (!isfinite(region_size) || !(region_size > 0.0) || !isfinite(accept))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: region_size must be finite and > 0 and accept finite (got %g, %g)", fn, region_size,
+                             accept);
+    if (capacity < 0 || (capacity > 0 && !out_points))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_points is NULL or capacity (%d) < 0", fn, capacity);
+    scc_params p;
+    if ((st = sdfccd__convert_params(params, fn, &p))) return st;
+    sdfccd_RigidMotion bm = sdfccd_default_rigid_motion(), sm = sdfccd_default_rigid_motion();
+    bm.pose = *pose;
+    if (sdf_pose) sm.pose = *sdf_pose;
+    step_setup q;
+    scc_rigid body;
+    if ((st = setup_step(ws, sdf, sdf_pose ? &sm : NULL, mesh, 0.0, 0.0, fn, &q)) || (st = setup_rigid(&bm, 0.0, 0.0, &q, fn, &body))) return st;
+    scc_mesh_motion mm = { &q.mesh->mesh, &body, NULL, NULL, q.smp, 0.0, 0.0, NULL, NULL };
+    scc_contact_point* c = NULL;
+    if (capacity > 0 && !(c = scc_ws_get(&ws->ws, SCC_WS_STAGING, (size_t)capacity * sizeof *c)))
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    size_t found = 0;
+    int64_t regions = 0, evals = 0;
+    if (!scc_search_faces(q.sdf->sdf, &mm, 0.0, region_size, accept, &p, &ws->ws, c, (size_t)capacity, &found, &regions, &evals))
+        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
+    const int fits = found <= (size_t)capacity;
+    for (size_t i = 0; fits && i < found; ++i) public_point(&c[i], q.smp, 0.0, &out_points[i]);
+    out->count = fits ? (int32_t)found : 0;
+    out->found = found > INT32_MAX ? INT32_MAX : (int32_t)found;
+    out->regions = regions;
+    out->sdf_evaluations = evals;
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_search_faces(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_Pose* sdf_pose, sdfccd_MeshId mesh, const sdfccd_Pose* pose,
+                                  double region_size, double accept, const sdfccd_QueryParams* params, sdfccd_ContactPoint* out_points,
+                                  int32_t capacity, sdfccd_FaceSearch* out)
+{
+    SDFCCD__HELD_CALL(search_faces(ws, sdf, sdf_pose, mesh, pose, region_size, accept, params, out_points, capacity, out));
+}
+
 /* ---- contact points: reduction ---- */
 
 static void public_item(const void* set, size_t i, scc_reduce_item* out)
@@ -341,23 +391,37 @@ static void public_item(const void* set, size_t i, scc_reduce_item* out)
     out->id = c->id;
 }
 
-sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance, int32_t* out_indices,
-                                     int32_t capacity, int32_t* out_count)
+static sdfccd_Status reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance, double depth_scale,
+                                     int32_t* out_indices, int32_t capacity, int32_t* out_count, const char* fn)
 {
-    static const char fn[] = "sdfccd_reduce_contacts";
     if (!out_count) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_count is NULL", fn);
     if (count < 0 || capacity < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: count (%d) and capacity (%d) must be >= 0", fn, count, capacity);
     if ((count > 0 && !points) || (capacity > 0 && !out_indices))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: points or out_indices is NULL", fn);
     if (!isfinite(same_place_distance) || same_place_distance < 0.0)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: same_place_distance must be finite and >= 0 (got %g)", fn, same_place_distance);
+    if (!isfinite(depth_scale) || depth_scale < 0.0)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: depth_scale must be finite and >= 0 (got %g)", fn, depth_scale);
     for (int32_t i = 0; i < count; ++i) {
         const sdfccd_ContactPoint* c = &points[i];
         if (!scc_vfinite(sdfccd__v(c->surface_point)) || !scc_vfinite(sdfccd__v(c->normal)) || !isfinite(c->gap))
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: point %d has a non-finite surface point, normal or gap", fn, i);
     }
-    *out_count = (int32_t)scc_reduce(points, (size_t)count, public_item, same_place_distance, -1, (size_t)capacity, out_indices, NULL);
+    *out_count = (int32_t)scc_reduce_weighted(points, (size_t)count, public_item, same_place_distance, depth_scale, -1, (size_t)capacity, out_indices, NULL);
     return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance, int32_t* out_indices,
+                                     int32_t capacity, int32_t* out_count)
+{
+    return reduce_contacts(points, count, same_place_distance, 0.0, out_indices, capacity, out_count, "sdfccd_reduce_contacts");
+}
+
+sdfccd_Status sdfccd_reduce_contacts_weighted(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
+                                              double depth_scale, int32_t* out_indices, int32_t capacity, int32_t* out_count)
+{
+    return reduce_contacts(points, count, same_place_distance, depth_scale, out_indices, capacity, out_count,
+                           "sdfccd_reduce_contacts_weighted");
 }
 
 sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points, int32_t count, const int32_t* chosen, int32_t chosen_count,

@@ -22,21 +22,11 @@
 #include <BulletCollision/Gimpact/btGImpactShape.h>
 
 #include "sdfccd_bullet/sdfccd_bullet.h"
+#include "bullet_check.h"
 
 #ifndef SDFCCD_DATA_DIR
 #error "SDFCCD_DATA_DIR must be defined (the project's data/ folder)"
 #endif
-
-static int g_fail = 0;
-#define CHECK(cond, ...)                                                         \
-    do {                                                                         \
-        if (!(cond)) {                                                           \
-            ++g_fail;                                                            \
-            std::fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            std::fprintf(stderr, __VA_ARGS__);                                   \
-            std::fputc('\n', stderr);                                            \
-        }                                                                        \
-    } while (0)
 
 static const double kDt = 1.0 / 60.0;
 static const double kLimit = 0.01;
@@ -197,6 +187,5 @@ int main(int argc, char** argv)
     bridge.unregister();
     }
     for (sdfccd_SdfId id : { grid4, grid, ring, ground }) sdfccd_destroy_sdf(id);
-    std::printf("%s\n", g_fail ? "FAILED" : "passed");
-    return g_fail ? 1 : 0;
+    return checkSummary();
 }

@@ -191,7 +191,6 @@ struct Stats {
     int64_t rollbacks = 0;             /**< Bodies the guarantee put back at their time of impact. */
     int64_t guard_skipped = 0;         /**< Checks the guarantee settled without a CCD: bodies that did not move,
                                             and motions sdfccd_guard_step_rigid's certificate proved clear. */
-    int64_t guard_bisections = 0;      /**< Unused since the guarantee's discrete check moved into the core (0). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (SdfShape::setFeatureSize). */
     int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
                                             they are counted in queries, end_pose_queries and sdf_evaluations too. */

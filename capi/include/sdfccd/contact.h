@@ -238,6 +238,51 @@ SDFCCD_API sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points
                                                int32_t chosen_count, double tilt, double depth, double same_place_distance,
                                                int32_t* out_indices, int32_t capacity, int32_t* out_count);
 
+/** sdfccd_reduce_contacts() for the points of a step, some of which may only reach the surface late in
+ * it: after the first point every score (distance, area) is multiplied by
+ * exp(-(gap - first gap) / depth_scale), so a point about to touch wins over a far one that spreads
+ * the polygon more; and among the points scoring at least 95 % of the best, the one with the
+ * smallest gap is chosen (then the smaller id, the lower index). The first point: gaps within a
+ * thousandth of same_place_distance count as equally deep (rounding of an engine's float gaps), and
+ * among those the farthest from their centre, a later point only by more than same_place_distance
+ * (so the choice does not flip from step to step); the contact plane is the deepest point's (the
+ * smallest gap, the lower index), and these distances are measured on it too. `depth_scale` (m, finite, >= 0; 0: sdfccd_reduce_contacts()). Same guarantees:
+ * deterministic, never two points within `same_place_distance`, never a prefix of the set.
+ * Errors: as sdfccd_reduce_contacts(), and a negative or non-finite depth_scale. */
+SDFCCD_API sdfccd_Status sdfccd_reduce_contacts_weighted(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
+                                                         double depth_scale, int32_t* out_indices, int32_t capacity, int32_t* out_count);
+
+/** What sdfccd_search_faces() found. */
+typedef struct sdfccd_FaceSearch {
+    int32_t count;           /**< Points written (all found, or 0 when they did not fit). */
+    int32_t found;           /**< Points found: the room a call needs. */
+    int64_t regions;         /**< Regions visited. */
+    int64_t sdf_evaluations; /**< SDF evaluations of the call. */
+} sdfccd_FaceSearch;
+
+/** The face search, for SDFs with features smaller than the mesh's faces (a plate over a grid of
+ * spikes), where the mesh queries' points (one per triangle, subdivision only around a point in
+ * contact) can all lie clear of the surface while features between them pierce a face. At the
+ * mesh pose `pose` and the SDF pose `sdf_pose` (NULL: the identity), every face with an edge
+ * longer than `region_size` is split into 4 at its edge midpoints, down to regions with no longer
+ * edge; a region whose centre is farther from the surface than the SDF's Lipschitz bound times its
+ * radius plus `accept` is dropped; the deepest point (DCD with `params`, no subdivision) of each
+ * remaining region is a point when its phi <= accept. It is held by its closest surface point and
+ * the field's normal, unless it lies inside the SDF where the field's normal is more than about
+ * 25 degrees from the face's direction out of the surface (a tip through the face: the gradient
+ * inside a cone points out of its side): then by the point where the line along that direction
+ * leaves the SDF, with that direction as its normal (within 4 region sizes; else as before). Faces
+ * with no edge longer than region_size are left to the mesh queries. Points in the world frame,
+ * `toi` 0, ids as ::sdfccd_ContactPoint. All or nothing: when more than `capacity` are found,
+ * `out->count` is 0 and `out->found` is the room needed (the search is deterministic: call again).
+ * Uses the workspace: no allocation after a first call of a given size. Errors
+ * (::SDFCCD_INVALID_ARGUMENT unless said): NULL ws, pose, params or out, out_points NULL with
+ * capacity > 0, capacity < 0, region_size not finite and > 0, accept not finite, a non-finite pose,
+ * params not from sdfccd_default_query_params(), dead handles (::SDFCCD_INVALID_HANDLE). */
+SDFCCD_API sdfccd_Status sdfccd_search_faces(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_Pose* sdf_pose, sdfccd_MeshId mesh,
+                                             const sdfccd_Pose* pose, double region_size, double accept, const sdfccd_QueryParams* params,
+                                             sdfccd_ContactPoint* out_points, int32_t capacity, sdfccd_FaceSearch* out);
+
 /** Settings of contact generation. Must be initialised with sdfccd_default_contact_params(). */
 typedef struct sdfccd_ContactParams {
     sdfccd_QueryParams query;    /**< The CCD of the step (method, caps); `query.margin` is the contact distance: a
