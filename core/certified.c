@@ -57,11 +57,11 @@ static scc_vec3 corner(const scc_tri_state* st, double u, double v)
     return scc_add(scc_add(scc_scale(st->x[0], u), scc_scale(st->x[1], v)), scc_scale(st->x[2], 1.0 - u - v));
 }
 
-/* The region store starts in a buffer on the stack (ours): a search that never holds more regions
- * than it does allocates nothing, so a mesh or guard query through a warm workspace whose checks of
- * FWGSS (scc_fwgss_verify) stay within it allocates nothing (test_guard). The heap grows by
- * allocating the new array, copying, then freeing the old one, so a request that fits is given the
- * same buffer again (the copy is onto itself); larger ones go to the caller's allocator. */
+/* The region store of a check of FWGSS (scc_fwgss_verify) starts in a buffer on the stack (ours): a
+ * check that never holds more regions than it does allocates nothing, so a mesh or guard query
+ * through a warm workspace allocates nothing when its checks stay within it (test_guard). The heap
+ * grows by allocating the new array, copying, then freeing the old one, so a request that fits is
+ * given the same buffer again (the copy is onto itself); larger ones go to the caller's allocator. */
 #define STACK_REGIONS 1024 /* 64 KB */
 typedef struct stack_store {
     region buf[STACK_REGIONS];
@@ -90,10 +90,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
     /* The region store never holds more than cert_max_bytes (0: no limit); when it is full the
      * search stops like at the other caps: NOT_CONVERGED, the earliest witness so far, and the
      * popped region's start as the proven lower bound. */
-    stack_store store;
-    store.next = alloc;
-    const scc_allocator stack_alloc_hooks = { stack_alloc, stack_free, &store };
-    region_heap h = { NULL, 0, 0, &stack_alloc_hooks, 0, 0 };
+    region_heap h = { NULL, 0, 0, alloc, 0, 0 };
     if (p->cert_max_bytes > 0) h.max_bytes = (uint64_t)p->cert_max_bytes > SIZE_MAX ? SIZE_MAX : (size_t)p->cert_max_bytes;
     region root = { ta, tb, { 1, 0, 0 }, { 0, 1, 0 } };
     int capped = 0, ok = 1;
@@ -216,7 +213,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         }
     }
     if (!h.n && ok && !capped) lo = isfinite(hi) ? hi : tb;
-    scc_free(&stack_alloc_hooks, h.a, h.cap * sizeof *h.a);
+    scc_free(alloc, h.a, h.cap * sizeof *h.a);
     if (!ok) return 0;
 
     out->iterations = processed;
@@ -278,7 +275,10 @@ int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, dou
     if (budget <= 0) return 1;
     scc_tri_hit c;
     const double seed_t = io->hit ? io->toi : INFINITY;
-    if (!certified_search(sdf, m, ta, io->hit ? io->toi : tb, p, alloc, seed_t, io->bary, fmax(p->time_tol, SCC_VERIFY_TOL), budget, &c)) return 0;
+    stack_store store;
+    store.next = alloc;
+    const scc_allocator hooks = { stack_alloc, stack_free, &store };
+    if (!certified_search(sdf, m, ta, io->hit ? io->toi : tb, p, &hooks, seed_t, io->bary, fmax(p->time_tol, SCC_VERIFY_TOL), budget, &c)) return 0;
     io->evals += c.evals;
     io->iterations += c.iterations;
     if (c.hit && c.toi < seed_t) {
