@@ -149,8 +149,8 @@ struct SoftState {
     bool guarded_this_step = false;
     bool auto_guard = true;
     double auto_tolerance = 5e-4;
-    // Per node of the pair being processed: the most restrictive plane found (the one the node's
-    // start position is closest to), so each node gets one contact and no two planes fight.
+    // Per node of the pair being processed (2 i: its own path, 2 i + 1: its faces): the most restrictive
+    // plane found of each kind (the one the node's start position is closest to).
     struct Plane {
         double dist;
         D3 normal;
