@@ -149,8 +149,8 @@ struct SoftState {
     bool guarded_this_step = false;
     bool auto_guard = true;
     double auto_tolerance = 5e-4;
-    // Per node of the pair being processed: the most restrictive plane found (the one the node's
-    // start position is closest to), so each node gets one contact and no two planes fight.
+    // Per node of the pair being processed (2 i: its own path, 2 i + 1: its faces): the most restrictive
+    // plane found of each kind (the one the node's start position is closest to).
     struct Plane {
         double dist;
         D3 normal;
@@ -348,25 +348,26 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     rec.start.resize((size_t)nn);
     for (int i = 0; i < nn; ++i) rec.start[(size_t)i] = d3(psb->m_nodes[i].m_q);
 
-    st->planes.assign((size_t)nn, SoftState::Plane{ HUGE_VAL, D3{ 0, 0, 1 }, 0, false });
+    st->planes.assign(2 * (size_t)nn, SoftState::Plane{ HUGE_VAL, D3{ 0, 0, 1 }, 0, false });
     auto offer = [&](int i, D3 nw, double offset, bool face) {
         const double dist = dot(nw, d3(psb->m_nodes[i].m_q)) + offset;
-        SoftState::Plane& pl = st->planes[(size_t)i];
+        SoftState::Plane& pl = st->planes[2 * (size_t)i + (face ? 1 : 0)];
         if (dist < pl.dist) pl = SoftState::Plane{ dist, nw, offset, face };
     };
-    // Nodes: each one's path from m_q to the predicted m_x.
+    // Nodes: each one's path from m_q to the predicted m_x (DCD, the discrete baseline: m_x alone).
+    const bool dcd = impl->cfg.query.method == SDFCCD_METHOD_DCD;
     for (int i = 0; i < nn; ++i) {
         btSoftBody::Node& n = psb->m_nodes[i];
         if (n.m_battach) continue;
         double f, phi;
         D3 g;
-        const D3 a = F.toLocal(d3(n.m_q)), b = F.toLocal(d3(n.m_x));
+        const D3 b = F.toLocal(d3(n.m_x)), a = dcd ? b : F.toLocal(d3(n.m_q));
         Cert& cert = rec.node_certs[(size_t)i];
         if (certBound(cert, &a, &b, 1, L) >= margin) continue;
         const bool hit = pointHit(sdf, a, b, margin, L, &f, &phi, &g, &evals, &cert.c);
         cert.a[0] = a;
         if (!hit) continue;
-        const D3 p = F.toLocal(d3(n.m_q)) + (F.toLocal(d3(n.m_x)) - F.toLocal(d3(n.m_q))) * f;
+        const D3 p = a + (b - a) * f;
         const D3 nl = unit(g);
         const D3 nw = F.dirToWorld(nl);
         offer(i, nw, -dot(nw, F.toWorld(p - nl * (phi - soft_margin))), false);
@@ -418,10 +419,10 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
             }
         }
     }
-    for (int i = 0; i < nn; ++i) {
+    for (int i = 0; i < 2 * nn; ++i) {
         const SoftState::Plane& pl = st->planes[(size_t)i];
         if (!(pl.dist < HUGE_VAL)) continue;
-        addContact(psb, psb->m_nodes[i], co, pl.normal, pl.offset);
+        addContact(psb, psb->m_nodes[i / 2], co, pl.normal, pl.offset);
         ++(pl.face ? st->stats.face_contacts : st->stats.node_contacts);
     }
     st->stats.sdf_evaluations += evals;
@@ -469,7 +470,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
             continue;
         }
         double phi;
-        if (sdfccd_sdf_eval(rec.sdf, sv(S[(size_t)i]), &phi, nullptr) == SDFCCD_OK && phi < -tol) level[(size_t)i] = phi - tol;
+        if (sdfccd_sdf_eval(rec.sdf, sv(S[(size_t)i]), &phi, nullptr) == SDFCCD_OK && phi < -tol) level[(size_t)i] = phi - 0.1 * tol; // no deeper than it started
         ++evals;
     }
     auto endOf = [&](int i) { return F.toLocal(d3(psb->m_nodes[i].m_x)); };
@@ -554,24 +555,29 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
             sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
             sdfccd_QueryResult res;
             sdfccd_Status status = SDFCCD_OK;
-            // A face that starts deeper than its level (its inside below its nodes) is held to its
-            // start depth minus the tolerance, as the rigid guard does (contact.h).
-            for (int round = 0; round < 3; ++round) {
-                const sdfccd_QueryParams qp = faceParams(st->impl, lev);
-                status = sdfccd_query_triangle_linear(rec.sdf, nullptr, ss, ee, 0.0, dt, &qp, st->contacts.data(), 8, &res);
-                ++st->stats.face_queries;
-                if (status != SDFCCD_OK) break;
+            const sdfccd_QueryParams qp = faceParams(st->impl, lev);
+            status = sdfccd_query_triangle_linear(rec.sdf, nullptr, ss, ee, 0.0, dt, &qp, st->contacts.data(), 8, &res);
+            ++st->stats.face_queries;
+            if (status == SDFCCD_OK && res.state == SDFCCD_STATE_PENETRATING && res.contact_count > 0) {
+                // A face that starts deeper than its level may not end deeper than it started (a
+                // level of start depth minus the tolerance would let it sink that much every step).
                 evals += res.sdf_evaluations;
-                if (res.state != SDFCCD_STATE_PENETRATING || res.contact_count < 1) break;
                 double deepest = lev;
                 for (int j = 0; j < res.contact_count; ++j) deepest = std::min(deepest, st->contacts[(size_t)j].distance);
-                lev = std::min(lev, deepest) - tol;
+                const sdfccd_QueryParams qd = faceParams(st->impl, deepest - 0.1 * tol);
+                status = sdfccd_query_triangle_linear(rec.sdf, nullptr, ee, ee, 0.0, dt, &qd, st->contacts.data(), 8, &res);
+                ++st->stats.face_queries;
+                if (status == SDFCCD_OK && res.hit) {
+                    for (int k = 0; k < 3; ++k) setEnd(idx[k], s[k]);
+                    changed = true;
+                }
+                continue;
             }
             if (status != SDFCCD_OK) {
                 if (status != SDFCCD_DEGENERATE) ++st->stats.query_errors;
                 continue;
             }
-            if (!res.hit || res.state == SDFCCD_STATE_PENETRATING) continue;
+            if (!res.hit) continue;
             // The last pass: the face goes back to its start, where the previous check left it.
             const D3 nw = F.dirToWorld(unit(fromSv(st->contacts[0].normal)));
             double f = pass >= passes ? 0.0 : res.fraction;
@@ -709,7 +715,7 @@ public:
     void solveConstraints(btScalar dt) override
     {
         m_inner->solveConstraints(dt);
-        if (m_state && m_state->dispatcher && m_state->auto_guard) {
+        if (m_state && m_state->dispatcher && m_state->auto_guard && m_state->impl->cfg.query.method != SDFCCD_METHOD_DCD) {
             guardWorld(m_state, m_world, m_state->auto_tolerance);
             m_state->guarded_this_step = true;
         }
