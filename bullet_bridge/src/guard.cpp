@@ -149,7 +149,6 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             btTransform t0, t1;
             btVector3 lo, hi;
             sdfccd_RigidMotion motion;
-            bool still; // static: bodies are checked in its frame with no SDF motion (no frame math per evaluation)
         };
         std::vector<SdfObject> sdfs;
         for (int i = 0; i < objs.size(); ++i) {
@@ -163,7 +162,6 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             if (objs[i]->isStaticObject() && !objs[i]->isKinematicObject()) o.t0 = o.t1;
             else startOf(i, o.t0);
             sweptBox(s, o.t0, o.t1, o.lo, o.hi);
-            o.still = o.t0 == o.t1;
             if (motionFromPoses(o.t0, o.t1, btVector3(0, 0, 0), dt, &o.motion) != SDFCCD_OK) {
                 stats.query_errors++;
                 continue;
@@ -203,10 +201,8 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     sdfccd_RigidMotion mm;
                     sdfccd_GuardResult r;
                     stats.guard_queries++;
-                    const btTransform frame = o.still ? o.t1.inverse() : id;
-                    if (motionFromPoses(frame * t0 * part.second, frame * t1 * part.second, part.second.inverse().getOrigin(), dt, &mm) !=
-                            SDFCCD_OK ||
-                        sdfccd_guard_step_rigid(workspace, o.sdf, o.still ? nullptr : &o.motion, me->id, &mm, 0, dt, &gp, &r) != SDFCCD_OK) {
+                    if (motionFromPoses(t0 * part.second, t1 * part.second, part.second.inverse().getOrigin(), dt, &mm) != SDFCCD_OK ||
+                        sdfccd_guard_step_rigid(workspace, o.sdf, &o.motion, me->id, &mm, 0, dt, &gp, &r) != SDFCCD_OK) {
                         stats.query_errors++;
                         continue;
                     }
@@ -220,17 +216,13 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                 }
             }
             if (!best_sdf) continue;
-            if (best_sdf->still) { // the SDF's frame to the world
-                best.point = v3(best_sdf->t1 * bt(best.point));
-                best.normal = v3(best_sdf->t1.getBasis() * bt(best.normal));
-            }
             // The safe pose (of the part that hit first: the body's follows), then the velocity
             // (sdfccd_guard_response, always as "repeated": the body loses its velocity into the surface;
             // keeping it for a first rollback raised the body and left the velocity that sank it, and
             // bodies rocking on a ring in gimpact-demo did not come to rest).
             const sdfccd_Quat& q = best.safe_pose.orientation;
-            const btTransform safe(btQuaternion((btScalar)q.x, (btScalar)q.y, (btScalar)q.z, (btScalar)q.w).normalized(), bt(best.safe_pose.position));
-            body->setCenterOfMassTransform((best_sdf->still ? best_sdf->t1 * safe : safe) * best_part.inverse());
+            body->setCenterOfMassTransform(btTransform(btQuaternion((btScalar)q.x, (btScalar)q.y, (btScalar)q.z, (btScalar)q.w).normalized(),
+                                                       bt(best.safe_pose.position)) * best_part.inverse());
             const btRigidBody* sb = btRigidBody::upcast(best_sdf->co);
             const sdfccd_BodyState ss = sb ? bodyState(sb) : sdfccd_BodyState();
             sdfccd_BodyState bs = bodyState(body);
