@@ -216,6 +216,37 @@ typedef struct trav {
     scc_bsh_stats* stats;
 } trav;
 
+/* A bound on |grad phi| where the mesh can be over [ta, tb]: the SDF's own bound inside the box
+ * its root sphere sweeps (grids bound the gradient per cell, scc_sdf_lipschitz), never above the
+ * global one. Every point phi is evaluated at and every material point it bounds lie in that box
+ * (a convex set), so the Lipschitz arguments below hold with it. A moving SDF keeps the global bound. */
+static double region_lipschitz(const scc_bsh* bsh, const scc_bsh_moving_node* moving, const scc_mesh_motion* mm, const scc_sdf* sdf,
+                               double ta, double tb)
+{
+    const double global = sdf->lipschitz > 0.0 ? sdf->lipschitz : 1.0;
+    if (!sdf->lipschitz_in || (mm->sdf && (scc_len2(mm->sdf->v) > 0.0 || scc_len2(mm->sdf->w) > 0.0))) return global;
+    scc_vec3 a, b;
+    double r;
+    if (moving) { /* linear motion: the root's spheres at both ends hold the mesh all along */
+        a = moving[0].c0;
+        b = moving[0].c1;
+        r = moving[0].radius;
+    } else if (mm->body) { /* rigid: every point stays within r of the centre, which moves on a line */
+        r = scc_dist(bsh->nodes[0].center, mm->body->c_local) + bsh->nodes[0].radius;
+        a = scc_rigid_center_at(mm->body, ta);
+        b = scc_rigid_center_at(mm->body, tb);
+    } else {
+        return global;
+    }
+    a = scc_sdf_frame_point(mm->sdf, ta, a);
+    b = scc_sdf_frame_point(mm->sdf, tb, b);
+    r += 1e-9 * (1.0 + r);
+    const scc_vec3 pad = scc_v3(r, r, r);
+    scc_aabb box = { scc_sub(scc_vmin(a, b), pad), scc_add(scc_vmax(a, b), pad) };
+    const double L = scc_sdf_lipschitz(sdf, &box);
+    return L > 0.0 && L < global ? L : global;
+}
+
 static double node_radius(const trav* tr, uint32_t i)
 {
     return tr->moving ? tr->moving[i].radius : tr->bsh->nodes[i].radius;
@@ -355,7 +386,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
     tr.bsh = bsh;
     tr.moving = moving;
     tr.in = in;
-    tr.lipschitz = in->sdf->lipschitz > 0.0 ? in->sdf->lipschitz : 1.0;
+    tr.lipschitz = region_lipschitz(bsh, moving, mm, in->sdf, p->method == SCC_METHOD_DCD ? t_end : mm->t0, t_end);
     tr.w_body2 = mm->body && !moving ? scc_len2(mm->body->w) : 0.0;
     tr.stats = stats;
     tr.seg = NULL;
@@ -518,7 +549,7 @@ int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc
     c.sdf = sdf;
     c.dcd = dcd;
     c.level = level;
-    c.lipschitz = sdf->lipschitz > 0.0 ? sdf->lipschitz : 1.0;
+    c.lipschitz = region_lipschitz(bsh, NULL, mm, sdf, mm->t0, mm->t1);
     double T = fabs(mm->t1 - mm->t0);
     c.lin = scc_len(mm->body->v) * T;
     c.ang = scc_len(mm->body->w) * T;

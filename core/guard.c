@@ -152,6 +152,20 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
         out->certified = 1;
         return 1;
     }
+    /* A static SDF: the body's motion is taken into its frame once, so that no evaluation pays for
+     * the SDF's pose and frame change (FW's rigid fast path applies). Points and normals are in that
+     * frame either way; times do not change. */
+    scc_rigid local_body;
+    if (mm->sdf && sdf_still) {
+        const scc_quat ci = scc_quat_conj(mm->sdf->q0); /* (the pose of a still SDF is (q0, p0) at every time) */
+        local_body = *mm->body;
+        local_body.p0 = scc_quat_rotate(ci, scc_sub(mm->body->p0, mm->sdf->p0));
+        local_body.q0 = scc_quat_mul(ci, mm->body->q0);
+        local_body.v = scc_quat_rotate(ci, mm->body->v);
+        local_body.w = scc_quat_rotate(ci, mm->body->w);
+        run.body = &local_body;
+        run.sdf = NULL;
+    }
     const scc_bsh* bsh = mm->mesh->bsh;
     uint8_t* flags = NULL;
     if (bsh && p->broad_phase) {

@@ -92,7 +92,9 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
         for (int j = 0; j < 3; ++j) primary.bary[j] = h.bary[j];
         primary.triangle = triangle_index;
         primary.kind = SCC_CONTACT_PRIMARY;
-        primary.gap_t0 = gap_at_t0(sdf, m, h.bary, &evals);
+        /* A contact at t0 (a discrete query at its pose) already has its gap there. */
+        const int at_t0 = h.toi == m->t0;
+        primary.gap_t0 = at_t0 ? h.distance : gap_at_t0(sdf, m, h.bary, &evals);
         if (n < capacity) out[n] = primary;
         ++n;
         if (p->subdivision) {
@@ -103,7 +105,7 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
             for (int i = 0; i < k; ++i) {
                 extra[i].toi = h.toi;
                 extra[i].triangle = triangle_index;
-                extra[i].gap_t0 = gap_at_t0(sdf, m, extra[i].bary, &evals);
+                extra[i].gap_t0 = at_t0 ? extra[i].distance : gap_at_t0(sdf, m, extra[i].bary, &evals);
                 if (n < capacity) out[n] = extra[i];
                 ++n;
             }

@@ -24,6 +24,8 @@
 //                 GImpact bodies (cubes x2, tori x2, alternating) on a 10 x 10 grid 6 m apart,
 //                 two layers at y = 20 and 26, dropped on the wavy landscape
 //                 h = 3 sin(x/8) cos(z/8) over 80 x 80 m (quick: 5 x 5, one layer).
+//  landscape-grid the same field baked into a grid SDF in-tree (sdfccd_create_grid_from_sdf, 1 m
+//                 cells, 82 x 21 x 82); stock: the grid's isosurface as a triangle mesh.
 #include <cmath>
 #include <cstdio>
 
@@ -210,7 +212,8 @@ double landscapeEval(sdfccd_Vec3 p, sdfccd_Vec3* g, void*)
 
 class Landscape : public BulletScene {
 public:
-    explicit Landscape(const Options& opt) : BulletScene(opt, btVector3(0, -10, 0), 1) {}
+    /** `grid`: the field baked into a grid SDF (1 m cells) and the bodies collide with that. */
+    Landscape(const Options& opt, bool grid) : BulletScene(opt, btVector3(0, -10, 0), 1), m_grid(grid) {}
 
     bool build()
     {
@@ -224,7 +227,21 @@ public:
         def.bounds = sdfccd_Aabb{ { -kHalf, -12, -kHalf }, { kHalf, kAmp, kHalf } };
         sdfccd_SdfId land{};
         if (sdfccd_create_callback_sdf(&def, &land) != SDFCCD_OK) return false;
-        Collider& c = addStaticSdf("landscape", land, btVector3(0, 0, 0), btQuaternion::getIdentity(),
+        sdfccd_SdfId field = land;
+        if (m_grid) { // 1 m cells over the field's box (y up to its top, 8 m): the terrain's 50 m waves to about 1e-5 m
+            sdfccd_GridDef gd = sdfccd_default_grid_def();
+            gd.fit_domain = 0;
+            gd.domain = sdfccd_Aabb{ { -kHalf - 1, -12.5, -kHalf - 1 }, { kHalf + 1, 8.5, kHalf + 1 } };
+            gd.resolution[0] = gd.resolution[2] = 2 * (int)kHalf + 2;
+            gd.resolution[1] = 21;
+            if (sdfccd_create_grid_from_sdf(land, &gd, &field) != SDFCCD_OK) {
+                std::fprintf(stderr, "sdfccd_scenes: landscape grid: %s\n", sdfccd_last_error());
+                sdfccd_destroy_sdf(land);
+                return false;
+            }
+        }
+        // (the analytic field stays the measuring reference)
+        Collider& c = addStaticSdf("landscape", field, btVector3(0, 0, 0), btQuaternion::getIdentity(),
                                    sdfccd_Aabb{ { -kHalf - 0.5, -12.5, -kHalf - 0.5 }, { kHalf + 0.5, kAmp + 1, kHalf + 0.5 } }, 128, land);
         c.killBelow(up, -12);
         for (auto& b : rigidStatics()) b->setFriction(0.9f);
@@ -243,6 +260,8 @@ public:
     }
 
 private:
+    bool m_grid;
+
     std::vector<btRigidBody*> rigidStatics()
     {
         std::vector<btRigidBody*> out;
@@ -254,7 +273,7 @@ private:
     }
 };
 
-Scene* createLandscape(const Options& opt) { return built(new Landscape(opt)); }
+template <bool kGrid> Scene* createLandscape(const Options& opt) { return built(new Landscape(opt, kGrid)); }
 
 } // namespace
 
@@ -274,8 +293,10 @@ void appendBulletRecreations(std::vector<SceneEntry>& t)
                   1.0 / 240 });
     t.push_back({ "sdf-box-btsdf-torus", "sdf-box-torus through Bullet's own btSdfCollisionShape (same .cdf file)",
                   createSdfBox<true, true>, 480, 1.0 / 240 });
-    t.push_back({ "landscape", "BenchmarkDemo landscape: 200 GImpact cubes and tori on a wavy SDF landscape (Y up, 1/60 s)", createLandscape,
+    t.push_back({ "landscape", "BenchmarkDemo landscape: 200 GImpact cubes and tori on a wavy SDF landscape (Y up, 1/60 s)", createLandscape<false>,
                   300, 1.0 / 60 });
+    t.push_back({ "landscape-grid", "the landscape baked into a grid SDF (1 m cells; stock: the grid's isosurface)", createLandscape<true>, 300,
+                  1.0 / 60 });
 }
 
 } // namespace scenes
