@@ -39,7 +39,7 @@ typedef struct scc_params {
     int fwgss_clear_budget; /* FWGSS: evaluations of the no-contact proof tried before the descents (0: off) */
     double fwgss_gap_tol;   /* FWGSS: line searches far from the surface stop early by this fraction of the gap */
     int fwgss_deriv_spatial; /* FWGSS: spatial line searches at full precision use the gradient (scc_deriv_minimize) */
-    int fwgss_verify;       /* FWGSS on analytic kinked fields: the answer checked by scc_fwgss_verify */
+    int fwgss_verify;       /* FWGSS on fields with gradient jumps (kinked analytic fields, grids): the answer checked by scc_fwgss_verify */
     int fwgss_kink_guard;   /* FWGSS on fields with gradient jumps (0 off, 1 grids after a check, 2 grids always): golden section, more starts, the 1 us probe */
     int fwgss_restart_at_witness; /* FWGSS: restarts begin at the earliest witness's time (else at ts) */
     int64_t max_evals;      /* SDF evaluation budget of this call (> 0); solvers stop at it (NOT_CONVERGED) */
@@ -98,11 +98,13 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
 #define SCC_VERIFY_TOL 1e-7
 #define SCC_VERIFY_FACTOR 128
 #define SCC_VERIFY_BASE_EVALS 16384
+#define SCC_VERIFY_GRID_BASE_EVALS 65536 /* grids (their bound is certified.c's per-cell Taylor form) */
 #define SCC_VERIFY_MAX_EVALS 1000000
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                      const scc_allocator* alloc, scc_tri_hit* io);
-/* Whether scc_fwgss_verify checks FWGSS on this field: analytic fields with gradient jumps and
- * fwgss_kink_guard and fwgss_verify on (grids are not: their cells' Lipschitz bounds make it far too slow). */
+/* Whether scc_fwgss_verify checks FWGSS on this field: fields with gradient jumps (analytic kinked
+ * fields, grids, user fields) with fwgss_kink_guard and fwgss_verify on. On grids the search bounds
+ * phi per cell by a first-order Taylor form (certified.c), not by the cells' Lipschitz bounds. */
 int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p);
 
 /* ---- adaptive triangle subdivision at the TOI (Section 4.5) ----
