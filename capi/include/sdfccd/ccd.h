@@ -140,17 +140,18 @@ typedef struct sdfccd_QueryParams {
                                         the gradient turns by more than 0.2 rad within 1 mm of the earliest contact; at 2
                                         every grid query gets the whole guard. Smooth analytic fields (sphere, torus,
                                         capsule, rounded box, half-space) are unaffected. At 1 and 2, on the analytic
-                                        fields with kinks, FWGSS's answer is then checked by the certified method's
-                                        search over [t0, TOI] (no hit: the whole interval) seeded with its witness: it
+                                        fields with kinks and on grids, FWGSS's answer is then checked by the certified
+                                        method's search over [t0, TOI] (no hit: the whole interval) seeded with its
+                                        witness (on grids bounding phi per cell by a first-order Taylor form): it
                                         stops once no contact is proven more than max(time_tolerance, 1e-7 s) before
-                                        the witness, or after 128 x FWGSS's evaluations + 16384 (at most 10^6), and an
-                                        earlier contact it finds replaces the answer; on the convex ones (box,
+                                        the witness, or after 128 x FWGSS's evaluations + 16384 (grids: + 65536; at
+                                        most 10^6), and an earlier contact it finds replaces the answer; on the convex ones (box,
                                         cylinder) the golden-section searches and the 1 us check are left to it. Per-kind
                                         data set (samples/report, section 2b) and costs: README. 0 = off, 1 (default) or 2. */
-    int32_t fwgss_verify;          /**< FWGSS: where fwgss_kink_guard applies to an analytic field with gradient jumps,
-                                        the answer is checked by the certified search seeded with FWGSS's witness
-                                        (an earlier contact found replaces it; at most 128x FWGSS's evaluations
-                                        + 16384). 0 = no check (the guard's searches instead), as before issue 20.
+    int32_t fwgss_verify;          /**< FWGSS: where fwgss_kink_guard applies to an analytic field with gradient jumps
+                                        or to a grid, the answer is checked by the certified search seeded with FWGSS's
+                                        witness (an earlier contact found replaces it; at most 128x FWGSS's evaluations
+                                        + 16384, grids + 65536). 0 = no check (the guard's searches instead), as before issue 20.
                                         Default 1. The Bullet bridge sets 0: a triangle resting at its contact level
                                         keeps the check busy at every step, and its guarantee backs the answer. */
 } sdfccd_QueryParams;
