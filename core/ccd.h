@@ -106,6 +106,13 @@ int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, dou
  * fields, grids, user fields) with fwgss_kink_guard and fwgss_verify on. On grids the search bounds
  * phi per cell by a first-order Taylor form (certified.c), not by the cells' Lipschitz bounds. */
 int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p);
+/* The lower bound of phi that the check uses on a grid, for tests: over the sub-triangle with weights
+ * (u[i], v[i], 1 - u[i] - v[i]) of motion m over [ta, tb]; `local` 1: every cell's Hessian bound over
+ * its part of the region's box (0: the whole cell's where the box lies inside it). Returns 0 when the
+ * bound does not apply (not a grid, the box leaves the domain, spans more than 3 cells per axis or
+ * touches a cell without values). */
+int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const double u[3], const double v[3], double ta, double tb, int local,
+                          double* out_bound);
 
 /* ---- adaptive triangle subdivision at the TOI (Section 4.5) ----
  * `tri` is the triangle at the TOI, `primary` the weights of the first contact. Writes up to

@@ -244,7 +244,8 @@ static const cell_poly* cell_poly_at(grid_bound_ctx* ctx, const uint32_t ijk[3])
  * along an axis, or a cell without values). Each cell first tries its cached whole-cell Hessian
  * bound and re-expresses its form on the box only when that does not prune. */
 static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const region* r, scc_vec3 c, double rho, double rs, double rt,
-                             double accel, double margin, int64_t* evals, double* out_bound, double* out_space, double* out_time)
+                             double accel, double margin, int force_local, int64_t* evals, double* out_bound, double* out_space,
+                             double* out_time)
 {
     const scc_grid* g = ctx->g;
     const double cc[3] = { c.x, c.y, c.z }, lo[3] = { g->lo.x, g->lo.y, g->lo.z }, hi[3] = { g->hi.x, g->hi.y, g->hi.z };
@@ -298,7 +299,7 @@ static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const
                 const double lin = fmax(offset + f.lin - f.curve, lin_box);
                 const double base = val + lin - (1e-12 * rho * (1.0 + scc_len(gq)) + 1e-15);
                 double extra = 0.5 * (1.0 + 1e-9) * e->hess * rho * rho;
-                if (base - extra <= margin && base > margin && !whole) {
+                if ((force_local || (base - extra <= margin && base > margin)) && !whole) {
                     /* the Hessian over the box's part in the cell (at least 1e-6 wide, for conditioning) */
                     double b[64], hs[3];
                     memcpy(b, e->b, sizeof b);
@@ -327,6 +328,26 @@ static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const
     *out_space = space;
     *out_time = time;
     return 1;
+}
+
+int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const double u[3], const double v[3], double ta, double tb, int local,
+                          double* out_bound)
+{
+    if (sdf->kind != SCC_SDF_GRID) return 0;
+    grid_bound_ctx ctx;
+    ctx.g = (const scc_grid*)sdf;
+    for (int i = 0; i < CELL_CACHE; ++i) ctx.cell[i].l = UINT64_MAX;
+    region r = { ta, tb, { u[0], u[1], u[2] }, { v[0], v[1], v[2] } };
+    scc_tri_state st;
+    scc_tri_state_at(m, ta, &st);
+    const double cu = (u[0] + u[1] + u[2]) / 3.0, cv = (v[0] + v[1] + v[2]) / 3.0;
+    const scc_vec3 c = corner(&st, cu, cv);
+    double rs = 0.0;
+    for (int i = 0; i < 3; ++i) rs = fmax(rs, scc_dist(corner(&st, u[i], v[i]), c));
+    const double rt = scc_tri_speed_bound(m) * (tb - ta);
+    double space, time;
+    int64_t evals = 0;
+    return grid_region_bound(&ctx, &st, &r, c, rs + rt, rs, rt, scc_tri_accel_bound(m), -INFINITY, local, &evals, out_bound, &space, &time);
 }
 
 /* The region store of a check of FWGSS (scc_fwgss_verify) starts in a buffer on the stack (ours): a
@@ -419,7 +440,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         } else if (grid) {
             /* a grid: the smallest of the per-cell first-order bounds (grid_region_bound) */
             double bound, gs, gt;
-            if (grid_region_bound(grid, &st, &r, c, rho, rs, rt, accel, p->margin, &evals, &bound, &gs, &gt)) {
+            if (grid_region_bound(grid, &st, &r, c, rho, rs, rt, accel, p->margin, 0, &evals, &bound, &gs, &gt)) {
                 if (bound > p->margin) continue;
                 if (bound > phi - L * rho) {
                     slack_space = gs;
