@@ -99,12 +99,15 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
 #define SCC_VERIFY_FACTOR 128
 #define SCC_VERIFY_BASE_EVALS 16384
 #define SCC_VERIFY_GRID_BASE_EVALS 65536 /* grids (their bound is certified.c's per-cell Taylor form) */
+#define SCC_VERIFY_GRID_MIN_LIPSCHITZ 2.25 /* grids are checked where their cells' gradient bound along the path exceeds this */
 #define SCC_VERIFY_MAX_EVALS 1000000
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                      const scc_allocator* alloc, scc_tri_hit* io);
 /* Whether scc_fwgss_verify checks FWGSS on this field: fields with gradient jumps (analytic kinked
  * fields, grids, user fields) with fwgss_kink_guard and fwgss_verify on. On grids the search bounds
- * phi per cell by a first-order Taylor form (certified.c), not by the cells' Lipschitz bounds. */
+ * phi per cell by a first-order Taylor form (certified.c), not by the cells' Lipschitz bounds, and
+ * runs only where the cells the triangle sweeps have a gradient bound above
+ * SCC_VERIFY_GRID_MIN_LIPSCHITZ (a crease; a smooth shape's grid stays near 1). */
 int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p);
 /* The lower bound of phi that the check uses on a grid, for tests: over the sub-triangle with weights
  * (u[i], v[i], 1 - u[i] - v[i]) of motion m over [ta, tb]; `local` 1: every cell's Hessian bound over
