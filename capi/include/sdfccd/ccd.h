@@ -142,7 +142,8 @@ typedef struct sdfccd_QueryParams {
                                         capsule, rounded box, half-space) are unaffected. At 1 and 2, on the analytic
                                         fields with kinks and on grids, FWGSS's answer is then checked by the certified
                                         method's search over [t0, TOI] (no hit: the whole interval) seeded with its
-                                        witness (on grids bounding phi per cell by a first-order Taylor form): it
+                                        witness (on grids bounding phi per cell by a first-order Taylor form, and
+                                        only where the cells along the path bound |grad phi| above 2.25): it
                                         stops once no contact is proven more than max(time_tolerance, 1e-7 s) before
                                         the witness, or after 128 x FWGSS's evaluations + 16384 (grids: + 65536; at
                                         most 10^6), and an earlier contact it finds replaces the answer; on the convex ones (box,
