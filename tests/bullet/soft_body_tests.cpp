@@ -772,6 +772,204 @@ static void bench(const char* only)
     }
 }
 
+// ---- the report (not a ctest; scripts/soft_report.sh): every soft scene above through the bridge and
+// through stock Bullet (the SDF's isosurface as a btBvhTriangleMeshShape; the SDF baked to a grid and
+// read by Bullet as btSdfCollisionShape), in one run, measured against the exact SDF at every step. ----
+
+enum class Collider { Bridge, StockMesh, StockBtSdf };
+
+// A soft scene of the tests above: its SDF and pose, a box around its surface (isosurface and grid),
+// the isosurface's resolution, and its steps.
+struct ReportScene {
+    const char* name;
+    int steps;
+    int mesh_res;
+};
+static const ReportScene kReportScenes[] = {
+    { "cloth_on_torus", 240, 24 }, { "cloth_on_spikes", 90, 24 }, { "cloth_fast_plate", 60, 160 },
+    { "rope_through_ring", 180, 24 }, { "ball_on_torus", 90, 24 },
+};
+
+static sdfccd_SdfId reportSdf(const std::string& n, btTransform* pose, sdfccd_Aabb* box)
+{
+    sdfccd_SdfId sdf{};
+    pose->setIdentity();
+    if (n == "cloth_on_torus" || n == "ball_on_torus") {
+        sdfccd_create_torus(0.3, 0.1, &sdf);
+        *box = sdfccd_Aabb{ { -0.45, -0.45, -0.15 }, { 0.45, 0.45, 0.15 } };
+    } else if (n == "cloth_on_spikes") {
+        sdfccd_SpikeGridDef def = sdfccd_default_spike_grid_def();
+        def.spacing = 0.12;
+        def.base_radius = 0.04;
+        def.height = 0.1;
+        def.count_x = 7;
+        def.count_y = 7;
+        sdfccd_create_spike_grid(&def, &sdf);
+        *box = sdfccd_Aabb{ { -0.5, -0.5, -0.05 }, { 0.5, 0.5, 0.12 } };
+    } else if (n == "cloth_fast_plate") {
+        sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.005 }, &sdf);
+        *box = sdfccd_Aabb{ { -0.4, -0.4, -0.02 }, { 0.4, 0.4, 0.02 } };
+    } else {
+        sdfccd_create_torus(0.25, 0.04, &sdf);
+        pose->setRotation(btQuaternion(btVector3(1, 0, 0), (btScalar)(M_PI / 2)));
+        *box = sdfccd_Aabb{ { -0.31, -0.31, -0.05 }, { 0.31, 0.31, 0.05 } };
+    }
+    return sdf;
+}
+
+static btSoftBody* reportBody(const std::string& n, SoftWorld& w)
+{
+    if (n == "cloth_on_torus") {
+        btSoftBody* c = w.addCloth(0.8, 0.05, -0.03, 0.3, -2.0);
+        c->m_cfg.kDP = 0.2f;
+        return c;
+    }
+    if (n == "cloth_on_spikes") return w.addCloth(0.6, 0.013, 0.021, 0.25, -2.0);
+    if (n == "cloth_fast_plate") return w.addCloth(0.6, 0.0, 0.0, 0.5, -20.0);
+    if (n == "ball_on_torus") {
+        btSoftBody* b = btSoftBodyHelpers::CreateEllipsoid(w.world.getWorldInfo(), btVector3(0.01f, 0.02f, 0.5f),
+                                                           btVector3(0.25f, 0.25f, 0.25f), 128);
+        b->m_cfg.kPR = 20;
+        w.setup(b, -3.0);
+        return b;
+    }
+    btSoftBody* r = btSoftBodyHelpers::CreateRope(w.world.getWorldInfo(), btVector3(0, -0.6f, 0.3f), btVector3(0, 0.4f, 0.3f), 40, 1);
+    w.setup(r, 0.0);
+    return r;
+}
+
+// Deepest point (m) of the body against the exact SDF: nodes, face lattice, 7 points inside each link
+// of a body without faces.
+static double reportPenetration(const btSoftBody* b, sdfccd_SdfId sdf, const btTransform& pose)
+{
+    double worst = softPenetration(b, sdf, pose);
+    for (int l = 0; b->m_faces.size() == 0 && l < b->m_links.size(); ++l)
+        for (int k = 1; k < 8; ++k)
+            worst = std::max(worst, -phiAt(sdf, pose, b->m_links[l].m_n[0]->m_x.lerp(b->m_links[l].m_n[1]->m_x, (btScalar)(k / 8.0))));
+    return worst;
+}
+
+// A shape Bullet reads: the isosurface as a triangle mesh, or the SDF baked to a grid saved as .cdf.
+struct StockShape {
+    btTriangleMesh tm;
+    std::unique_ptr<btBvhTriangleMeshShape> mesh;
+    std::vector<char> bytes;
+    std::unique_ptr<btSdfCollisionShape> cdf;
+    int triangles = 0;
+    btCollisionShape* make(Collider c, sdfccd_SdfId sdf, sdfccd_Aabb box, int res)
+    {
+        if (c == Collider::StockMesh) {
+            sdfccd_MeshId m;
+            if (sdfccd_extract_isosurface(sdf, box, res, &m) != SDFCCD_OK) return nullptr;
+            sdfccd_MeshInfo info;
+            sdfccd_mesh_get_info(m, &info);
+            std::vector<double> v(3 * (size_t)info.vertex_count);
+            std::vector<uint32_t> idx(3 * (size_t)info.triangle_count);
+            sdfccd_mesh_get_data(m, v.data(), idx.data());
+            sdfccd_destroy_mesh(m);
+            for (size_t t = 0; t < idx.size(); t += 3) {
+                btVector3 p[3];
+                for (int k = 0; k < 3; ++k)
+                    p[k] = btVector3((btScalar)v[3 * idx[t + k]], (btScalar)v[3 * idx[t + k] + 1], (btScalar)v[3 * idx[t + k] + 2]);
+                tm.addTriangle(p[0], p[1], p[2]);
+            }
+            triangles = (int)info.triangle_count;
+            mesh.reset(new btBvhTriangleMeshShape(&tm, true));
+            return mesh.get();
+        }
+        // The grid: cells of about the isosurface's (at most 64 per axis), over the box grown by 2 cm.
+        sdfccd_GridDef def = sdfccd_default_grid_def();
+        def.fit_domain = 0;
+        def.domain = box;
+        const double ext[3] = { box.hi.x - box.lo.x + 0.04, box.hi.y - box.lo.y + 0.04, box.hi.z - box.lo.z + 0.04 };
+        const double cell = std::max(ext[0], std::max(ext[1], ext[2])) / std::min(res, 64);
+        def.domain.lo = sdfccd_Vec3{ box.lo.x - 0.02, box.lo.y - 0.02, box.lo.z - 0.02 };
+        def.domain.hi = sdfccd_Vec3{ box.hi.x + 0.02, box.hi.y + 0.02, box.hi.z + 0.02 };
+        for (int k = 0; k < 3; ++k) def.resolution[k] = std::max(2, (int)std::ceil(ext[k] / cell));
+        sdfccd_SdfId grid;
+        if (sdfccd_create_grid_from_sdf(sdf, &def, &grid) != SDFCCD_OK) return nullptr;
+        const std::string path = std::string("/tmp/sdfccd_soft_report_") + std::to_string((long)std::rand()) + ".cdf";
+        const bool saved = sdfccd_save_grid(grid, path.c_str()) == SDFCCD_OK;
+        sdfccd_destroy_sdf(grid);
+        if (!saved || !loadFile(path, bytes)) return nullptr;
+        std::remove(path.c_str());
+        cdf.reset(new btSdfCollisionShape());
+        if (!cdf->initializeSDF(bytes.data(), (int)bytes.size())) return nullptr;
+        return cdf.get();
+    }
+};
+
+// One row: the scene with one collider; prints the figures as a markdown row.
+static void reportRow(const ReportScene& rs, Collider c)
+{
+    btTransform pose;
+    sdfccd_Aabb box;
+    const sdfccd_SdfId sdf = reportSdf(rs.name, &pose, &box);
+    double worst = 0, rest = 0, ms = 0;
+    double lowest = 1e30;
+    int64_t evals = 0;
+    int deep_steps = 0;
+    std::string extra;
+    {
+        StockShape stock;
+        SdfShape shape(sdf);
+        if (std::string(rs.name) == "cloth_on_spikes") shape.setLocalBounds(btVector3(-1, -1, -0.1f), btVector3(1, 1, 0.11f));
+        Bridge bridge;
+        btCollisionShape* coll = c == Collider::Bridge ? (btCollisionShape*)&shape : stock.make(c, sdf, box, rs.mesh_res);
+        if (!coll) {
+            CHECK(false, "%s: the stock shape could not be built", rs.name);
+            sdfccd_destroy_sdf(sdf);
+            return;
+        }
+        if (c == Collider::StockMesh) extra = ", " + std::to_string(stock.triangles) + " triangles";
+        if (c == Collider::StockBtSdf) extra = ", " + std::to_string(stock.bytes.size() / 1024) + " KiB .cdf";
+        SoftWorld w(c == Collider::Bridge ? &bridge : nullptr);
+        w.addStatic(coll, pose);
+        btSoftBody* body = reportBody(rs.name, w);
+        // Bullet's soft-concave path costs up to seconds per step: the isosurface rows stop after
+        // SOFT_REPORT_MESH_STEPS steps (default 40; said in the row).
+        const char* cap = std::getenv("SOFT_REPORT_MESH_STEPS");
+        const int steps = c == Collider::StockMesh ? std::min(rs.steps, cap ? std::max(1, std::atoi(cap)) : 40) : rs.steps;
+        if (steps < rs.steps) extra += ", " + std::to_string(steps) + " of " + std::to_string(rs.steps) + " steps";
+        for (int s = 0; s < steps; ++s) {
+            const auto t0 = std::chrono::steady_clock::now();
+            w.step();
+            ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            const double pen = reportPenetration(body, sdf, pose);
+            worst = std::max(worst, pen);
+            deep_steps += pen > 1e-3 ? 1 : 0;
+            if (s >= steps - 60) rest = std::max(rest, maxSpeed(body));
+        }
+        ms /= steps;
+        if (steps < 120) rest = -1; // shorter than 2 s: no last second at rest to speak of
+        lowest = minZ(body);
+        if (c == Collider::Bridge) {
+            evals = sdfccd_bullet::softBodyStats(bridge).sdf_evaluations / steps;
+            checkNoErrors(bridge, rs.name);
+        }
+    }
+    sdfccd_destroy_sdf(sdf);
+    const char* label = c == Collider::Bridge ? "bridge (SdfShape)" : c == Collider::StockMesh ? "stock, isosurface btBvhTriangleMeshShape"
+                                                                                              : "stock, btSdfCollisionShape";
+    const std::string rest_s = rest < 0 ? std::string("-") : std::to_string(rest).substr(0, 5);
+    // Through: every body but the rope (which swings below its ring) ends above the SDF's lowest point.
+    const bool rope = std::string(rs.name) == "rope_through_ring";
+    const bool through = !rope && lowest < box.lo.z - 0.05;
+    std::printf("| %s | %s%s | %.2f | %s | %s | %d | %.4f | %s | %.2f | %s |\n", rs.name, label, extra.c_str(), worst * 1e3,
+                rope ? "-" : through ? "yes" : "no", worst <= 1e-3 && !through ? "yes" : "no", deep_steps, lowest, rest_s.c_str(), ms, c == Collider::Bridge ? std::to_string(evals).c_str() : "-");
+    std::fflush(stdout);
+}
+
+static void report(const char* only)
+{
+    std::printf("| scene | collider | max pen. mm | passed through | holds | steps > 1 mm | lowest node z m | rest speed m/s | step ms | SDF evals/step |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const ReportScene& rs : kReportScenes) {
+        if (only && std::strcmp(only, rs.name) != 0) continue;
+        for (Collider c : { Collider::Bridge, Collider::StockMesh, Collider::StockBtSdf }) reportRow(rs, c);
+    }
+}
+
 struct Test {
     const char* name;
     void (*fn)();
@@ -794,6 +992,10 @@ int main(int argc, char** argv)
 {
     std::printf("sdfccd Bullet soft-body tests, btScalar = %d bytes\n", (int)sizeof(btScalar));
     int ran = 0;
+    if (argc >= 2 && std::strcmp(argv[1], "report") == 0) {
+        report(argc >= 3 ? argv[2] : nullptr);
+        return g_fail == 0 ? 0 : 1;
+    }
     if (argc >= 2 && std::strcmp(argv[1], "bench") == 0) {
         bench(argc >= 3 ? argv[2] : nullptr);
         return g_fail == 0 ? 0 : 1;
