@@ -251,7 +251,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
  * fields), where the descents' local steps can stop at a later contact. Smooth fields are not. */
 int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p)
 {
-    if (p->fwgss_kink_guard <= 0 || !p->fwgss_verify) return 0;
+    if (p->fwgss_kink_guard <= 0 || !p->fwgss_verify || sdf->smooth) return 0; /* smooth: scc_sdf.smooth */
     switch (sdf->kind) {
     case SCC_SDF_SPHERE: case SCC_SDF_TORUS: case SCC_SDF_CAPSULE: case SCC_SDF_ROUNDED_BOX: case SCC_SDF_HALF_SPACE: return 0;
     case SCC_SDF_GRID: return 0; /* the Lipschitz bounds of a grid's cells make it far too slow (median 10^5 evaluations) */

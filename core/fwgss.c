@@ -526,15 +526,9 @@ static int sharp_at_witness(scc_fw_state* s)
 }
 
 /* Whether phi may have gradient jumps outside the surface: box edges and faces, CSG seams, cone
- * tips, grid cells, or unknown (transformed and user fields). The sphere, torus, capsule, rounded
- * box and half-space are smooth there. */
-static int field_has_kinks(const scc_sdf* sdf)
-{
-    switch (sdf->kind) {
-    case SCC_SDF_SPHERE: case SCC_SDF_TORUS: case SCC_SDF_CAPSULE: case SCC_SDF_ROUNDED_BOX: case SCC_SDF_HALF_SPACE: return 0;
-    default: return 1;
-    }
-}
+ * tips, grid cells, or unknown (transformed fields, user fields not declared smooth). The sphere,
+ * torus, capsule, rounded box and half-space are smooth there (scc_sdf.smooth). */
+static int field_has_kinks(const scc_sdf* sdf) { return !sdf->smooth; }
 
 void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out)
 {

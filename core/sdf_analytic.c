@@ -31,6 +31,8 @@ static void base_init(scc_sdf* b, scc_sdf_eval_fn* fn, scc_sdf_kind kind, scc_aa
     /* The signed distance of a convex shape is a convex function. */
     b->convex = kind == SCC_SDF_SPHERE || kind == SCC_SDF_BOX || kind == SCC_SDF_ROUNDED_BOX || kind == SCC_SDF_CAPSULE ||
                 kind == SCC_SDF_CYLINDER || kind == SCC_SDF_HALF_SPACE;
+    b->smooth = kind == SCC_SDF_SPHERE || kind == SCC_SDF_TORUS || kind == SCC_SDF_CAPSULE || kind == SCC_SDF_ROUNDED_BOX ||
+                kind == SCC_SDF_HALF_SPACE;
 }
 
 
