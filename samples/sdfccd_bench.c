@@ -357,6 +357,8 @@ static void exp_scaling(const options* o)
                 lo[k] = fmin(lo[k], lv[L].v[3 * i + k]);
                 hi[k] = fmax(hi[k], lv[L].v[3 * i + k]);
             }
+        /* SDFCCD_BENCH_SCALING_LEVEL=0|1|2: that mesh size alone (1K, 10K, 100K; a short run for profiling) */
+        if (getenv("SDFCCD_BENCH_SCALING_LEVEL") && L != atoi(getenv("SDFCCD_BENCH_SCALING_LEVEL"))) continue;
         /* the certified bracket of the scene, once */
         sdfccd_QueryParams pc = certified_params();
         fall_result c = fall(spikes, mesh, lo, hi, &pc, ws);
