@@ -363,13 +363,15 @@ static void exp_scaling(const options* o)
         sdfccd_QueryParams pc = certified_params();
         fall_result c = fall(spikes, mesh, lo, hi, &pc, ws);
         printf("%u,Certified,1,0,%.4f,%d,%.12g,%.12g,%lld,%lld\n", info.triangle_count, c.total_ms, c.steps, c.toi, c.toi_lower, c.tested, c.evals);
-        struct { const char* name; sdfccd_QueryParams p; } m[4] = {
+        struct { const char* name; sdfccd_QueryParams p; } m[5] = {
             { "DCD", method_params(SDFCCD_METHOD_DCD, 1) },
             { "FWGSS", config_params(CFG_NEW, 1) },
+            { "FWGSS-no-check", config_params(CFG_NEW, 1) },
             { "FWGSS-baseline", config_params(CFG_BASELINE, 1) },
             { "FWGSS-paper", config_params(CFG_PAPER, 1) },
         };
-        int nm = o->baseline ? 4 : 2;
+        m[2].p.fwgss_verify = 0; /* the defaults without the certified check of the answer (the Bullet bridge's setting) */
+        int nm = o->baseline ? 5 : 3;
         for (int bp = 1; bp >= 0; --bp) {
             if (!bp && (L == 2 || o->quick)) continue; /* without the hierarchy 100K takes seconds per repeat */
             int reps = bp ? R : (R > 3 ? 3 : R);
