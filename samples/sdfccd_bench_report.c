@@ -340,8 +340,9 @@ static void section_scaling(FILE* md, const char* dir, const table* t)
                 "(20 × 20 cones, 10 cm apart, 10 cm tall; analytic, 1-Lipschitz) until the first step with a contact. Total = query "
                 "time summed over the steps (median of the repeats, configurations interleaved). Certified = the certified bracket of "
                 "the same scene (one run); ΔTOI = TOI − certified upper bound (0 inside the bracket). The spike grid's gradient jumps "
-                "(between cones, at the tips), so FWGSS (the defaults) runs its kink guard and the certified check of its answer "
-                "(`fwgss_verify`); FWGSS-no-check is the same without the check (the Bullet bridge's setting). The certified search "
+                "(between cones, at the tips), so FWGSS (the defaults) checks its answer by the certified search (`fwgss_verify`; "
+                "with the check on, the kink guard's extra searches are skipped on this field, as on convex ones); FWGSS-no-check is "
+                "without the check (the Bullet bridge's setting), with the kink guard's searches instead. The certified search "
                 "uses the field's convexity on the boxes that one cone or the ground decides (`convex_in`).\n\n");
     fprintf(md, "| Triangles | Method | Broad phase | Total (ms) | steps | TOI (s) | certified [lower, upper] (s) | ΔTOI (s) | tested | SDF evals |\n");
     fprintf(md, "|---|---|---|---|---|---|---|---|---|---|\n");
@@ -391,7 +392,7 @@ static void section_scaling(FILE* md, const char* dir, const table* t)
                 "and the certified bracket can be narrower than that. At 100K the contact is a spike's tip under the armadillo: "
                 "phi then changes linearly with the contact point's sideways error (the spatial tolerance, speed × time "
                 "tolerance), so a witness a few 1e-8 s after the certified one is within FWGSS's tolerance; refining the witness's "
-                "own entry time to 1e-9 s leaves it 6.6e-9 s after the bracket (measured), so the lateness is in which point of "
+                "own entry time to 1e-9 s leaves it 6.6e-9 s after the bracket (measured with the guard's searches), so the lateness is in which point of "
                 "the triangle, not in the search along its path. CSV: `scaling.csv` (every repeat).\n\n");
 }
 
