@@ -103,6 +103,7 @@ typedef struct space_ctx {
     scc_vec3 a, b;      /* segment from the iterate to the support vertex */
     double ba[3], bb[3];
     double t;
+    scc_vec3 d;         /* b - a, once per segment (scc_lerp's difference) */
 } space_ctx;
 
 /* phi at parameter l of the segment (and its derivative along it when df is not NULL); a point in
@@ -110,9 +111,9 @@ typedef struct space_ctx {
 static double eval_on_segment(space_ctx* k, double l, double* df)
 {
     scc_vec3 g;
-    double phi = scc_sdf_eval_builtin(k->s->sdf, scc_lerp(k->a, k->b, l), df ? &g : NULL);
+    double phi = scc_sdf_eval_builtin(k->s->sdf, scc_madd(k->a, k->d, l), df ? &g : NULL);
     k->s->evals++;
-    if (df) *df = scc_dot(g, scc_sub(k->b, k->a));
+    if (df) *df = scc_dot(g, k->d);
     if (phi <= k->s->p->margin) {
         double b[3];
         for (int j = 0; j < 3; ++j) b[j] = (1.0 - l) * k->ba[j] + l * k->bb[j];
@@ -159,7 +160,7 @@ static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 
     scc_vec3 end = scc_add(scc_add(scc_scale(st->x[0], bb[0]), scc_scale(st->x[1], bb[1])), scc_scale(st->x[2], bb[2]));
     double len = scc_dist(end, xn);
     if (!(len > s->dist_tol)) return 0.0;
-    space_ctx k = { s, xn, end, { s->b[0], s->b[1], s->b[2] }, { bb[0], bb[1], bb[2] }, t };
+    space_ctx k = { s, xn, end, { s->b[0], s->b[1], s->b[2] }, { bb[0], bb[1], bb[2] }, t, scc_sub(end, xn) };
     const double fine = s->dist_tol, coarse = p->fwgss_gap_tol * gap;
     const double tol = scc_fmax(fine, coarse) / len;
     const double f0 = gap + p->margin; /* phi at the iterate, l = 0: not evaluated again */
