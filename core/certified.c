@@ -543,7 +543,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
  * fields), where the descents' local steps can stop at a later contact. Smooth fields are not. */
 int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p)
 {
-    if (p->fwgss_kink_guard <= 0 || !p->fwgss_verify) return 0;
+    if (p->fwgss_kink_guard <= 0 || !p->fwgss_verify || sdf->smooth) return 0; /* smooth: scc_sdf.smooth */
     switch (sdf->kind) {
     case SCC_SDF_SPHERE: case SCC_SDF_TORUS: case SCC_SDF_CAPSULE: case SCC_SDF_ROUNDED_BOX: case SCC_SDF_HALF_SPACE: return 0;
     default: return 1;

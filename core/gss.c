@@ -5,6 +5,7 @@
  * near l = 0 and is meaningless for intervals that straddle zero). Also here (ours): Brent's
  * minimiser, and a line search with derivatives that FWGSS uses near contact. */
 #include "gss.h"
+#include "scc_math.h"
 
 #include <math.h>
 
@@ -45,11 +46,11 @@ scc_gss_result scc_gss_minimize_from(double a, double b, double fa, double fb, d
     int it = 0, flat = 0;
     while (fabs(l3 - l0) > tol && it < max_iter) {
         if (slope > 0.0) {
-            double m = fmin(fmin(f0, f1), fmin(f2, f3));
+            double m = scc_fmin(scc_fmin(f0, f1), scc_fmin(f2, f3));
             if (m > 0.0 && fabs(l3 - l0) * slope <= m) { flat = 1; break; }
         }
         ++it;
-        if (fmin(f0, f1) < fmin(f2, f3)) {
+        if (scc_fmin(f0, f1) < scc_fmin(f2, f3)) {
             a3 = a2; l3 = l2; f3 = f2;
             a2 = a1; l2 = l1; f2 = f1;
             a1 = r * a2 + rc * a0;

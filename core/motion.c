@@ -124,7 +124,7 @@ static double speed_bound_of(const scc_tri_motion* m, const int idx[3])
     if (m->kind == SCC_TRI_RIGID) {
         scc_vec3 c = m->body->c_local;
         double r = 0.0;
-        for (int i = 0; i < 3; ++i) r = fmax(r, scc_dist(m->local[idx[i]], c));
+        for (int i = 0; i < 3; ++i) r = scc_fmax(r, scc_dist(m->local[idx[i]], c));
         speed = scc_len(m->body->v) + scc_len(m->body->w) * r;
         if (m->sdf) {
             scc_vec3 g0 = scc_rigid_center_at(m->body, m->t0);
@@ -133,8 +133,8 @@ static double speed_bound_of(const scc_tri_motion* m, const int idx[3])
     } else {
         for (int i = 0; i < 3; ++i) {
             double d = scc_dist(m->end[idx[i]], m->start[idx[i]]);
-            speed = fmax(speed, T > 0.0 ? d / T : 0.0);
-            if (m->sdf) reach = fmax(reach, scc_dist(m->start[idx[i]], gs0) + d + scc_len(m->sdf->v) * fabs(T));
+            speed = scc_fmax(speed, T > 0.0 ? d / T : 0.0);
+            if (m->sdf) reach = scc_fmax(reach, scc_dist(m->start[idx[i]], gs0) + d + scc_len(m->sdf->v) * fabs(T));
         }
     }
     if (m->sdf) speed += scc_len(m->sdf->v) + scc_len(m->sdf->w) * reach;
@@ -160,7 +160,7 @@ double scc_tri_accel_bound(const scc_tri_motion* m)
      * apparent acceleration adds Coriolis and centripetal terms: 2 |w_s| |v_rel| + |w_s|^2 |r_s|. */
     double a = 0.0, r = 0.0;
     if (m->kind == SCC_TRI_RIGID) {
-        for (int i = 0; i < 3; ++i) r = fmax(r, scc_dist(m->local[i], m->body->c_local));
+        for (int i = 0; i < 3; ++i) r = scc_fmax(r, scc_dist(m->local[i], m->body->c_local));
         a = scc_len2(m->body->w) * r;
     }
     if (m->sdf) {
@@ -172,7 +172,7 @@ double scc_tri_accel_bound(const scc_tri_motion* m)
             double reach = 0.0;
             for (int i = 0; i < 3; ++i) {
                 scc_vec3 x0 = m->kind == SCC_TRI_RIGID ? scc_xform_apply((scc_xform){ m->body->q0, m->body->p0 }, m->local[i]) : m->start[i];
-                reach = fmax(reach, scc_dist(x0, gs0));
+                reach = scc_fmax(reach, scc_dist(x0, gs0));
             }
             reach += (S + scc_len(m->sdf->v)) * T;
             a += 2.0 * ws * S + ws * ws * reach;

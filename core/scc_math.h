@@ -43,7 +43,21 @@ static inline double scc_hypot3(double x, double y, double z)
     x /= m; y /= m; z /= m;
     return m * sqrt(x * x + y * y + z * z);
 }
-static inline double scc_hypot2(double x, double y) { return scc_hypot3(x, y, 0.0); }
+/* scc_hypot3(x, y, 0) bit for bit, without the third coordinate's work on the common path. */
+static inline double scc_hypot2(double x, double y)
+{
+    double ax = fabs(x), ay = fabs(y);
+    double m = ax > ay ? ax : ay;
+    if (m <= 1e150 && m >= 1e-150) {
+        double s = x * x + y * y; /* + 0 * 0 in scc_hypot3: the same value (s is not -0) */
+        if (s >= 1e-300) return sqrt(s);
+    }
+    return scc_hypot3(x, y, 0.0);
+}
+/* fmin and fmax as the C library's (x86-64 glibc: minsd / maxsd, the other operand for a NaN, the
+ * second operand when equal, e.g. -0 and +0), inline instead of a call. */
+static inline double scc_fmin(double a, double b) { return a < b ? a : (b == b ? b : a); }
+static inline double scc_fmax(double a, double b) { return a > b ? a : (b == b ? b : a); }
 static inline double scc_len_safe(scc_vec3 a) { return scc_hypot3(a.x, a.y, a.z); }
 static inline scc_vec3 scc_lerp(scc_vec3 a, scc_vec3 b, double t) { return scc_madd(a, scc_sub(b, a), t); }
 static inline scc_vec3 scc_mul(scc_vec3 a, scc_vec3 b) { return scc_v3(a.x * b.x, a.y * b.y, a.z * b.z); }

@@ -45,6 +45,10 @@ struct scc_sdf {
      * phi(x) >= phi(c) + grad(c) . (x - c), which the certified TOI uses. 0 when unknown. */
     int convex;
     scc_sdf_convex_fn* convex_in; /* may be NULL */
+    /* 1 when the gradient is continuous outside the surface (no edges, corners, tips or seams):
+     * FWGSS then needs neither its kink guard nor the certified check (fwgss.c, certified.c).
+     * 0 when it may jump or is unknown. */
+    int smooth;
     scc_sdf_kind kind;
 };
 

@@ -31,6 +31,8 @@ static void base_init(scc_sdf* b, scc_sdf_eval_fn* fn, scc_sdf_kind kind, scc_aa
     /* The signed distance of a convex shape is a convex function. */
     b->convex = kind == SCC_SDF_SPHERE || kind == SCC_SDF_BOX || kind == SCC_SDF_ROUNDED_BOX || kind == SCC_SDF_CAPSULE ||
                 kind == SCC_SDF_CYLINDER || kind == SCC_SDF_HALF_SPACE;
+    b->smooth = kind == SCC_SDF_SPHERE || kind == SCC_SDF_TORUS || kind == SCC_SDF_CAPSULE || kind == SCC_SDF_ROUNDED_BOX ||
+                kind == SCC_SDF_HALF_SPACE;
 }
 
 
@@ -196,11 +198,49 @@ static double spike_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
     return best;
 }
 
+/* phi is the distance to the union of convex pieces (the ground slab and the cones), their minimum:
+ * it is convex on a box where one piece is nearer than every other at every point (ours). With c the
+ * box's centre and h its half-diagonal, each piece's distance changes by at most h over the box, so
+ * piece k decides the whole box when d_k(c) + h < d_j(c) - h for every other piece j: the ground and
+ * the cones of the 3 x 3 cells about c's (clamped) cell, tested here; every other cone's axis is at
+ * least 1.5 spacings away horizontally, so it is at least 1.5 spacing - base radius away. */
+static int spike_grid_convex_in(const scc_sdf* self, const scc_aabb* box)
+{
+    const scc_sdf_spike_grid* s = (const scc_sdf_spike_grid*)self;
+    const scc_vec3 c = scc_scale(scc_add(box->lo, box->hi), 0.5);
+    const double h = 0.5 * scc_dist(box->lo, box->hi);
+    if (!(h < 0.25 * s->spacing) || !scc_vfinite(c)) return 0;
+    double best = c.z, second = 1.5 * s->spacing - s->base_radius; /* the ground; the far cones' bound */
+    int ci = (int)lround(scc_clamp((c.x - s->x0) / s->spacing, -1.0, (double)s->count_x));
+    int cj = (int)lround(scc_clamp((c.y - s->y0) / s->spacing, -1.0, (double)s->count_y));
+    ci = ci < 0 ? 0 : (ci >= s->count_x ? s->count_x - 1 : ci);
+    cj = cj < 0 ? 0 : (cj >= s->count_y ? s->count_y - 1 : cj);
+    for (int j = cj - 1; j <= cj + 1; ++j) {
+        if (j < 0 || j >= s->count_y) continue;
+        for (int i = ci - 1; i <= ci + 1; ++i) {
+            if (i < 0 || i >= s->count_x) continue;
+            double grho, gz;
+            const double d = cone_distance2(scc_hypot2(c.x - (s->x0 + i * s->spacing), c.y - (s->y0 + j * s->spacing)), c.z, s->base_radius,
+                                            s->height, &grho, &gz);
+            if (d < best) {
+                second = fmin(second, best);
+                best = d;
+            } else {
+                second = fmin(second, d);
+            }
+        }
+    }
+    /* the margin covers the rounding of the distances (relative 1e-12 of the sizes involved) */
+    const double eps = 1e-12 * (fabs(best) + fabs(second) + s->spacing + s->height);
+    return best + 2.0 * h + eps < second;
+}
+
 void scc_sdf_spike_grid_init(scc_sdf_spike_grid* s, double spacing, double base_radius, double height, int nx, int ny)
 {
     scc_aabb b = box_infinite();
     b.hi.z = height;
     base_init(&s->base, spike_grid_eval, SCC_SDF_SPIKE_GRID, b);
+    s->base.convex_in = spike_grid_convex_in;
     s->spacing = spacing;
     s->base_radius = base_radius;
     s->height = height;

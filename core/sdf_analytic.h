@@ -68,10 +68,12 @@ static inline double scc_sdf_box_value(const scc_sdf_box* s, scc_vec3 p, scc_vec
 static inline double scc_sdf_torus_value(const scc_sdf_torus* s, scc_vec3 p, scc_vec3* g)
 {
     double rho = scc_hypot2(p.x, p.y);
-    double ex = rho > 0.0 ? p.x / rho : 1.0, ey = rho > 0.0 ? p.y / rho : 0.0;
     double qx = rho - s->major, qz = p.z;
     double l = scc_hypot2(qx, qz);
-    if (g) *g = l > 0.0 ? scc_v3(qx / l * ex, qx / l * ey, qz / l) : scc_v3(ex, ey, 0.0);
+    if (g) {
+        double ex = rho > 0.0 ? p.x / rho : 1.0, ey = rho > 0.0 ? p.y / rho : 0.0;
+        *g = l > 0.0 ? scc_v3(qx / l * ex, qx / l * ey, qz / l) : scc_v3(ex, ey, 0.0);
+    }
     return l - s->minor;
 }
 

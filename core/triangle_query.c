@@ -47,7 +47,7 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
             double sa = ta + (tb - ta) * k / segments;
             if (evals >= p->max_evals) {
                 not_converged = 1;
-                unresolved = fmin(unresolved, sa);
+                unresolved = scc_fmin(unresolved, sa);
                 break;
             }
             sp.max_evals = p->max_evals - evals;
@@ -69,7 +69,7 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
             }
             if (seg.state == SCC_NOT_CONVERGED) {
                 not_converged = 1;
-                unresolved = fmin(unresolved, seg.toi_lower);
+                unresolved = scc_fmin(unresolved, seg.toi_lower);
             }
             h = seg;
         }
@@ -79,7 +79,7 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
         }
         /* A certified search stopped by a cap proves nothing after its lower bound, nor does a
          * segment never searched: the bracket's lower end must not claim more. */
-        if (p->method == SCC_METHOD_CERTIFIED) h.toi_lower = fmin(h.toi_lower, unresolved);
+        if (p->method == SCC_METHOD_CERTIFIED) h.toi_lower = scc_fmin(h.toi_lower, unresolved);
     }
 
     int n = 0;

@@ -357,17 +357,21 @@ static void exp_scaling(const options* o)
                 lo[k] = fmin(lo[k], lv[L].v[3 * i + k]);
                 hi[k] = fmax(hi[k], lv[L].v[3 * i + k]);
             }
+        /* SDFCCD_BENCH_SCALING_LEVEL=0|1|2: that mesh size alone (1K, 10K, 100K; a short run for profiling) */
+        if (getenv("SDFCCD_BENCH_SCALING_LEVEL") && L != atoi(getenv("SDFCCD_BENCH_SCALING_LEVEL"))) continue;
         /* the certified bracket of the scene, once */
         sdfccd_QueryParams pc = certified_params();
         fall_result c = fall(spikes, mesh, lo, hi, &pc, ws);
         printf("%u,Certified,1,0,%.4f,%d,%.12g,%.12g,%lld,%lld\n", info.triangle_count, c.total_ms, c.steps, c.toi, c.toi_lower, c.tested, c.evals);
-        struct { const char* name; sdfccd_QueryParams p; } m[4] = {
+        struct { const char* name; sdfccd_QueryParams p; } m[5] = {
             { "DCD", method_params(SDFCCD_METHOD_DCD, 1) },
             { "FWGSS", config_params(CFG_NEW, 1) },
+            { "FWGSS-no-check", config_params(CFG_NEW, 1) },
             { "FWGSS-baseline", config_params(CFG_BASELINE, 1) },
             { "FWGSS-paper", config_params(CFG_PAPER, 1) },
         };
-        int nm = o->baseline ? 4 : 2;
+        m[2].p.fwgss_verify = 0; /* the defaults without the certified check of the answer (the Bullet bridge's setting) */
+        int nm = o->baseline ? 5 : 3;
         for (int bp = 1; bp >= 0; --bp) {
             if (!bp && (L == 2 || o->quick)) continue; /* without the hierarchy 100K takes seconds per repeat */
             int reps = bp ? R : (R > 3 ? 3 : R);
@@ -474,9 +478,10 @@ static void exp_cost(const options* o)
         d.eval = torus_eval;
         d.user = &cb[k];
         d.bounds = (sdfccd_Aabb){ { -0.15, -0.15, -0.05 }, { 0.15, 0.15, 0.05 } };
+        d.smooth = 1; /* as the built-in torus: no kink guard, no certified check */
         CHECK(sdfccd_create_callback_sdf(&d, &sdf[k]));
     }
-    int R = o->quick >= 2 ? 1 : 5;
+    int R = o->quick >= 2 ? 1 : (o->quick ? 5 : 15); /* the fastest of the repeats: more of them find a quieter moment on a shared machine */
     printf("mesh,queries,evals_per_query,ns_per_evaluation,ns_field,ns_motion_solver_dispatch,ns_per_evaluation_builtin_torus\n");
     for (int mesh = 0; mesh < 2; ++mesh) {
         int n = ds.n_per_mesh;
@@ -499,6 +504,47 @@ static void exp_cost(const options* o)
         printf("%s,%d,%.1f,%.1f,%.1f,%.1f,%.1f\n", k_mesh_name[mesh], n, (double)evals / n, per, field, per - field, best[2] * 1e3 / (double)evals);
     }
     for (int k = 0; k < 2; ++k) sdfccd_destroy_sdf(sdf[k]);
+    sdfccd_destroy_workspace(ws);
+    free_dataset(&ds);
+}
+
+/* Every answer of the data set, exactly (hexadecimal floats), for the methods whose results must not
+ * change when the solver's code is made faster: FWGSS (defaults, and with subdivision), FW and DCD.
+ * `diff` two runs to compare builds bit for bit.
+ * SDFCCD_BENCH_MESH=triangle|shuriken restricts it to one mesh and SDFCCD_BENCH_METHOD to one method
+ * (a short run for callgrind; a method name that matches none runs nothing: the loading alone);
+ * SDFCCD_BENCH_REPEAT=N runs the queries N times (the first pass printed; for perf). */
+static void exp_fingerprint(const options* o)
+{
+    dataset ds;
+    build_dataset(o->dataset_dir, &ds, o->quick);
+    const char* only = getenv("SDFCCD_BENCH_MESH");
+    const char* only_method = getenv("SDFCCD_BENCH_METHOD");
+    struct { const char* name; sdfccd_QueryParams p; } m[4] = {
+        { "FWGSS", config_params(CFG_NEW, 0) },
+        { "FWGSS+subdivision", config_params(CFG_NEW, 1) },
+        { "FW", method_params(SDFCCD_METHOD_FW, 0) },
+        { "DCD", method_params(SDFCCD_METHOD_DCD, 0) },
+    };
+    sdfccd_Workspace* ws;
+    CHECK(sdfccd_create_workspace(&ws));
+    sdfccd_Contact out[64];
+    printf("method,id,hit,state,toi,toi_lower,evals,contacts,point,normal,distance\n");
+    const int repeat = getenv("SDFCCD_BENCH_REPEAT") ? atoi(getenv("SDFCCD_BENCH_REPEAT")) : 1;
+    for (int pass = 0; pass < repeat; ++pass)
+    for (int k = 0; k < 4; ++k)
+        for (int i = 0; i < ds.n; ++i) {
+            const bcase* c = &ds.c[i];
+            if ((only && strcmp(only, k_mesh_name[c->mesh]) != 0) || (only_method && strcmp(only_method, m[k].name) != 0)) continue;
+            sdfccd_QueryResult r;
+            CHECK(sdfccd_query_mesh_ws(ws, ds.torus, NULL, ds.mid[c->mesh], &c->m, 0.0, DT, &m[k].p, out, 64, &r));
+            if (pass > 0) continue;
+            const sdfccd_Contact* f = &out[0];
+            printf("%s,%s,%d,%d,%a,%a,%lld,%d,%a %a %a,%a %a %a,%a\n", m[k].name, c->id, r.hit, (int)r.state, r.toi, r.toi_lower,
+                   (long long)r.sdf_evaluations, (int)r.contacts_found, r.hit ? f->point.x : 0.0, r.hit ? f->point.y : 0.0,
+                   r.hit ? f->point.z : 0.0, r.hit ? f->normal.x : 0.0, r.hit ? f->normal.y : 0.0, r.hit ? f->normal.z : 0.0,
+                   r.hit ? f->distance : 0.0);
+        }
     sdfccd_destroy_workspace(ws);
     free_dataset(&ds);
 }
@@ -640,6 +686,7 @@ static const experiment k_experiments[] = {
     { "batch", exp_batch, "the data set as one sdfccd_query_batch on 1 and --threads N threads" },
     { "kinds", exp_kinds, "the data set per SDF kind (issue 20): FWGSS with the kink guard at levels 1 (default), 0 and 2, and FW on every case; --baseline adds the previous and the paper's FWGSS" },
     { "kinds_front", exp_kinds_front, "speed versus accuracy per SDF kind: FWGSS restarts and trace, the paper's caps, FW, DCD, certified" },
+    { "fingerprint", exp_fingerprint, "every answer of the data set in hexadecimal (FWGSS, with subdivision, FW, DCD): diff two builds bit for bit" },
     { "cost", exp_cost, "cost per SDF evaluation in a query: the field and the rest (motion, solver, dispatch), measured differentially" },
 };
 #define N_EXPERIMENTS ((int)(sizeof k_experiments / sizeof k_experiments[0]))

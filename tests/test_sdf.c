@@ -3,6 +3,7 @@
  * gradients; CSG, transforms and uniform scale; the spike grid against a brute-force minimum
  * over all cones; bad parameters. */
 #include <math.h>
+#include <string.h>
 #include "test_util.h"
 
 static double eval(sdfccd_SdfId s, double x, double y, double z, sdfccd_Vec3* g)
@@ -287,6 +288,71 @@ START_TEST(test_callback)
 }
 END_TEST
 
+/* A callback declared smooth (sdfccd_CallbackSdfDef.smooth) is queried as the built-in smooth field
+ * it evaluates: the built-in torus wrapped in a callback gives FWGSS's answers and evaluation counts
+ * of the built-in torus bit for bit when declared smooth (no kink guard, no certified check), and
+ * more evaluations when not. */
+static double wrapped_builtin(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
+{
+    double v = NAN;
+    sdfccd_sdf_eval(*(const sdfccd_SdfId*)user, p, &v, g);
+    return v;
+}
+START_TEST(test_callback_smooth)
+{
+    sdfccd_SdfId torus, cb[2];
+    ck_assert_int_eq(sdfccd_create_torus(0.1, 0.05, &torus), SDFCCD_OK);
+    for (int k = 0; k < 2; ++k) {
+        sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
+        ck_assert_int_eq(def.smooth, 0);
+        def.eval = wrapped_builtin;
+        def.user = &torus;
+        def.smooth = k;
+        ck_assert_int_eq(sdfccd_create_callback_sdf(&def, &cb[k]), SDFCCD_OK);
+        def.smooth = 2;
+        sdfccd_SdfId bad;
+        ck_assert_int_eq(sdfccd_create_callback_sdf(&def, &bad), SDFCCD_INVALID_ARGUMENT);
+    }
+    const sdfccd_Vec3 tri[3] = { { -0.05, -0.03, 0 }, { 0.05, -0.03, 0 }, { 0, 0.06, 0 } };
+    const sdfccd_QueryParams p = sdfccd_default_query_params();
+    test_rng rng = { 2026 };
+    int hits = 0;
+    long long evals[3] = { 0, 0, 0 };
+    for (int i = 0; i < 24; ++i) {
+        /* from 25-35 cm out, aimed within 8 cm of the ring, arriving in about half a step, spinning */
+        sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+        sdfccd_Vec3 dir = test_rng_unit_vector(&rng), aim = test_rng_unit_vector(&rng);
+        double dist = test_rng_uniform(&rng, 0.25, 0.35), a = test_rng_uniform(&rng, 0.0, 2.0 * 3.14159265358979);
+        sdfccd_Vec3 target = { 0.1 * cos(a) + 0.08 * aim.x, 0.1 * sin(a) + 0.08 * aim.y, 0.08 * aim.z };
+        m.pose.position = (sdfccd_Vec3){ target.x + dist * dir.x, target.y + dist * dir.y, target.z + dist * dir.z };
+        double speed = dist / (test_rng_uniform(&rng, 0.6, 1.2) / 60.0);
+        m.linear_velocity = (sdfccd_Vec3){ -speed * dir.x, -speed * dir.y, -speed * dir.z };
+        sdfccd_Vec3 w = test_rng_unit_vector(&rng);
+        double wl = test_rng_uniform(&rng, 0.0, 100.0);
+        m.angular_velocity = (sdfccd_Vec3){ wl * w.x, wl * w.y, wl * w.z };
+        sdfccd_QueryResult r[3];
+        sdfccd_Contact c[3][8];
+        const sdfccd_SdfId f[3] = { torus, cb[1], cb[0] };
+        for (int k = 0; k < 3; ++k) {
+            ck_assert_int_eq(sdfccd_query_triangle(f[k], NULL, tri, &m, 0.0, 1.0 / 60.0, &p, c[k], 8, &r[k]), SDFCCD_OK);
+            evals[k] += r[k].sdf_evaluations;
+        }
+        ck_assert_int_eq(r[1].hit, r[0].hit);
+        ck_assert_int_eq(r[1].state, r[0].state);
+        ck_assert(r[1].toi == r[0].toi);
+        ck_assert_int_eq(r[1].sdf_evaluations, r[0].sdf_evaluations);
+        if (r[0].hit) {
+            ck_assert(memcmp(&c[1][0], &c[0][0], sizeof c[0][0]) == 0);
+            ++hits;
+        }
+    }
+    ck_assert_msg(hits >= 8, "only %d of 24 paths hit the torus", hits);
+    ck_assert_msg(evals[2] > evals[0], "not declared smooth: %lld evaluations, the built-in %lld (the guard should run)", evals[2], evals[0]);
+    for (int k = 0; k < 2; ++k) sdfccd_destroy_sdf(cb[k]);
+    sdfccd_destroy_sdf(torus);
+}
+END_TEST
+
 START_TEST(test_bad_parameters)
 {
     sdfccd_SdfId s;
@@ -329,6 +395,7 @@ int main(void)
     tcase_add_test(tc, test_spike_grid);
     tcase_add_test(tc, test_csg_and_transform);
     tcase_add_test(tc, test_callback);
+    tcase_add_test(tc, test_callback_smooth);
     tcase_add_test(tc, test_bad_parameters);
     tcase_add_test(tc, test_eval_batch_matches_eval);
     suite_add_tcase(s, tc);

@@ -252,6 +252,41 @@ START_TEST(test_dcd_box_separated)
 }
 END_TEST
 
+/* The spike grid's convexity claim (scc_sdf.convex_in, which the certified bound relies on): on every
+ * random box it accepts, phi lies above its tangent plane at the box's centre and below its chords
+ * (sampled); it accepts boxes about single cones and the ground and rejects boxes across the seams
+ * between them. Accepting every small box fails the first check (seams between cones). */
+START_TEST(test_spike_grid_convex_in)
+{
+    scc_sdf_spike_grid sg;
+    scc_sdf_spike_grid_init(&sg, 0.1, 0.05, 0.1, 20, 20);
+    const scc_sdf* f = &sg.base;
+    ck_assert_ptr_nonnull(f->convex_in);
+    test_rng rng = { 77 };
+    int accepted = 0, rejected = 0;
+    for (int n = 0; n < 4000; ++n) {
+        scc_vec3 c = scc_v3(test_rng_uniform(&rng, -1.2, 1.2), test_rng_uniform(&rng, -1.2, 1.2), test_rng_uniform(&rng, -0.03, 0.15));
+        double h = pow(10.0, test_rng_uniform(&rng, -5.0, -1.5));
+        scc_aabb box = { scc_sub(c, scc_v3(h, h, h)), scc_add(c, scc_v3(h, h, h)) };
+        if (!scc_sdf_convex_in(f, &box)) {
+            ++rejected;
+            continue;
+        }
+        ++accepted;
+        scc_vec3 g;
+        double pc = scc_sdf_eval(f, c, &g);
+        for (int k = 0; k < 16; ++k) {
+            scc_vec3 x = scc_add(c, scc_v3(test_rng_uniform(&rng, -h, h), test_rng_uniform(&rng, -h, h), test_rng_uniform(&rng, -h, h)));
+            scc_vec3 y = scc_add(c, scc_v3(test_rng_uniform(&rng, -h, h), test_rng_uniform(&rng, -h, h), test_rng_uniform(&rng, -h, h)));
+            double px = scc_sdf_eval(f, x, NULL), py = scc_sdf_eval(f, y, NULL), pm = scc_sdf_eval(f, scc_scale(scc_add(x, y), 0.5), NULL);
+            ck_assert_msg(px >= pc + scc_dot(g, scc_sub(x, c)) - 1e-12, "below the tangent plane: box at (%g, %g, %g), half size %g", c.x, c.y, c.z, h);
+            ck_assert_msg(pm <= 0.5 * (px + py) + 1e-12, "above a chord: box at (%g, %g, %g), half size %g", c.x, c.y, c.z, h);
+        }
+    }
+    ck_assert_msg(accepted >= 1000 && rejected >= 200, "accepted %d, rejected %d of 4000 boxes", accepted, rejected);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("solvers");
@@ -267,6 +302,7 @@ int main(void)
     tcase_add_test(d, test_dcd_face_interior);
     tcase_add_test(d, test_dcd_edge_interior);
     tcase_add_test(d, test_dcd_box_separated);
+    tcase_add_test(d, test_spike_grid_convex_in);
     suite_add_tcase(s, d);
     return test_run_suite(s);
 }

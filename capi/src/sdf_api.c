@@ -227,6 +227,8 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
     if (isnan(def->bounds.lo.x) || isnan(def->bounds.lo.y) || isnan(def->bounds.lo.z) || isnan(def->bounds.hi.x) ||
         isnan(def->bounds.hi.y) || isnan(def->bounds.hi.z))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: bounds contain NaN");
+    if (def->smooth != 0 && def->smooth != 1)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: smooth must be 0 or 1 (got %d)", (int)def->smooth);
     sdfccd__sdf* s = new_shape(sizeof(callback_sdf), "a callback SDF");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
     callback_sdf* c = s->storage;
@@ -238,6 +240,7 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
     c->base.lipschitz = def->lipschitz;
     c->base.convex = 0;
     c->base.convex_in = NULL;
+    c->base.smooth = def->smooth;
     c->base.kind = SCC_SDF_CALLBACK;
     c->fn = def->eval;
     c->user = def->user;

@@ -439,18 +439,20 @@ class _PyCallback:
             return math.nan
 
 
-def callback(fn, lipschitz=1.0, bounds=None, gradient_step=1e-6):
+def callback(fn, lipschitz=1.0, bounds=None, gradient_step=1e-6, smooth=False):
     """An SDF evaluated by the Python callable ``fn(p) -> phi`` or ``-> (phi, gradient)`` for a point
     p (numpy (3,)). Without a gradient it is taken by central differences (6 more calls). Slow: a
     few microseconds of Python per evaluation; the library calls it from its own threads too (with
     the GIL). If ``fn`` raises, the calls that evaluated it raise :class:`CallbackError` from that
-    exception, and the SDF keeps failing. ``bounds`` = (lo, hi) contains every point with phi <= 0."""
+    exception, and the SDF keeps failing. ``bounds`` = (lo, hi) contains every point with phi <= 0.
+    ``smooth``: the gradient is continuous outside the surface (sdfccd_CallbackSdfDef.smooth)."""
     if not callable(fn):
         raise TypeError("fn: expected a callable")
     cb = _PyCallback(fn, _scalar(gradient_step, "gradient_step"))
     d = _L.sdfccd_default_callback_sdf_def()
     d.eval = cb.thunk
     d.lipschitz = _scalar(lipschitz, "lipschitz")
+    d.smooth = 1 if smooth else 0
     if bounds is not None:
         lo, hi = bounds
         d.bounds.lo[:] = _float_array(lo, "bounds[0]", (3,))

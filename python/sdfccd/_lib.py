@@ -134,6 +134,7 @@ class CallbackSdfDef(C.Structure):
         ("user", C.c_void_p),
         ("lipschitz", C.c_double),
         ("bounds", Aabb),
+        ("smooth", C.c_int32),
         ("internal_value", C.c_int32),
     ]
 

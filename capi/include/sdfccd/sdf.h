@@ -99,9 +99,18 @@ typedef struct sdfccd_CallbackSdfDef {
     void* user;              /**< Passed to `eval`. */
     double lipschitz;        /**< Bound on |grad phi| everywhere (> 0). */
     sdfccd_Aabb bounds;      /**< Contains every point with phi <= 0 (+-INFINITY if unbounded). */
+    /** 1: phi is smooth outside the surface, i.e. its gradient is continuous there (no edges,
+     * corners, cone tips or CSG seams; a sphere, a torus, a capsule, a rounded box are). FWGSS then
+     * skips what it does against gradient jumps (sdfccd_QueryParams::fwgss_kink_guard's extra
+     * descents and sdfccd_QueryParams::fwgss_verify's certified check), as it does for the built-in
+     * smooth shapes: a torus given as a callback takes about 150 SDF evaluations per triangle query
+     * instead of about 570. Declaring a field with kinks smooth can make FWGSS answer late or miss
+     * where the gradient jumps. 0 (default): not known to be smooth, checked. Other values:
+     * ::SDFCCD_INVALID_ARGUMENT. */
+    int32_t smooth;
     int32_t internal_value; /**< Set by sdfccd_default_callback_sdf_def(); do not change. */
 } sdfccd_CallbackSdfDef;
-/** Defaults: eval NULL (must be set), user NULL, lipschitz 1, infinite bounds. */
+/** Defaults: eval NULL (must be set), user NULL, lipschitz 1, infinite bounds, smooth 0. */
 SDFCCD_API sdfccd_CallbackSdfDef sdfccd_default_callback_sdf_def(void);
 /** Creates a user SDF. The library does not check that `eval` keeps `lipschitz`. */
 SDFCCD_API sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfccd_SdfId* out_sdf);
