@@ -88,6 +88,35 @@ double scc_mesh_speed_bound(const scc_mesh_motion* mm)
     return speed;
 }
 
+scc_vertex_trace* scc_mesh_traces(scc_workspace* ws, const scc_mesh* mesh)
+{
+    /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
+    size_t need = (size_t)mesh->vertex_count * sizeof(scc_vertex_trace);
+    int fresh = ws->slot[SCC_WS_TRACES].bytes < need;
+    scc_vertex_trace* traces = scc_ws_get(ws, SCC_WS_TRACES, need);
+    if (!traces) return NULL;
+    if (fresh || ++ws->trace_epoch == 0) {
+        memset(traces, 0, ws->slot[SCC_WS_TRACES].bytes);
+        ws->trace_epoch = 1;
+    }
+    return traces;
+}
+
+void scc_triangle_traces(scc_vertex_trace* traces, const scc_mesh* mesh, uint32_t t, uint32_t epoch, scc_vertex_trace* out[3])
+{
+    const uint32_t* f = mesh->indices + 3 * t;
+    for (int i = 0; i < 3; ++i) {
+        scc_vertex_trace* r = &traces[f[i]];
+        if (r->epoch != epoch) {
+            r->epoch = epoch;
+            r->speed = -1.0;
+            r->from = r->to = 0.0;
+            r->hit_t = r->hit_phi = INFINITY;
+        }
+        out[i] = r;
+    }
+}
+
 typedef struct mesh_ctx {
     scc_mesh_query_in in;        /* the query's inputs, handed to the broad phase as they are */
     contact_buf buf;
@@ -129,19 +158,7 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
     double tb = fmin(mm->t1, c->best + p->toi_window);
     scc_tri_motion m;
     scc_mesh_triangle_motion(mm, t, &m);
-    if (c->traces) {
-        const uint32_t* f = mm->mesh->indices + 3 * t;
-        for (int i = 0; i < 3; ++i) {
-            scc_vertex_trace* r = &c->traces[f[i]];
-            if (r->epoch != c->in.ws->trace_epoch) {
-                r->epoch = c->in.ws->trace_epoch;
-                r->speed = -1.0;
-                r->from = r->to = 0.0;
-                r->hit_t = r->hit_phi = INFINITY;
-            }
-            m.trace[i] = r;
-        }
-    }
+    if (c->traces) scc_triangle_traces(c->traces, mm->mesh, t, c->in.ws->trace_epoch, m.trace);
     scc_query_summary s;
     if (c->probe) c->probe(c->probe_user, t, 1);
     if (!(ta < tb)) ta = mm->t0;
@@ -298,17 +315,9 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     c.traces = NULL;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
     int ok = 1;
-    if (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0 && mm->mesh->vertex_count > 0 && !mm->tri_margin) {
-        /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
-        size_t need = (size_t)mm->mesh->vertex_count * sizeof *c.traces;
-        int fresh = ws->slot[SCC_WS_TRACES].bytes < need;
-        c.traces = scc_ws_get(ws, SCC_WS_TRACES, need);
-        if (!c.traces) ok = 0;
-        else if (fresh || ++ws->trace_epoch == 0) {
-            memset(c.traces, 0, ws->slot[SCC_WS_TRACES].bytes);
-            ws->trace_epoch = 1;
-        }
-    }
+    /* FWGSS's vertex traces; DCD keeps each vertex's value at the tested pose there (scc_dcd_traced) */
+    const int traced = (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0) || p->method == SCC_METHOD_DCD;
+    if (traced && mm->mesh->vertex_count > 0 && !mm->tri_margin && !(c.traces = scc_mesh_traces(ws, mm->mesh))) ok = 0;
     if (!ok) {
     } else if (p->broad_phase && mm->mesh->triangle_count > 0) {
         ok = run_broad_phase(&c);
