@@ -295,6 +295,10 @@ bool touching(const sdfccd_QueryResult& r, const sdfccd_Contact* c, int n, doubl
     return false;
 }
 
+// The end-pose query runs unless the step's travel is within the guarantee's tolerance: the end
+// pose's features are then the start pose's (within the reach of its query), moved by at most that.
+bool endQuery(const PairPlan& P, const Config& cfg) { return !(P.continuous && cfg.guard_tolerance > 0 && P.travel <= cfg.guard_tolerance); }
+
 // Room given to a batched query's contacts (a query that finds more is run again in the narrow
 // phase with room for all, as an unbatched one is).
 const int32_t kBatchCapacity = 256;
@@ -399,12 +403,13 @@ void BridgeImpl::prefetch(double dt, double margin)
         if (c.status != SDFCCD_OK) continue;
         if (culled(c.result) || faceSearch(items[k].P)) continue;
         const int n = std::min(c.result.contact_count, kBatchCapacity);
-        (touching(c.result, c.contacts.data(), n, items[k].P.margin) ? end : ccd).push_back(k);
+        if (!touching(c.result, c.contacts.data(), n, items[k].P.margin)) ccd.push_back(k);
+        else if (endQuery(items[k].P, cfg)) end.push_back(k);
     }
     runStage(ccd, kStageCcd);
     for (size_t k : ccd) {
         const CachedQuery& c = batch_cache[PairStageKey{ items[k].mo, items[k].so, kStageCcd }];
-        if (c.status == SDFCCD_OK && c.result.hit) end.push_back(k);
+        if (c.status == SDFCCD_OK && c.result.hit && endQuery(items[k].P, cfg)) end.push_back(k);
     }
     std::sort(end.begin(), end.end());
     runStage(end, kStageEnd);
@@ -583,7 +588,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
                                               : start_margin;
         if (start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, accept);
         sdfccd_QueryResult r1;
-        if (discrete(contacts, G.M.t1, G.S.t1, margin, &r1, kStageEnd) && r1.hit) G.addPose(contacts.data(), r1.contact_count, G.M.t1, G.S.t1, margin);
+        if (endQuery(P, cfg) && discrete(contacts, G.M.t1, G.S.t1, margin, &r1, kStageEnd) && r1.hit) G.addPose(contacts.data(), r1.contact_count, G.M.t1, G.S.t1, margin);
     }
     return finish();
 }
