@@ -80,14 +80,15 @@ struct Gatherer {
         c.speculative = c.d > margin;
         out->push_back(c);
     }
-    // The material point constrained by its own closest surface point at the START of the step.
-    void addFromStart(const btVector3& local, int tri)
+    // The material point constrained by its own closest surface point at the START of the step
+    // (none when it is farther than `accept` there).
+    void addFromStart(const btVector3& local, int tri, double accept = HUGE_VAL)
     {
         const btVector3 q = S.t0.invXform(M.t0 * local);
         double phi = 0;
         sdfccd_Vec3 g;
         ++evals;
-        if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !std::isfinite(phi)) return;
+        if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !std::isfinite(phi) || !(phi <= accept)) return;
         btVector3 nL = bt(g);
         const btScalar len = nL.length();
         if (!(len > btScalar(0))) return;
@@ -100,6 +101,7 @@ struct Gatherer {
     {
         std::vector<uint32_t>& ts = w->pose_tris;
         ts.clear();
+        const bool at_start = Mx == M.t0 && Sx == S.t0;
         for (int i = 0; i < count; ++i) {
             addFromStart(Mx.invXform(bt(cs[i].point)), (int)cs[i].triangle);
             if (cs[i].triangle < me->indices.size() / 3) ts.push_back(cs[i].triangle);
@@ -113,6 +115,10 @@ struct Gatherer {
             if (i > 0 && vt[i].first == vt[i - 1].first) continue;
             const double* v = &me->vertices[3 * (size_t)vt[i].first];
             const btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
+            if (at_start) { // one evaluation: the test within `accept` and the start's closest point
+                addFromStart(local, (int)vt[i].second, accept);
+                continue;
+            }
             double phi = 0;
             ++evals;
             if (sdfccd_sdf_eval(sdf, v3(Sx.invXform(Mx * local)), &phi, nullptr) != SDFCCD_OK || !(phi <= accept)) continue;
