@@ -493,6 +493,8 @@ typedef struct cert_ctx {
     scc_quat q;
     scc_vec3 p;                            /* the pose at tm */
     uint8_t* clear;
+    scc_workspace* ws;       /* vertex records for the leaves' DCD (NULL: none) */
+    scc_vertex_trace* traces;
     int64_t evals, left;
 } cert_ctx;
 
@@ -504,7 +506,7 @@ static int leaf_clear(cert_ctx* c, const scc_tri_motion* m, double ta, double tb
 {
     scc_tri_state st;
     scc_tri_state_at(m, 0.5 * (ta + tb), &st);
-    scc_dcd_result d = scc_dcd(c->sdf, st.x, c->dcd);
+    scc_dcd_result d = scc_dcd_traced(c->sdf, st.x, m->trace, st.t, c->dcd);
     c->evals += d.evals;
     if (d.phi - c->lipschitz * half_path > c->level) return 1;
     if (splits <= 0 || !(d.phi > c->level)) return 0;
@@ -523,6 +525,7 @@ static void certify_node(cert_ctx* c, uint32_t i)
     if (!(low > c->level) && n->is_leaf && c->dcd) {
         scc_tri_motion m;
         scc_mesh_triangle_motion(mm, n->first, &m);
+        if (c->traces) scc_triangle_traces(c->traces, mm->mesh, n->first, c->ws->trace_epoch, m.trace);
         if (leaf_clear(c, &m, mm->t0, mm->t1, half_path, CERT_TIME_SPLITS)) low = INFINITY;
     }
     if (low > c->level) { /* NaN fails */
@@ -539,7 +542,7 @@ static void certify_node(cert_ctx* c, uint32_t i)
 }
 
 int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, const scc_params* dcd,
-                        uint8_t* clear, int64_t* io_evals)
+                        uint8_t* clear, scc_workspace* ws, int64_t* io_evals)
 {
     if (!bsh || !bsh->node_count || !mm->body) return -1;
     if (mm->sdf && (scc_len2(mm->sdf->v) > 0.0 || scc_len2(mm->sdf->w) > 0.0)) return -1; /* a moving SDF frame */
@@ -557,6 +560,8 @@ int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc
     c.tm = 0.5 * (mm->t0 + mm->t1);
     scc_rigid_pose_at(mm->body, c.tm, &c.q, &c.p);
     c.clear = clear;
+    c.ws = ws;
+    c.traces = ws && dcd && mm->mesh->vertex_count > 0 ? scc_mesh_traces(ws, mm->mesh) : NULL; /* (none: evaluated per leaf) */
     c.evals = 0;
     c.left = 0;
     certify_node(&c, 0);

@@ -106,8 +106,9 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
  * for each node so proven, whose subtree is then skipped, and 0 for the others; returns the number
  * of leaves not proven clear (the triangles the CCD must still check), or -1 when the motion is not
  * one it applies to (nothing written). Adds its SDF evaluations (one per node, plus the DCDs) to
- * *io_evals. */
+ * *io_evals. `ws` (may be NULL) holds vertex records (scc_mesh_traces) so that the leaves' DCDs at
+ * the middle time evaluate each vertex once. */
 int64_t scc_bsh_certify(const scc_bsh* bsh, const scc_mesh_motion* mm, const scc_sdf* sdf, double level, const scc_params* dcd,
-                        uint8_t* clear, int64_t* io_evals);
+                        uint8_t* clear, scc_workspace* ws, int64_t* io_evals);
 
 #endif

@@ -81,6 +81,11 @@ typedef struct scc_dcd_result {
     int iterations, evals, converged;
 } scc_dcd_result;
 scc_dcd_result scc_dcd(const scc_sdf* sdf, const scc_vec3 tri[3], const scc_params* p);
+/* The same with the vertices' values shared between the triangles of one mesh query (the same
+ * answer, fewer evaluations): rec[i] (NULL, or rec NULL: none) is vertex i's record, fresh for the
+ * query (hit_t INFINITY) or holding phi at the pose of time t (hit_t == t, hit_phi); a fresh record
+ * is filled. The tri[] of every triangle at time t must come from the same pose computation. */
+scc_dcd_result scc_dcd_traced(const scc_sdf* sdf, const scc_vec3 tri[3], scc_vertex_trace* const rec[3], double t, const scc_params* p);
 
 /* ---- CCD on one interval [ta, tb] with at most max_rotation of rotation ---- */
 void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out);
@@ -176,6 +181,11 @@ int scc_query_mesh(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
 double scc_mesh_speed_bound(const scc_mesh_motion* mm);
 /* The motion of triangle t of the mesh motion `mm` (what the mesh query tests per triangle). */
 void scc_mesh_triangle_motion(const scc_mesh_motion* mm, uint32_t t, scc_tri_motion* out);
+/* One vertex record per mesh vertex in `ws` (SCC_WS_TRACES) under a new epoch (ws->trace_epoch):
+ * every record stale until handed out. NULL when out of memory. */
+scc_vertex_trace* scc_mesh_traces(scc_workspace* ws, const scc_mesh* mesh);
+/* The records of triangle t's vertices, made fresh (empty) where they are stale for `epoch`. */
+void scc_triangle_traces(scc_vertex_trace* traces, const scc_mesh* mesh, uint32_t t, uint32_t epoch, scc_vertex_trace* out[3]);
 /* The same with the scratch storage in a caller-kept workspace (workspace.h): after a first query
  * of a given size, later ones allocate nothing. */
 int scc_query_mesh_ws(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, scc_workspace* ws, scc_contact* out,

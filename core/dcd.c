@@ -17,16 +17,14 @@ static double segment_phi(double l, void* c)
     return scc_sdf_eval(s->sdf, scc_lerp(s->a, s->b, l), NULL);
 }
 
-scc_dcd_result scc_dcd(const scc_sdf* sdf, const scc_vec3 tri[3], const scc_params* p)
+/* The search from the vertex values phi[3] (`evals` of them evaluated here). */
+static scc_dcd_result dcd_from(const scc_sdf* sdf, const scc_vec3 tri[3], const double phi[3], int evals, const scc_params* p)
 {
     scc_dcd_result r;
-    double phi[3];
     int best = 0;
-    for (int i = 0; i < 3; ++i) {
-        phi[i] = scc_sdf_eval(sdf, tri[i], NULL);
+    for (int i = 1; i < 3; ++i)
         if (phi[i] < phi[best]) best = i;
-    }
-    r.evals = 3;
+    r.evals = evals;
     r.iterations = 0;
     r.converged = 0;
     double b[3] = { 0, 0, 0 };
@@ -64,4 +62,31 @@ scc_dcd_result scc_dcd(const scc_sdf* sdf, const scc_vec3 tri[3], const scc_para
     r.normal = g;
     for (int j = 0; j < 3; ++j) r.bary[j] = b[j];
     return r;
+}
+
+scc_dcd_result scc_dcd(const scc_sdf* sdf, const scc_vec3 tri[3], const scc_params* p)
+{
+    double phi[3];
+    for (int i = 0; i < 3; ++i) phi[i] = scc_sdf_eval(sdf, tri[i], NULL);
+    return dcd_from(sdf, tri, phi, 3, p);
+}
+
+scc_dcd_result scc_dcd_traced(const scc_sdf* sdf, const scc_vec3 tri[3], scc_vertex_trace* const rec[3], double t, const scc_params* p)
+{
+    double phi[3];
+    int evals = 0;
+    for (int i = 0; i < 3; ++i) {
+        scc_vertex_trace* r = rec ? rec[i] : NULL;
+        if (r && r->hit_t == t) {
+            phi[i] = r->hit_phi;
+            continue;
+        }
+        phi[i] = scc_sdf_eval(sdf, tri[i], NULL);
+        ++evals;
+        if (r && r->hit_t == INFINITY) {
+            r->hit_t = t;
+            r->hit_phi = phi[i];
+        }
+    }
+    return dcd_from(sdf, tri, phi, evals, p);
 }

@@ -147,6 +147,21 @@ int scc_grid_interpolate(const scc_grid* g, uint32_t field, scc_vec3 p, double* 
 /* Field 0 as an SDF (the scc_sdf eval function): see the header comment for the three cases. */
 double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad);
 
+/* scc_grid_eval at n points (out_g may be NULL): the same numbers, with a dense grid's cell
+ * loads started ahead of the points that need them. */
+void scc_grid_eval_batch(const scc_grid* g, const scc_vec3* p, size_t n, double* out_v, scc_vec3* out_g);
+
+/* x86-64 with GCC or Clang: the direct grids' evaluation also compiled for AVX (no FMA: the same
+ * bits), chosen at finalize when the processor has it (scc_grid_avx). */
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(SCC_CELL_PLAIN_C) && !defined(SCC_GRID_NO_AVX)
+#define SCC_GRID_AVX 1
+double scc_grid_eval_avx(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad);
+#else
+#define SCC_GRID_AVX 0
+#endif
+/* 1 when the AVX evaluation is available and the processor runs it. */
+int scc_grid_avx(void);
+
 /* Bound on |grad phi| of field 0 inside `box` (the scc_sdf lipschitz_in function): the max of
  * the per-cell bounds of the cells the box touches; at least 1 where the box touches a cell
  * without values; 1 + the global bound where the box leaves the domain. */

@@ -351,7 +351,11 @@ static int bernstein_nonnegative(const double v[32], const int lo_face[3], const
  * (phi_q - d continues the inside). */
 static void fill_sdf_interface(scc_grid* g, int boundary_nonneg)
 {
+#if SCC_GRID_AVX
+    g->base.eval = scc_grid_avx() ? scc_grid_eval_avx : scc_grid_eval;
+#else
     g->base.eval = scc_grid_eval;
+#endif
     g->base.lipschitz_in = scc_grid_lipschitz_in;
     g->base.domain.lo = g->lo;
     g->base.domain.hi = g->hi;

@@ -172,7 +172,7 @@ int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_para
         flags = scc_ws_get(ws, SCC_WS_CERTIFIED, bsh->node_count);
         if (!flags) return 0;
         int64_t evals = 0;
-        out->uncertified = scc_bsh_certify(bsh, &run, sdf, -0.5 * tolerance, p, flags, &evals);
+        out->uncertified = scc_bsh_certify(bsh, &run, sdf, -0.5 * tolerance, p, flags, ws, &evals);
         if (out->uncertified == 0) {
             out->evals = evals;
             out->certified = 1;

@@ -88,6 +88,41 @@ double scc_mesh_speed_bound(const scc_mesh_motion* mm)
     return speed;
 }
 
+scc_vertex_trace* scc_mesh_traces(scc_workspace* ws, const scc_mesh* mesh)
+{
+    /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
+    size_t need = (size_t)mesh->vertex_count * sizeof(scc_vertex_trace);
+    int fresh = ws->slot[SCC_WS_TRACES].bytes < need;
+    scc_vertex_trace* traces = scc_ws_get(ws, SCC_WS_TRACES, need);
+    if (!traces) return NULL;
+    if (fresh || ++ws->trace_epoch == 0) {
+        memset(traces, 0, ws->slot[SCC_WS_TRACES].bytes);
+        ws->trace_epoch = 1;
+    }
+    return traces;
+}
+
+void scc_triangle_traces(scc_vertex_trace* traces, const scc_mesh* mesh, uint32_t t, uint32_t epoch, scc_vertex_trace* out[3])
+{
+    const uint32_t* f = mesh->indices + 3 * t;
+    for (int i = 0; i < 3; ++i) {
+        scc_vertex_trace* r = &traces[f[i]];
+        if (r->epoch != epoch) {
+            r->epoch = epoch;
+            r->speed = -1.0;
+            r->from = r->to = 0.0;
+            r->hit_t = r->hit_phi = INFINITY;
+        }
+        out[i] = r;
+    }
+}
+
+/* A vertex at a discrete query's pose, computed once per query (the epoch tells). */
+typedef struct posed_vertex {
+    scc_vec3 x;
+    uint32_t epoch;
+} posed_vertex;
+
 typedef struct mesh_ctx {
     scc_mesh_query_in in;        /* the query's inputs, handed to the broad phase as they are */
     contact_buf buf;
@@ -101,6 +136,9 @@ typedef struct mesh_ctx {
     const scc_bsh_stats* broad;  /* live broad-phase counters (NULL without the broad phase) */
     scc_vertex_trace* traces;    /* one per mesh vertex (FWGSS with the vertex trace), else NULL */
     int budget_exhausted;        /* the evaluation budget ran out before every triangle was tested */
+    posed_vertex* posed;         /* DCD of a rigid mesh against a still SDF: vertices at the pose (else NULL) */
+    scc_quat pose_q;             /* that pose (scc_rigid_pose_at at mm->t1) */
+    scc_vec3 pose_p;
 } mesh_ctx;
 
 /* Evaluations left of the query's budget (narrow phase so far plus the broad phase's marching). */
@@ -129,17 +167,20 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
     double tb = fmin(mm->t1, c->best + p->toi_window);
     scc_tri_motion m;
     scc_mesh_triangle_motion(mm, t, &m);
-    if (c->traces) {
+    if (c->traces) scc_triangle_traces(c->traces, mm->mesh, t, c->in.ws->trace_epoch, m.trace);
+    if (c->posed && tb == mm->t1) {
+        /* The discrete pose as a motion that stays there: the triangle gets the vertices computed for
+         * the query (the numbers scc_tri_state_at gives, without the pose per triangle). */
         const uint32_t* f = mm->mesh->indices + 3 * t;
+        m.kind = SCC_TRI_LINEAR;
+        m.body = NULL;
         for (int i = 0; i < 3; ++i) {
-            scc_vertex_trace* r = &c->traces[f[i]];
-            if (r->epoch != c->in.ws->trace_epoch) {
-                r->epoch = c->in.ws->trace_epoch;
-                r->speed = -1.0;
-                r->from = r->to = 0.0;
-                r->hit_t = r->hit_phi = INFINITY;
+            posed_vertex* v = &c->posed[f[i]];
+            if (v->epoch != c->in.ws->trace_epoch) {
+                v->x = scc_add(scc_quat_rotate(c->pose_q, mm->mesh->vertices[f[i]]), c->pose_p);
+                v->epoch = c->in.ws->trace_epoch;
             }
-            m.trace[i] = r;
+            m.start[i] = m.end[i] = v->x;
         }
     }
     scc_query_summary s;
@@ -298,16 +339,16 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     c.traces = NULL;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
     int ok = 1;
-    if (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0 && mm->mesh->vertex_count > 0 && !mm->tri_margin) {
-        /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
-        size_t need = (size_t)mm->mesh->vertex_count * sizeof *c.traces;
-        int fresh = ws->slot[SCC_WS_TRACES].bytes < need;
-        c.traces = scc_ws_get(ws, SCC_WS_TRACES, need);
-        if (!c.traces) ok = 0;
-        else if (fresh || ++ws->trace_epoch == 0) {
-            memset(c.traces, 0, ws->slot[SCC_WS_TRACES].bytes);
-            ws->trace_epoch = 1;
-        }
+    /* FWGSS's vertex traces; DCD keeps each vertex's value at the tested pose there (scc_dcd_traced) */
+    const int traced = (p->method == SCC_METHOD_FWGSS && p->fwgss_vertex_trace > 0) || p->method == SCC_METHOD_DCD;
+    if (traced && mm->mesh->vertex_count > 0 && !mm->tri_margin && !(c.traces = scc_mesh_traces(ws, mm->mesh))) ok = 0;
+    c.posed = NULL;
+    if (ok && c.traces && p->method == SCC_METHOD_DCD && mm->body && !mm->sdf && mm->t0 == mm->t1) {
+        const size_t need = (size_t)mm->mesh->vertex_count * sizeof *c.posed;
+        const int fresh = ws->slot[SCC_WS_POSED].bytes < need;
+        if (!(c.posed = scc_ws_get(ws, SCC_WS_POSED, need))) ok = 0;
+        else if (fresh || ws->trace_epoch == 1) memset(c.posed, 0, ws->slot[SCC_WS_POSED].bytes); /* epochs start again */
+        scc_rigid_pose_at(mm->body, mm->t1, &c.pose_q, &c.pose_p);
     }
     if (!ok) {
     } else if (p->broad_phase && mm->mesh->triangle_count > 0) {

@@ -21,7 +21,7 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
     if (p->method == SCC_METHOD_DCD) {
         scc_tri_state st;
         scc_tri_state_at(m, tb, &st);
-        scc_dcd_result d = scc_dcd(sdf, st.x, p);
+        scc_dcd_result d = scc_dcd_traced(sdf, st.x, m->trace, tb, p); /* vertex values shared in a mesh query */
         evals += d.evals;
         iterations += d.iterations;
         h.hit = d.phi <= p->margin;

@@ -720,6 +720,54 @@ START_TEST(test_concurrent_eval)
 }
 END_TEST
 
+/* Every evaluation path of a grid gives the bits of the reference scc_grid_eval (SSE2 code): the
+ * evaluator chosen at finalize (the AVX build where the processor has it), the core batch (cell
+ * loads ahead, block reuse) with and without gradients, and the ABI's single and batch calls; on a
+ * dense grid (the direct path) and a narrow band, at points inside and outside the domain, random
+ * and on a walk of small steps (consecutive points in one cell). */
+START_TEST(test_eval_paths_identical)
+{
+    enum { N = 6000 };
+    sdfccd_Vec3* p = malloc(N * sizeof *p);
+    scc_vec3* q = malloc(N * sizeof *q);
+    double *ref = malloc(N * sizeof *ref), *v = malloc(N * sizeof *v), *w = malloc(N * sizeof *w);
+    scc_vec3 *rg = malloc(N * sizeof *rg), *gg = malloc(N * sizeof *gg);
+    sdfccd_Vec3* ag = malloc(N * sizeof *ag);
+    test_rng rng = { 5 };
+    for (int i = 0; i < N; ++i) {
+        if (i < N / 2 || i == 0) /* random, a fifth of them outside the domain */
+            q[i] = scc_v3(test_rng_uniform(&rng, -0.22, 0.22), test_rng_uniform(&rng, -0.22, 0.22), test_rng_uniform(&rng, -0.22, 0.22));
+        else /* a walk of 2 mm steps (cells are 10 mm) */
+            q[i] = scc_add(q[i - 1], scc_v3(test_rng_uniform(&rng, -0.002, 0.002), test_rng_uniform(&rng, -0.002, 0.002),
+                                            test_rng_uniform(&rng, -0.002, 0.002)));
+        p[i] = (sdfccd_Vec3){ q[i].x, q[i].y, q[i].z };
+    }
+    for (int band = 0; band < 2; ++band) {
+        sdfccd_SdfId id = sphere_grid(0.1, 30, 1, band ? 0.02 : 0.0);
+        const scc_grid* g = test_grid_of(id);
+        ck_assert_int_eq(g->direct, !band);
+        ck_assert(g->base.eval == (SCC_GRID_AVX && scc_grid_avx() ? scc_grid_eval_avx : scc_grid_eval));
+        for (int i = 0; i < N; ++i) ref[i] = scc_grid_eval(&g->base, q[i], &rg[i]);
+        for (int i = 0; i < N; ++i) v[i] = g->base.eval(&g->base, q[i], &gg[i]);
+        ck_assert_msg(memcmp(v, ref, N * sizeof *v) == 0 && memcmp(gg, rg, N * sizeof *gg) == 0, "finalize's evaluator (band %d)", band);
+        for (size_t n = 1; n <= N; n = n * 7 + 3) { /* batch lengths 1, 10, 73, 514, 3601 */
+            scc_grid_eval_batch(g, q, n, v, gg);
+            scc_grid_eval_batch(g, q, n, w, NULL);
+            ck_assert_msg(memcmp(v, ref, n * sizeof *v) == 0 && memcmp(gg, rg, n * sizeof *gg) == 0 && memcmp(w, ref, n * sizeof *w) == 0,
+                          "core batch of %zu (band %d)", n, band);
+        }
+        ck_assert_int_eq(sdfccd_sdf_eval_batch(id, p, N, v, ag), SDFCCD_OK);
+        for (int i = 0; i < N; ++i) gg[i] = scc_v3(ag[i].x, ag[i].y, ag[i].z);
+        ck_assert_msg(memcmp(v, ref, N * sizeof *v) == 0 && memcmp(gg, rg, N * sizeof *gg) == 0, "sdfccd_sdf_eval_batch (band %d)", band);
+        for (int i = 0; i < N; ++i) ck_assert_int_eq(sdfccd_sdf_eval(id, p[i], &w[i], &ag[i]), SDFCCD_OK);
+        for (int i = 0; i < N; ++i) gg[i] = scc_v3(ag[i].x, ag[i].y, ag[i].z);
+        ck_assert_msg(memcmp(w, ref, N * sizeof *w) == 0 && memcmp(gg, rg, N * sizeof *gg) == 0, "sdfccd_sdf_eval (band %d)", band);
+        ck_assert_int_eq(sdfccd_destroy_sdf(id), SDFCCD_OK);
+    }
+    free(p); free(q); free(ref); free(v); free(w); free(rg); free(gg); free(ag);
+}
+END_TEST
+
 static double sphere_cb(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 {
     (void)user;
@@ -842,6 +890,7 @@ int main(void)
     tcase_add_test(tc, test_core_band_unknown_lipschitz);
     tcase_add_test(tc, test_band_never_dense);
     tcase_add_test(tc, test_concurrent_eval);
+    tcase_add_test(tc, test_eval_paths_identical);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -457,6 +457,13 @@ double Bridge::timeOfImpact(const btCollisionObject* mesh_body, const btCollisio
     return m_impl->timeOfImpact(mesh_body, sdf_body, dt);
 }
 
+Status Bridge::setBtSdfData(const btSdfCollisionShape* shape, const void* data, size_t size)
+{
+    if (!m_impl->shapes.setBtSdfData(shape, data, size)) return Status::InvalidArgument;
+    m_impl->batch_cache.clear(); // its queries name the shape's old SDF handle
+    return Status::Ok;
+}
+
 void Bridge::invalidateShape(const btCollisionShape* shape)
 {
     m_impl->shapes.invalidate(shape);

@@ -80,14 +80,15 @@ struct Gatherer {
         c.speculative = c.d > margin;
         out->push_back(c);
     }
-    // The material point constrained by its own closest surface point at the START of the step.
-    void addFromStart(const btVector3& local, int tri)
+    // The material point constrained by its own closest surface point at the START of the step
+    // (none when it is farther than `accept` there).
+    void addFromStart(const btVector3& local, int tri, double accept = HUGE_VAL)
     {
         const btVector3 q = S.t0.invXform(M.t0 * local);
         double phi = 0;
         sdfccd_Vec3 g;
         ++evals;
-        if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !std::isfinite(phi)) return;
+        if (sdfccd_sdf_eval(sdf, v3(q), &phi, &g) != SDFCCD_OK || !std::isfinite(phi) || !(phi <= accept)) return;
         btVector3 nL = bt(g);
         const btScalar len = nL.length();
         if (!(len > btScalar(0))) return;
@@ -100,6 +101,7 @@ struct Gatherer {
     {
         std::vector<uint32_t>& ts = w->pose_tris;
         ts.clear();
+        const bool at_start = Mx == M.t0 && Sx == S.t0;
         for (int i = 0; i < count; ++i) {
             addFromStart(Mx.invXform(bt(cs[i].point)), (int)cs[i].triangle);
             if (cs[i].triangle < me->indices.size() / 3) ts.push_back(cs[i].triangle);
@@ -113,6 +115,10 @@ struct Gatherer {
             if (i > 0 && vt[i].first == vt[i - 1].first) continue;
             const double* v = &me->vertices[3 * (size_t)vt[i].first];
             const btVector3 local((btScalar)v[0], (btScalar)v[1], (btScalar)v[2]);
+            if (at_start) { // one evaluation: the test within `accept` and the start's closest point
+                addFromStart(local, (int)vt[i].second, accept);
+                continue;
+            }
             double phi = 0;
             ++evals;
             if (sdfccd_sdf_eval(sdf, v3(Sx.invXform(Mx * local)), &phi, nullptr) != SDFCCD_OK || !(phi <= accept)) continue;
@@ -295,6 +301,10 @@ bool touching(const sdfccd_QueryResult& r, const sdfccd_Contact* c, int n, doubl
     return false;
 }
 
+// The end-pose query runs unless the step's travel is within the guarantee's tolerance: the end
+// pose's features are then the start pose's (within the reach of its query), moved by at most that.
+bool endQuery(const PairPlan& P, const Config& cfg) { return !(P.continuous && cfg.guard_tolerance > 0 && P.travel <= cfg.guard_tolerance); }
+
 // Room given to a batched query's contacts (a query that finds more is run again in the narrow
 // phase with room for all, as an unbatched one is).
 const int32_t kBatchCapacity = 256;
@@ -399,12 +409,13 @@ void BridgeImpl::prefetch(double dt, double margin)
         if (c.status != SDFCCD_OK) continue;
         if (culled(c.result) || faceSearch(items[k].P)) continue;
         const int n = std::min(c.result.contact_count, kBatchCapacity);
-        (touching(c.result, c.contacts.data(), n, items[k].P.margin) ? end : ccd).push_back(k);
+        if (!touching(c.result, c.contacts.data(), n, items[k].P.margin)) ccd.push_back(k);
+        else if (endQuery(items[k].P, cfg)) end.push_back(k);
     }
     runStage(ccd, kStageCcd);
     for (size_t k : ccd) {
         const CachedQuery& c = batch_cache[PairStageKey{ items[k].mo, items[k].so, kStageCcd }];
-        if (c.status == SDFCCD_OK && c.result.hit) end.push_back(k);
+        if (c.status == SDFCCD_OK && c.result.hit && endQuery(items[k].P, cfg)) end.push_back(k);
     }
     std::sort(end.begin(), end.end());
     runStage(end, kStageEnd);
@@ -583,7 +594,7 @@ bool BridgeImpl::gather(const btCollisionObjectWrapper* mw, const btCollisionObj
                                               : start_margin;
         if (start_ok && r0.hit) G.addPose(start_contacts.data(), r0.contact_count, G.M.t0, G.S.t0, accept);
         sdfccd_QueryResult r1;
-        if (discrete(contacts, G.M.t1, G.S.t1, margin, &r1, kStageEnd) && r1.hit) G.addPose(contacts.data(), r1.contact_count, G.M.t1, G.S.t1, margin);
+        if (endQuery(P, cfg) && discrete(contacts, G.M.t1, G.S.t1, margin, &r1, kStageEnd) && r1.hit) G.addPose(contacts.data(), r1.contact_count, G.M.t1, G.S.t1, margin);
     }
     return finish();
 }

@@ -80,6 +80,8 @@ public:
     const MeshEntry* meshFor(const btCollisionShape* shape);
     /** The SDF handle of an SdfShape (with its scaling) or of a btSdfCollisionShape. Null otherwise. */
     sdfccd_SdfId sdfFor(const btCollisionShape* shape, int sdf_shape_type, bool bt_sdf);
+    /** Bridge::setBtSdfData: the shape's field from sdfccd's grid of its .cdf bytes. */
+    bool setBtSdfData(const btSdfCollisionShape* shape, const void* data, size_t size);
     void invalidate(const btCollisionShape* shape);
 
 private:

@@ -292,6 +292,35 @@ sdfccd_SdfId ShapeCache::btSdfFor(const btSdfCollisionShape* shape)
     return e.id;
 }
 
+bool ShapeCache::setBtSdfData(const btSdfCollisionShape* shape, const void* data, size_t size)
+{
+    sdfccd_SdfId grid;
+    if (!shape || !data || sdfccd_load_grid_memory(data, size, &grid) != SDFCCD_OK) return false;
+    // The same field as the shape's (queryPoint) at 125 points of its domain, to the float build's precision.
+    btTransform id;
+    id.setIdentity();
+    btVector3 lo, hi;
+    shape->getAabb(id, lo, hi);
+    const double tol = 1e-5 * (double)(hi - lo).length();
+    bool same = true;
+    for (int k = 0; k < 125 && same; ++k) {
+        const btVector3 f((btScalar)(0.1 + 0.2 * (k % 5)), (btScalar)(0.1 + 0.2 * (k / 5 % 5)), (btScalar)(0.1 + 0.2 * (k / 25)));
+        const btVector3 x = lo + (hi - lo) * f;
+        btScalar theirs = 0;
+        btVector3 n;
+        double ours = 0;
+        if (const_cast<btSdfCollisionShape*>(shape)->queryPoint(x, theirs, n))
+            same = sdfccd_sdf_eval(grid, v3(x), &ours, nullptr) == SDFCCD_OK && std::fabs(ours - (double)theirs) <= tol;
+    }
+    if (!same) {
+        sdfccd_destroy_sdf(grid);
+        return false;
+    }
+    invalidate(shape);
+    m_bt_sdfs[shape].id = grid; // (no queryPoint data: the grid is the field)
+    return true;
+}
+
 void ShapeCache::invalidate(const btCollisionShape* shape)
 {
     auto it = m_meshes.find(shape);

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT
  * sdfccd C ABI: creating, combining, evaluating and describing SDF handles. */
 #include "capi_internal.h"
+#include "../../core/grid.h"
 #include "../../core/sdf_analytic.h"
 
 #include <stdio.h>
@@ -271,6 +272,16 @@ static sdfccd_Status sdf_eval_batch_held(sdfccd_SdfId sdf, const sdfccd_Vec3* po
     if ((st = sdfccd__check_points("sdfccd_sdf_eval_batch", points, count, out_values, "out_values"))) return st;
     sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
     if (!s) return SDFCCD_INVALID_HANDLE;
+    if (s->sdf->kind == SCC_SDF_GRID) { /* grids: the batch evaluator (core/grid.c), 64 points at a time */
+        scc_vec3 p[64], g[64];
+        for (int32_t i = 0; i < count; i += 64) {
+            const int32_t n = count - i < 64 ? count - i : 64;
+            for (int32_t k = 0; k < n; ++k) p[k] = sdfccd__v(points[i + k]);
+            scc_grid_eval_batch((const scc_grid*)s->sdf, p, (size_t)n, out_values + i, out_grads ? g : NULL);
+            for (int32_t k = 0; out_grads && k < n; ++k) out_grads[i + k] = sdfccd__pv(g[k]);
+        }
+        return SDFCCD_OK;
+    }
     for (int32_t i = 0; i < count; ++i) {
         scc_vec3 g;
         out_values[i] = scc_sdf_eval(s->sdf, sdfccd__v(points[i]), out_grads ? &g : NULL);

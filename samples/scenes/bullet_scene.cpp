@@ -216,6 +216,9 @@ Collider& BulletScene::addStaticBtSdf(const std::string& name, const std::string
     if (!s->initializeSDF(m_files.back().data(), (int)m_files.back().size()))
         std::fprintf(stderr, "sdfccd_scenes: btSdfCollisionShape::initializeSDF(%s) failed\n", cdf_path.c_str());
     m_shapes.emplace_back(s);
+    // The bridge evaluates the shape with sdfccd's grid of the same bytes (not queryPoint).
+    if (m_bridge && m_bridge->setBtSdfData(s, m_files.back().data(), m_files.back().size()) != sdfccd_bullet::Status::Ok)
+        std::fprintf(stderr, "sdfccd_scenes: Bridge::setBtSdfData(%s) failed\n", cdf_path.c_str());
     btTransform t(btQuaternion::getIdentity(), pos);
     m_rigid.emplace_back(new btRigidBody(0, nullptr, s));
     m_rigid.back()->setWorldTransform(t);

@@ -60,6 +60,8 @@ class btCollisionWorld;
 class btCollisionObject;
 class btDiscreteDynamicsWorld;
 
+class btSdfCollisionShape;
+
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
 /** Outcome of registration and verification. */
@@ -262,6 +264,14 @@ public:
     /** Drops the packed copy of a GImpact mesh shape: call after changing its vertices, or
      * before deleting the shape if another shape may be created at the same address. */
     void invalidateShape(const btCollisionShape* shape);
+
+    /** The .cdf bytes `shape` was initialised from (btSdfCollisionShape::initializeSDF): the bridge then
+     * evaluates the shape's field with sdfccd's grid evaluator of the same file (the same interpolant,
+     * several times faster than queryPoint, with per-cell gradient bounds for its culling) instead of
+     * sampling queryPoint. InvalidArgument (nothing changes) when sdfccd cannot load the bytes or their
+     * field differs from the shape's at sample points (other bytes). Call before stepping; the shape
+     * keeps the grid until invalidateShape(shape). */
+    Status setBtSdfData(const btSdfCollisionShape* shape, const void* data, size_t size);
 
     /** The configuration the bridge was made with. */
     const Config& config() const;
