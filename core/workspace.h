@@ -29,6 +29,7 @@ enum {
     SCC_WS_MARKS,     /* contact sets: one mark per mesh vertex (tagged by mark_epoch) */
     SCC_WS_CERTIFIED, /* guard: one flag per BSH node proven clear (bsh.c, scc_bsh_certify) */
     SCC_WS_FACES,     /* the face search's region stack (faces.c) */
+    SCC_WS_START,     /* contact sets: the start-pose query's contacts, kept while the CCD runs (contacts.c) */
     SCC_WS_SLOTS
 };
 
