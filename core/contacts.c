@@ -26,6 +26,7 @@
 #include "faces.h"
 #include "reduce.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* Scales of the mesh's radius R (the largest distance of a vertex from its centre of rotation). */
@@ -121,19 +122,46 @@ static int add_from_start(gen* g, uint32_t t, const double bary[3])
     return add(g, t, bary, x0, scc_sub(x0, scc_scale(n, phi)), n, g->mm->t0);
 }
 
-/* Per-vertex marks for one pass, told apart from earlier passes' by a new epoch. */
-static uint32_t* marks_for(scc_workspace* ws, uint32_t nv, uint32_t* io_epoch)
+/* A vertex of a touching triangle: its index, the time it is looked at and the triangle. */
+typedef struct vertex_ref {
+    uint32_t vertex, triangle;
+    double time;
+} vertex_ref;
+
+static int vertex_ref_cmp(const void* pa, const void* pb)
 {
-    size_t need = (size_t)(nv ? nv : 1) * sizeof(uint32_t);
-    int fresh = ws->slot[SCC_WS_MARKS].bytes < need;
-    uint32_t* marks = scc_ws_get(ws, SCC_WS_MARKS, need);
-    if (!marks) return NULL;
-    if (fresh || ++ws->mark_epoch == 0) {
-        memset(marks, 0, ws->slot[SCC_WS_MARKS].bytes);
-        ws->mark_epoch = 1;
+    const vertex_ref* a = pa;
+    const vertex_ref* b = pb;
+    if (a->vertex != b->vertex) return a->vertex < b->vertex ? -1 : 1;
+    if (a->time != b->time) return a->time < b->time ? -1 : 1;
+    return a->triangle < b->triangle ? -1 : a->triangle > b->triangle;
+}
+
+/* The vertices of the contacts' triangles, each once (its earliest time, then its lowest triangle),
+ * in vertex order: the order of the candidates, and so of the reduction's ties, does not depend on
+ * the order the queries found the contacts in. Writes their count; NULL on allocation failure. */
+static const vertex_ref* contact_vertices(gen* g, const scc_contact* cs, int count, size_t* out_n)
+{
+    const scc_mesh* mesh = g->mm->mesh;
+    vertex_ref* v = scc_ws_get(g->ws, SCC_WS_VERTEX_LIST, 3 * (size_t)(count > 0 ? count : 1) * sizeof *v);
+    if (!v) return NULL;
+    size_t n = 0;
+    for (int i = 0; i < count; ++i) {
+        if (cs[i].triangle >= mesh->triangle_count) continue;
+        for (int k = 0; k < 3; ++k) v[n++] = (vertex_ref){ mesh->indices[3 * (size_t)cs[i].triangle + (size_t)k], cs[i].triangle, cs[i].toi };
     }
-    *io_epoch = ws->mark_epoch;
-    return marks;
+    qsort(v, n, sizeof *v, vertex_ref_cmp);
+    size_t u = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (u == 0 || v[i].vertex != v[u - 1].vertex) v[u++] = v[i];
+    *out_n = u;
+    return v;
+}
+
+static int corner_of(const scc_mesh* mesh, const vertex_ref* r)
+{
+    const uint32_t* f = &mesh->indices[3 * (size_t)r->triangle];
+    return f[0] == r->vertex ? 0 : f[1] == r->vertex ? 1 : 2;
 }
 
 static const double unit_bary[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
@@ -145,27 +173,21 @@ static int add_pose(gen* g, const scc_contact* cs, int count, const scc_mesh_mot
     const scc_mesh* mesh = g->mm->mesh;
     for (int i = 0; i < count; ++i)
         if (cs[i].triangle < mesh->triangle_count && !add_from_start(g, cs[i].triangle, cs[i].bary)) return 0;
-    uint32_t epoch = 0;
-    uint32_t* marks = marks_for(g->ws, mesh->vertex_count, &epoch);
-    if (!marks) return 0;
-    for (int i = 0; i < count; ++i) {
-        const uint32_t t = cs[i].triangle;
-        if (t >= mesh->triangle_count) continue;
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t v = mesh->indices[3 * (size_t)t + (size_t)k];
-            if (marks[v] == epoch) continue;
-            marks[v] = epoch;
-            const double phi = scc_sdf_eval(g->sdf, point_at(pose, t, unit_bary[k], pose->t0), NULL);
-            g->sum->own_evals++;
-            if (phi <= accept && !add_from_start(g, t, unit_bary[k])) return 0;
-        }
+    size_t n = 0;
+    const vertex_ref* v = contact_vertices(g, cs, count, &n);
+    if (!v) return 0;
+    for (size_t i = 0; i < n; ++i) {
+        const int k = corner_of(mesh, &v[i]);
+        const double phi = scc_sdf_eval(g->sdf, point_at(pose, v[i].triangle, unit_bary[k], pose->t0), NULL);
+        g->sum->own_evals++;
+        if (phi <= accept && !add_from_start(g, v[i].triangle, unit_bary[k])) return 0;
     }
     return 1;
 }
 
 /* The CCD's contacts, each held by the surface point and normal it touches at its time of impact,
  * and the vertices of their triangles within `accept` of the surface at that time (a face landing
- * flat gives its corners; a vertex once, at its earliest time: the contacts come earliest first). */
+ * flat gives its corners). */
 static int add_ccd(gen* g, const scc_contact* cs, int count, double accept)
 {
     const scc_mesh_motion* mm = g->mm;
@@ -176,28 +198,22 @@ static int add_ccd(gen* g, const scc_contact* cs, int count, double accept)
         const scc_vec3 x0 = point_at(mm, k->triangle, k->bary, mm->t0);
         if (!add(g, k->triangle, k->bary, x0, scc_sub(k->point, scc_scale(n, k->distance)), n, k->toi)) return 0;
     }
-    uint32_t epoch = 0;
-    uint32_t* marks = marks_for(g->ws, mm->mesh->vertex_count, &epoch);
-    if (!marks) return 0;
-    for (int i = 0; i < count; ++i) {
-        const uint32_t t = cs[i].triangle;
-        if (t >= mm->mesh->triangle_count) continue;
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t v = mm->mesh->indices[3 * (size_t)t + (size_t)k];
-            if (marks[v] == epoch) continue;
-            marks[v] = epoch;
-            scc_tri_motion m;
-            scc_mesh_triangle_motion(mm, t, &m);
-            const scc_vec3 x = scc_tri_point_at(&m, unit_bary[k], cs[i].toi, NULL);
-            scc_vec3 grad;
-            const double phi = scc_sdf_eval(g->sdf, x, &grad);
-            g->sum->own_evals++;
-            if (!(phi <= accept)) continue;
-            const scc_vec3 n = scc_normalize_or(grad, scc_v3(0, 0, 0));
-            if (!(scc_len2(n) > 0.0)) continue;
-            const scc_vec3 x0 = scc_tri_point_at(&m, unit_bary[k], mm->t0, NULL);
-            if (!add(g, t, unit_bary[k], x0, scc_sub(x, scc_scale(n, phi)), n, cs[i].toi)) return 0;
-        }
+    size_t nv = 0;
+    const vertex_ref* v = contact_vertices(g, cs, count, &nv);
+    if (!v) return 0;
+    for (size_t i = 0; i < nv; ++i) {
+        const int k = corner_of(mm->mesh, &v[i]);
+        scc_tri_motion m;
+        scc_mesh_triangle_motion(mm, v[i].triangle, &m);
+        const scc_vec3 x = scc_tri_point_at(&m, unit_bary[k], v[i].time, NULL);
+        scc_vec3 grad;
+        const double phi = scc_sdf_eval(g->sdf, x, &grad);
+        g->sum->own_evals++;
+        if (!(phi <= accept)) continue;
+        const scc_vec3 n = scc_normalize_or(grad, scc_v3(0, 0, 0));
+        if (!(scc_len2(n) > 0.0)) continue;
+        const scc_vec3 x0 = scc_tri_point_at(&m, unit_bary[k], mm->t0, NULL);
+        if (!add(g, v[i].triangle, unit_bary[k], x0, scc_sub(x, scc_scale(n, phi)), n, v[i].time)) return 0;
     }
     return 1;
 }

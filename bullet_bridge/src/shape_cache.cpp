@@ -248,9 +248,6 @@ const MeshEntry* ShapeCache::meshFor(const btCollisionShape* shape)
         packConvex(static_cast<const btConvexShape*>(shape), e);
     }
     if (e.indices.empty()) return nullptr;
-    for (size_t i = 0; i + 2 < e.vertices.size(); i += 3)
-        e.radius = std::max(e.radius, std::sqrt(e.vertices[i] * e.vertices[i] + e.vertices[i + 1] * e.vertices[i + 1] +
-                                                e.vertices[i + 2] * e.vertices[i + 2]));
     sdfccd_MeshDef def = sdfccd_default_mesh_def();
     def.vertices = e.vertices.data();
     def.vertex_count = (uint32_t)(e.vertices.size() / 3);
