@@ -133,8 +133,8 @@ bool BridgeImpl::pairInput(const btCollisionObjectWrapper* mw, const btCollision
     in.sdf = shapes.sdfFor(sw->getCollisionShape(), cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
     if (!me || !in.sdf.index1) return false;
     in.mesh = me->id;
-    in.motion = motionOf(mw->getCollisionObject(), mw->getWorldTransform(), dt).rigid();
-    in.sdf_motion = motionOf(sw->getCollisionObject(), sw->getWorldTransform(), dt).rigid();
+    in.motion = motionOf(mw->getCollisionObject(), mw->getWorldTransform(), dt);
+    in.sdf_motion = motionOf(sw->getCollisionObject(), sw->getWorldTransform(), dt);
     in.dt = dt;
     const sdfccd_ContactParams p = sdfccd_default_contact_params();
     std::memcpy(&in.params, &p, sizeof p);
@@ -275,8 +275,7 @@ double BridgeImpl::timeOfImpact(const btCollisionObject* mo, const btCollisionOb
     const MeshEntry* me = shapes.meshFor(mo->getCollisionShape());
     sdfccd_SdfId sdf = shapes.sdfFor(so->getCollisionShape(), cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
     if (!me || !sdf.index1) return 1.0;
-    BodyMotion M = motionOf(mo, mo->getWorldTransform(), dt), S = motionOf(so, so->getWorldTransform(), dt);
-    sdfccd_RigidMotion mm = M.rigid(), sm = S.rigid();
+    const sdfccd_RigidMotion mm = motionOf(mo, mo->getWorldTransform(), dt), sm = motionOf(so, so->getWorldTransform(), dt);
     sdfccd_QueryParams params = cfg.query;
     params.margin = 0;
     sdfccd_QueryResult res;

@@ -36,16 +36,10 @@ inline sdfccd_Vec3 v3(const btVector3& v)
 inline btVector3 bt(const sdfccd_Vec3& v) { return btVector3((btScalar)v.x, (btScalar)v.y, (btScalar)v.z); }
 sdfccd_Pose toPose(const btTransform& t);
 
-// Start and end pose of a body (or compound child) over a step, and the constant velocities that
-// connect them in Bullet's motion model (origin lerp + exponential-map rotation), sdfccd's too.
-struct BodyMotion {
-    btTransform t0, t1;
-    btVector3 v, w;
-    sdfccd_RigidMotion rigid() const;
-    btTransform at(double t) const;
-};
-// `wrapper_transform` is the wrapper's world transform (a compound child's includes its offset).
-BodyMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt);
+// The motion of a body (or compound child: `wrapper_transform` includes its offset) over a step:
+// from its start pose to its end pose with the constant velocities that connect them in Bullet's
+// motion model (origin lerp + exponential-map rotation), sdfccd's too.
+sdfccd_RigidMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt);
 
 // A shape packed as a triangle mesh for sdfccd (scaled, in the shape's local frame).
 struct MeshEntry {

@@ -191,7 +191,8 @@ typedef enum sdfccd_FeatureKind {
  * the step; a negative gap is a penetration to push out. */
 typedef struct sdfccd_ContactPoint {
     sdfccd_Vec3 point;          /**< The mesh's material point at t0 (world, m). */
-    sdfccd_Vec3 surface_point;  /**< The point of the SDF's surface that holds it, at t0: point - gap * normal (world, m). */
+    sdfccd_Vec3 surface_point;  /**< The point of the SDF's surface that holds it (found at `toi`), at t0 (world, m); gap is
+                                     normal . (point - surface_point). */
     sdfccd_Vec3 normal;         /**< Unit normal out of the SDF (world), at t0. */
     double gap;                 /**< Signed gap at t0 along the normal (m); negative: penetrating. */
     double toi;                 /**< When the constraint was found: t0 for points of the start pose, the time of impact
