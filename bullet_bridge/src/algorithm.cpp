@@ -568,14 +568,7 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported)
                   "Bullet's GImpact algorithm is colliding a GImpact mesh with an SdfShape, without CCD (it can pass through): %s; "
                   "Bridge::check(world) names the problem",
                   what);
-    MisuseHandler h;
-    void* user;
-    {
-        std::lock_guard<std::mutex> lock(g_misuse_mutex);
-        h = g_misuse_handler ? g_misuse_handler : defaultMisuseHandler;
-        user = g_misuse_user;
-    }
-    h(status, message, shape, user);
+    callMisuseHandler(status, message, shape);
 }
 
 } // namespace detail

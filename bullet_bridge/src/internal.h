@@ -124,8 +124,6 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported);
 // removed by unregister().
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world);
 void guardDetach(BridgeImpl* impl);
-// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
-sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out);
 // soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones.
 void softRegister(BridgeImpl* impl, btCollisionDispatcher* d);
 void softAttach(BridgeImpl* impl, btCollisionWorld* world);
