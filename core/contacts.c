@@ -228,6 +228,15 @@ static int query(gen* g, const scc_mesh_motion* mm, const scc_params* p, scc_que
 
 static const scc_contact* slot_contacts(const gen* g) { return (const scc_contact*)g->ws->slot[SCC_WS_CONTACTS].p; }
 
+/* The start-pose query's contacts copied out of the contact slot (the next query reuses it); NULL on
+ * allocation failure. */
+static const scc_contact* keep_start(gen* g, const scc_query_summary* r0)
+{
+    scc_contact* copy = scc_ws_get(g->ws, SCC_WS_START, ((size_t)r0->contacts_found + 1) * sizeof *copy);
+    if (copy) memcpy(copy, slot_contacts(g), (size_t)r0->contacts_found * sizeof *copy);
+    return copy;
+}
+
 /* A rigid motion at rest at its pose at time t. */
 static scc_rigid at_rest(const scc_rigid* r, double t)
 {
@@ -328,12 +337,7 @@ static int candidates(gen* g, const scc_contact_params* cp, double radius)
         if (r0.triangles_tested == 0 && r0.state == SCC_NO_HIT) return 1; /* culled: no contact this step */
         for (int i = 0; r0.hit && i < r0.contacts_found; ++i) touching |= slot_contacts(g)[i].distance <= margin;
     }
-    if (start_ran && r0.hit) {
-        scc_contact* copy = scc_ws_get(g->ws, SCC_WS_START, (size_t)r0.contacts_found * sizeof *copy);
-        if (!copy) return 0;
-        memcpy(copy, slot_contacts(g), (size_t)r0.contacts_found * sizeof *copy);
-        kept = copy;
-    }
+    if (start_ran && r0.hit && !(kept = keep_start(g, &r0))) return 0;
 
     /* 2. the face search: at the start pose over the step's reach (the DCD baseline: at the end
      *    pose within the margin); its points count like the start pose's */
@@ -379,12 +383,7 @@ static int candidates(gen* g, const scc_contact_params* cp, double radius)
             dp.margin = start_margin;
             sum->discrete_queries++;
             if (!query(g, &start, &dp, &r0)) return 0;
-            if (r0.hit) {
-                scc_contact* copy = scc_ws_get(g->ws, SCC_WS_START, (size_t)r0.contacts_found * sizeof *copy);
-                if (!copy) return 0;
-                memcpy(copy, slot_contacts(g), (size_t)r0.contacts_found * sizeof *copy);
-                kept = copy;
-            }
+            if (r0.hit && !(kept = keep_start(g, &r0))) return 0;
         }
     }
 
