@@ -30,6 +30,8 @@ enum {
     SCC_WS_CERTIFIED, /* guard: one flag per BSH node proven clear (bsh.c, scc_bsh_certify) */
     SCC_WS_FACES,     /* the face search's region stack (faces.c) */
     SCC_WS_POSED,     /* mesh query (DCD): vertices at the tested pose, tagged by trace_epoch (mesh_query.c) */
+    SCC_WS_START,     /* contact sets: the start-pose query's contacts, kept while the CCD runs (contacts.c) */
+    SCC_WS_VERTEX_LIST, /* contact sets: the vertices of the touching triangles, sorted (contacts.c) */
     SCC_WS_SLOTS
 };
 

@@ -218,6 +218,9 @@ int main(void)
     OFF(sdfccd_ContactParams, query);
     OFF(sdfccd_ContactParams, vertex_distance);
     OFF(sdfccd_ContactParams, same_place_distance);
+    OFF(sdfccd_ContactParams, feature_size);
+    OFF(sdfccd_ContactParams, reduced_count);
+    OFF(sdfccd_ContactParams, cover_depth);
     OFF(sdfccd_ContactParams, internal_value);
     SIZE(sdfccd_ContactSet);
     OFF(sdfccd_ContactSet, count);
@@ -227,6 +230,10 @@ int main(void)
     OFF(sdfccd_ContactSet, ccd_state);
     OFF(sdfccd_ContactSet, toi);
     OFF(sdfccd_ContactSet, sdf_evaluations);
+    OFF(sdfccd_ContactSet, reduced);
+    OFF(sdfccd_ContactSet, discrete_queries);
+    OFF(sdfccd_ContactSet, own_evaluations);
+    OFF(sdfccd_ContactSet, face_regions);
 #endif
     return 0;
 }

@@ -701,6 +701,23 @@ START_TEST(test_generate_no_allocation_after_warm_up)
         long before = allocs;
         for (int i = 0; i < 10; ++i)
             for (int k = 0; k < 3; ++k) ck_assert_int_eq(generate(ws, floor, cube, &m[k], c, 8).count, k == 2 ? 0 : 8);
+        ck_assert_int_eq(allocs - before, 0);
+        /* the batch, one workspace per thread, each warmed up with every pair */
+        sdfccd_Workspace* ws2[2] = { ws, NULL };
+        ck_assert_int_eq(sdfccd_create_workspace(&ws2[1]), SDFCCD_OK);
+        sdfccd_ContactParams bp = sdfccd_default_contact_params();
+        sdfccd_ContactPoint bc[3][8];
+        sdfccd_ContactSet bs[3];
+        sdfccd_ContactPair pairs[3];
+        for (int k = 0; k < 3; ++k) (void)generate(ws2[1], floor, cube, &m[k], c, 8); /* either thread may take any pair */
+        for (int round = 0; round < 8; ++round) {
+            if (round == 1) before = allocs;
+            for (int k = 0; k < 3; ++k) pairs[k] = (sdfccd_ContactPair){ floor, NULL, cube, &m[k], 0.0, DT, &bp, bc[k], 8, &bs[k], SDFCCD_OK };
+            ck_assert_int_eq(sdfccd_generate_contacts_batch(ws2, 2, pairs, 3), SDFCCD_OK);
+        }
+        ck_assert_int_eq(allocs - before, 0);
+        sdfccd_destroy_workspace(ws2[1]);
+        before = allocs;
         /* the face search: a slab on the floor, after a first call */
         sdfccd_MeshId slab = test_box_mesh((sdfccd_Vec3){ 0.2, 0.2, 0.05 }, 1, 1, 1);
         sdfccd_Pose pose = sdfccd_pose_identity();
@@ -1027,6 +1044,284 @@ START_TEST(test_faces_bad_input)
 }
 END_TEST
 
+/* ---- the one generator's rules (the Bullet bridge's sequence) on sets known in closed form ---- */
+
+static sdfccd_ContactSet generate_p(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sm, sdfccd_MeshId mesh,
+                                    const sdfccd_RigidMotion* m, const sdfccd_ContactParams* p, sdfccd_ContactPoint* out, int32_t cap)
+{
+    sdfccd_ContactSet set;
+    ck_assert_msg(sdfccd_generate_contacts(ws, sdf, sm, mesh, m, 0.0, DT, p, out, cap, &set) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert(set.count >= 0 && set.count <= cap && set.reduced <= set.count && set.count <= set.candidates);
+    ck_assert(set.own_evaluations >= 0 && set.own_evaluations <= set.sdf_evaluations);
+    return set;
+}
+
+/* A coarse cube (2 triangles a face, each face with its own 4 vertices, no subdivision) 5 mm above
+ * the floor at rest, margin 1 cm: the start-pose query holds the 10 triangles with a point at the
+ * bottom (bottom and sides, each at gap 5 mm), so the step starts in contact and the CCD is skipped;
+ * the end-pose query (the same pose) holds them again. Each gives 10 points and, of their faces' 20
+ * vertices, the 12 at the bottom (the others are 10.5 cm away): 2 x 22 = 44 candidates and
+ * 2 x (10 + 20 + 12) = 84 closest-point evaluations of our own. */
+START_TEST(test_generate_rules_resting_closed_form)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    p.query.subdivision = 0;
+    p.query.margin = 0.01;
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position = (sdfccd_Vec3){ 0.2, 0.1, H + 0.005 };
+    sdfccd_ContactPoint c[64], few[4];
+    memset(c, 0, sizeof c); /* padding too: compared byte for byte */
+    memset(few, 0, sizeof few);
+    sdfccd_ContactSet set = generate_p(ws, floor, NULL, cube, &m, &p, c, 64);
+    ck_assert_int_eq(set.started_in_contact, 1);
+    ck_assert_int_eq(set.ccd_ran, 0);
+    ck_assert_int_eq(set.discrete_queries, 2);
+    ck_assert_int_eq(set.candidates, 44);
+    ck_assert_int_eq(set.own_evaluations, 84);
+    for (int i = 0; i < set.count; ++i) {
+        ck_assert_double_near(c[i].gap, 0.005, 1e-9);
+        ck_assert_double_near(c[i].point.z, 0.005, 1e-9);
+        ck_assert_double_near(c[i].surface_point.z, 0.0, 1e-9);
+        ck_assert(c[i].toi == 0.0);
+    }
+    /* buffer smaller than the set: the reduction, the same choice in the same order, never a prefix of the candidates */
+    for (int32_t cap = 1; cap <= 4; ++cap) {
+        sdfccd_ContactSet s2 = generate_p(ws, floor, NULL, cube, &m, &p, few, cap);
+        ck_assert_int_eq(s2.count, cap);
+        ck_assert_int_eq(s2.candidates, 44);
+        for (int32_t i = 0; i < cap; ++i) ck_assert(memcmp(&few[i], &c[i], sizeof few[i]) == 0);
+    }
+    assert_bottom_corners(few, 4, m.pose.position, 0.005);
+    /* the same with the floor given as a motion at rest (moved and turned): the same points moved */
+    sdfccd_RigidMotion sm = sdfccd_default_rigid_motion();
+    sm.pose.position = (sdfccd_Vec3){ 1, 2, 3 };
+    sm.pose.orientation = (sdfccd_Quat){ cos(0.3), sin(0.3), 0, 0 }; /* 0.6 rad about x */
+    sdfccd_RigidMotion mw = m; /* the cube carried along with the floor's frame */
+    const double cs = cos(0.6), sn = sin(0.6);
+    sdfccd_Vec3 q = m.pose.position;
+    mw.pose.position = (sdfccd_Vec3){ 1 + q.x, 2 + cs * q.y - sn * q.z, 3 + sn * q.y + cs * q.z };
+    mw.pose.orientation = sm.pose.orientation;
+    sdfccd_ContactSet s3 = generate_p(ws, floor, &sm, cube, &mw, &p, few, 4);
+    ck_assert_int_eq(s3.candidates, 44);
+    ck_assert_int_eq(s3.count, 4);
+    for (int i = 0; i < 4; ++i) {
+        sdfccd_Vec3 a = c[i].point, b = few[i].point;
+        ck_assert_double_near(b.x, 1 + a.x, 1e-9);
+        ck_assert_double_near(b.y, 2 + cs * a.y - sn * a.z, 1e-9);
+        ck_assert_double_near(b.z, 3 + sn * a.y + cs * a.z, 1e-9);
+        ck_assert_double_near(few[i].gap, 0.005, 1e-9);
+        ck_assert(few[i].id == c[i].id);
+    }
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+/* The coarse cube 5 cm above the floor at 10 m/s (margin 0, no subdivision; reach 10/60 m): every
+ * triangle is within reach at t0 and none touches, so the CCD runs: its first time of impact is 5 ms
+ * (5 cm / 10 m/s), with the bottom and side triangles (10 points) and, of their 20 vertices, the 12
+ * at the bottom; then the start pose's 12 triangles and 24 vertices (all within 5 cm + reach), and
+ * the end pose's 12 triangles and 24 vertices (all below the floor): 22 + 36 + 36 = 94 candidates;
+ * own evaluations 20 (the vertices at the TOI) + 2 x (12 + 24 + 24) = 140. */
+START_TEST(test_generate_rules_falling_closed_form)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    p.query.subdivision = 0;
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.z = H + 0.05;
+    m.linear_velocity.z = -10;
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set = generate_p(ws, floor, NULL, cube, &m, &p, c, 4);
+    ck_assert_int_eq(set.started_in_contact, 0);
+    ck_assert_int_eq(set.ccd_ran, 1);
+    ck_assert_int_eq(set.ccd_state, SDFCCD_STATE_HIT);
+    ck_assert_double_near(set.toi, 0.005, 1e-7);
+    ck_assert_int_eq(set.discrete_queries, 2);
+    ck_assert_int_eq(set.candidates, 94);
+    ck_assert_int_eq(set.own_evaluations, 140);
+    assert_bottom_corners(c, set.count, m.pose.position, 0.05);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+/* The cull: out of reach, the start-pose query's broad phase proves the step clear and nothing else
+ * runs: the call costs exactly that one discrete query (the same evaluations as sdfccd_query_mesh
+ * with DCD at t0 and the margin widened by the reach). */
+START_TEST(test_generate_rules_cull)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    p.query.margin = 0.01;
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.z = 0.5;
+    m.linear_velocity.z = -6; /* reach 0.1 m */
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set = generate_p(ws, floor, NULL, cube, &m, &p, c, 4);
+    ck_assert_int_eq(set.count, 0);
+    ck_assert_int_eq(set.candidates, 0);
+    ck_assert_int_eq(set.ccd_ran, 0);
+    ck_assert_int_eq(set.discrete_queries, 1);
+    ck_assert_int_eq(set.own_evaluations, 0);
+    ck_assert(set.toi == DT);
+    sdfccd_QueryParams dcd = p.query;
+    dcd.method = SDFCCD_METHOD_DCD;
+    dcd.margin = 0.01 + 6 * DT;
+    dcd.subdivision_min_area = fmax(dcd.subdivision_min_area, pow(0.1 * H * sqrt(3.0), 2));
+    sdfccd_RigidMotion at = m;
+    at.linear_velocity.z = 0;
+    sdfccd_QueryResult r;
+    ck_assert_int_eq(sdfccd_query_mesh(floor, NULL, cube, &at, 0.0, 0.0, &dcd, NULL, 0, &r), SDFCCD_OK);
+    ck_assert_int_eq(r.triangles_tested, 0);
+    ck_assert_int_eq(set.sdf_evaluations, r.sdf_evaluations);
+    /* spinning about z at 6 rad/s, 1.5 cm up: within the reach the spin gives (margin + 6 R dt,
+     * R = H sqrt 3) but never closer than 1.5 cm: the CCD runs and misses */
+    m.pose.position.z = H + 0.015;
+    m.linear_velocity.z = 0;
+    m.angular_velocity.z = 6;
+    set = generate_p(ws, floor, NULL, cube, &m, &p, c, 4);
+    ck_assert_int_eq(set.ccd_ran, 1);
+    ck_assert_int_eq(set.ccd_state, SDFCCD_STATE_NO_HIT);
+    ck_assert_int_eq(set.candidates, 0);
+    ck_assert_int_eq(set.own_evaluations, 0); /* no hit: the start pose's points are not even held */
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+/* Cover points: a fine cube at rest gives none (no turn); spinning about x at 30 rad/s on the floor
+ * it gets points beyond the reduction's 4, none of them one of the 4, the same as
+ * sdfccd_cover_contacts would pick from the 4 (checked: every cover point is deeper than the
+ * reduction lets it stay by more than the depth). */
+START_TEST(test_generate_rules_cover)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    p.query.margin = 0.01;
+    p.reduced_count = 4;
+    p.cover_depth = 0.0005;
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.z = H;
+    sdfccd_ContactPoint c[16];
+    sdfccd_ContactSet set = generate_p(ws, floor, NULL, cube, &m, &p, c, 16);
+    ck_assert_int_eq(set.reduced, 4);
+    ck_assert_int_eq(set.count, 4);
+    m.angular_velocity.x = 30;
+    set = generate_p(ws, floor, NULL, cube, &m, &p, c, 16);
+    ck_assert_int_eq(set.reduced, 4);
+    ck_assert_int_gt(set.count, 4);
+    for (int i = 4; i < set.count; ++i)
+        for (int j = 0; j < i; ++j) ck_assert(c[i].id != c[j].id || c[i].toi != c[j].toi || c[i].gap != c[j].gap);
+    /* p.cover_depth 0: the reduction only, to the whole capacity */
+    p.cover_depth = 0;
+    p.reduced_count = 0;
+    set = generate_p(ws, floor, NULL, cube, &m, &p, c, 16);
+    ck_assert_int_eq(set.reduced, set.count);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+/* The face search runs only with a feature size (and subdivision): a coarse 40 cm plate resting on
+ * the floor gets its regions' points too. */
+START_TEST(test_generate_rules_face_search)
+{
+    sdfccd_MeshId plate = test_box_mesh((sdfccd_Vec3){ 0.2, 0.2, 0.01 }, 1, 1, 1);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    p.query.margin = 0.01;
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position.z = 0.01;
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet off = generate_p(ws, floor, NULL, plate, &m, &p, c, 4);
+    ck_assert_int_eq(off.face_regions, 0);
+    p.feature_size = 0.1;
+    sdfccd_ContactSet on = generate_p(ws, floor, NULL, plate, &m, &p, c, 4);
+    ck_assert_int_gt(on.face_regions, 0);
+    ck_assert_int_gt(on.candidates, off.candidates);
+    p.query.subdivision = 0; /* part of the subdivision: off with it */
+    ck_assert_int_eq(generate_p(ws, floor, NULL, plate, &m, &p, c, 4).face_regions, 0);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(plate), SDFCCD_OK);
+}
+END_TEST
+
+/* The batch: every pair exactly as its own call, whatever the thread count; a bad pair reports its
+ * status and message, the others still run. */
+START_TEST(test_generate_batch)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws[3];
+    for (int k = 0; k < 3; ++k) ck_assert_int_eq(sdfccd_create_workspace(&ws[k]), SDFCCD_OK);
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    p.query.margin = 0.01;
+    enum { N = 12 };
+    sdfccd_RigidMotion m[N];
+    sdfccd_ContactPoint one[N][8], many[N][8];
+    memset(one, 0, sizeof one); /* padding too: compared byte for byte */
+    sdfccd_ContactSet s1[N], sn[N];
+    sdfccd_ContactPair pairs[N];
+    for (int i = 0; i < N; ++i) {
+        m[i] = sdfccd_default_rigid_motion();
+        m[i].pose.position = (sdfccd_Vec3){ 0.3 * i, 0, H + 0.01 * (i % 4) };
+        m[i].linear_velocity.z = -(double)(i % 3);
+        m[i].angular_velocity.y = 2.0 * (i % 5);
+        s1[i] = generate_p(ws[0], floor, NULL, cube, &m[i], &p, one[i], 8);
+    }
+    for (int threads = 1; threads <= 3; ++threads) {
+        memset(many, 0, sizeof many);
+        for (int i = 0; i < N; ++i)
+            pairs[i] = (sdfccd_ContactPair){ floor, NULL, cube, &m[i], 0.0, DT, &p, many[i], 8, &sn[i], SDFCCD_INVALID_ARGUMENT };
+        ck_assert_int_eq(sdfccd_generate_contacts_batch(ws, threads, pairs, N), SDFCCD_OK);
+        for (int i = 0; i < N; ++i) {
+            ck_assert_int_eq(pairs[i].status, SDFCCD_OK);
+            ck_assert(memcmp(&sn[i], &s1[i], sizeof sn[i]) == 0);
+            ck_assert(memcmp(many[i], one[i], (size_t)s1[i].count * sizeof one[i][0]) == 0);
+        }
+    }
+    sdfccd_ContactParams bad = p;
+    bad.reduced_count = -1;
+    pairs[5].params = &bad;
+    ck_assert_int_eq(sdfccd_generate_contacts_batch(ws, 2, pairs, N), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(strstr(sdfccd_last_error(), "pair 5") != NULL);
+    ck_assert_int_eq(pairs[5].status, SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(pairs[6].status, SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_generate_contacts_batch(NULL, 1, pairs, N), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_generate_contacts_batch(ws, 0, pairs, N), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_generate_contacts_batch(ws, 257, pairs, N), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_generate_contacts_batch(ws, 1, NULL, 3), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_generate_contacts_batch(ws, 1, pairs, -1), SDFCCD_INVALID_ARGUMENT);
+    sdfccd_Workspace* holes[2] = { ws[0], NULL };
+    ck_assert_int_eq(sdfccd_generate_contacts_batch(holes, 2, pairs, N), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_generate_contacts_batch(ws, 1, NULL, 0), SDFCCD_OK);
+    for (int k = 0; k < 3; ++k) sdfccd_destroy_workspace(ws[k]);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
 START_TEST(test_generate_bad_input)
 {
     sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
@@ -1062,6 +1357,15 @@ START_TEST(test_generate_bad_input)
     bad.same_place_distance = NAN;
     EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
     bad = p;
+    bad.feature_size = NAN;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
+    bad.cover_depth = -1;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
+    bad.reduced_count = -1;
+    EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    bad = p;
     bad.query.margin = INFINITY;
     EXPECT(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0, DT, &bad, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
     sdfccd_RigidMotion nan_m = m;
@@ -1091,6 +1395,12 @@ int main(void)
     tcase_add_test(tg, test_generate_falling_box);
     tcase_add_test(tg, test_generate_fast_plate_thin_wall);
     tcase_add_test(tg, test_generate_linear_cloth);
+    tcase_add_test(tg, test_generate_rules_resting_closed_form);
+    tcase_add_test(tg, test_generate_rules_falling_closed_form);
+    tcase_add_test(tg, test_generate_rules_cull);
+    tcase_add_test(tg, test_generate_rules_cover);
+    tcase_add_test(tg, test_generate_rules_face_search);
+    tcase_add_test(tg, test_generate_batch);
     tcase_add_test(tg, test_generate_bad_input);
     tcase_add_test(tg, test_faces_sphere_cap);
     tcase_add_test(tg, test_faces_ridge);

@@ -8,6 +8,8 @@
 #include "../../core/contacts.h"
 #include "../../core/faces.h"
 
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 
 /* Finite pose with a unit orientation (within 1e-4, then normalised) and a bounded position. */
@@ -234,12 +236,19 @@ static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, cons
     sdfccd_Status st;
     if (!in) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
     if ((st = sdfccd__check_def(in->internal_value, fn, "params were", "sdfccd_default_contact_params"))) return st;
-    if (!isfinite(in->vertex_distance) || in->vertex_distance < 0.0 || !isfinite(in->same_place_distance) || in->same_place_distance < 0.0)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->vertex_distance and same_place_distance must be finite and >= 0 (got %g, %g)",
-                             fn, in->vertex_distance, in->same_place_distance);
+    const double d[4] = { in->vertex_distance, in->same_place_distance, in->feature_size, in->cover_depth };
+    for (int i = 0; i < 4; ++i)
+        if (!isfinite(d[i]) || d[i] < 0.0)
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT,
+                                 "%s: params->vertex_distance, same_place_distance, feature_size and cover_depth must be finite and >= 0 "
+                                 "(got %g, %g, %g, %g)", fn, d[0], d[1], d[2], d[3]);
+    if (in->reduced_count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->reduced_count (%d) < 0", fn, in->reduced_count);
     if ((st = sdfccd__convert_params(&in->query, fn, &out->query))) return st;
     out->vertex_distance = in->vertex_distance;
     out->same_place = in->same_place_distance;
+    out->feature_size = in->feature_size;
+    out->reduced = in->reduced_count;
+    out->cover_depth = in->cover_depth;
     return SDFCCD_OK;
 }
 
@@ -281,6 +290,10 @@ static sdfccd_Status run_contacts(sdfccd_Workspace* ws, const step_setup* q, con
     r.ccd_state = sdfccd__public_state(s.ccd_state);
     r.toi = s.toi;
     r.sdf_evaluations = s.evals;
+    r.reduced = (int32_t)s.reduced;
+    r.discrete_queries = s.discrete_queries;
+    r.own_evaluations = s.own_evals;
+    r.face_regions = s.face_regions;
     *out_set = r;
     return SDFCCD_OK;
 }
@@ -330,6 +343,67 @@ sdfccd_Status sdfccd_generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId
                                               sdfccd_ContactSet* out_set)
 {
     SDFCCD__HELD_CALL(generate_contacts_linear(ws, sdf, sdf_motion, mesh, start, end, t0, t1, params, out_points, capacity, out_set));
+}
+
+/* ---- contact sets of many pairs on threads ---- */
+
+typedef struct contact_batch {
+    sdfccd_ContactPair* pairs;
+    int32_t count;
+    sdfccd_Workspace* const* ws;
+    atomic_int next, worker;
+} contact_batch;
+
+static sdfccd_Status run_pair(sdfccd_ContactPair* q, sdfccd_Workspace* ws)
+{
+    return sdfccd_generate_contacts(ws, q->sdf, q->sdf_motion, q->mesh, q->motion, q->t0, q->t1, q->params, q->out_points, q->capacity,
+                                    q->out_set);
+}
+
+/* Takes the next pair until none is left (each thread its own workspace). */
+static void* contact_worker(void* arg)
+{
+    contact_batch* b = arg;
+    sdfccd_Workspace* ws = b->ws[atomic_fetch_add(&b->worker, 1)];
+    for (int i; (i = atomic_fetch_add(&b->next, 1)) < b->count;) b->pairs[i].status = run_pair(&b->pairs[i], ws);
+    return NULL;
+}
+
+sdfccd_Status sdfccd_generate_contacts_batch(sdfccd_Workspace* const* workspaces, int32_t thread_count, sdfccd_ContactPair* pairs,
+                                             int32_t count)
+{
+    static const char fn[] = "sdfccd_generate_contacts_batch";
+    enum { MAX_THREADS = 256 };
+    if (count < 0 || (count > 0 && !pairs) || !workspaces)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: pairs or workspaces is NULL or count (%d) < 0", fn, (int)count);
+    if (thread_count < 1 || thread_count > MAX_THREADS)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: thread_count must be in [1, %d] (got %d)", fn, MAX_THREADS, (int)thread_count);
+    for (int32_t k = 0; k < thread_count; ++k)
+        if (!workspaces[k]) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: workspaces[%d] is NULL", fn, (int)k);
+    if (count == 0) return SDFCCD_OK;
+    contact_batch b;
+    b.pairs = pairs;
+    b.count = count;
+    b.ws = workspaces;
+    atomic_init(&b.next, 0);
+    atomic_init(&b.worker, 0);
+    pthread_t tid[MAX_THREADS];
+    int started = 0;
+    for (int k = 1; k < thread_count && k < count; ++k) {
+        if (pthread_create(&tid[started], NULL, contact_worker, &b) != 0) break; /* fewer threads: still correct */
+        ++started;
+    }
+    contact_worker(&b);
+    for (int k = 0; k < started; ++k) pthread_join(tid[k], NULL);
+    /* The first failure again on this thread, so that its message is this thread's last error. */
+    for (int32_t i = 0; i < count; ++i)
+        if (pairs[i].status != SDFCCD_OK) {
+            sdfccd_Status st = run_pair(&pairs[i], workspaces[0]);
+            char msg[512];
+            snprintf(msg, sizeof msg, "%s", sdfccd_last_error());
+            return sdfccd__error(st, "%s: pair %d: %s", fn, (int)i, msg);
+        }
+    return SDFCCD_OK;
 }
 
 /* ---- the face search ---- */

@@ -114,7 +114,10 @@ sdfccd_ContactParams sdfccd_default_contact_params(void)
     sdfccd_ContactParams c;
     SDFCCD__DEF_BEGIN(c);
     c.query = sdfccd_default_query_params();
-    c.vertex_distance = 1e-3;
-    c.same_place_distance = 1e-4;
+    c.vertex_distance = 0.02;
+    c.same_place_distance = 0.0;
+    c.feature_size = 0.0;
+    c.reduced_count = 0;
+    c.cover_depth = 0.0;
     return c;
 }

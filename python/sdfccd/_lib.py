@@ -299,6 +299,9 @@ class ContactParams(C.Structure):
         ("query", QueryParams),
         ("vertex_distance", C.c_double),
         ("same_place_distance", C.c_double),
+        ("feature_size", C.c_double),
+        ("reduced_count", C.c_int32),
+        ("cover_depth", C.c_double),
         ("internal_value", C.c_int32),
     ]
 
@@ -312,6 +315,10 @@ class ContactSet(C.Structure):
         ("ccd_state", C.c_int32),
         ("toi", C.c_double),
         ("sdf_evaluations", C.c_int64),
+        ("reduced", C.c_int32),
+        ("discrete_queries", C.c_int32),
+        ("own_evaluations", C.c_int64),
+        ("face_regions", C.c_int64),
     ]
 
 

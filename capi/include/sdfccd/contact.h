@@ -191,7 +191,8 @@ typedef enum sdfccd_FeatureKind {
  * the step; a negative gap is a penetration to push out. */
 typedef struct sdfccd_ContactPoint {
     sdfccd_Vec3 point;          /**< The mesh's material point at t0 (world, m). */
-    sdfccd_Vec3 surface_point;  /**< The point of the SDF's surface that holds it, at t0: point - gap * normal (world, m). */
+    sdfccd_Vec3 surface_point;  /**< The point of the SDF's surface that holds it (found at `toi`), at t0 (world, m); gap is
+                                     normal . (point - surface_point). */
     sdfccd_Vec3 normal;         /**< Unit normal out of the SDF (world), at t0. */
     double gap;                 /**< Signed gap at t0 along the normal (m); negative: penetrating. */
     double toi;                 /**< When the constraint was found: t0 for points of the start pose, the time of impact
@@ -286,13 +287,21 @@ SDFCCD_API sdfccd_Status sdfccd_search_faces(sdfccd_Workspace* ws, sdfccd_SdfId 
 /** Settings of contact generation. Must be initialised with sdfccd_default_contact_params(). */
 typedef struct sdfccd_ContactParams {
     sdfccd_QueryParams query;    /**< The CCD of the step (method, caps); `query.margin` is the contact distance: a
-                                      point touches when phi <= margin (default 0). ::SDFCCD_METHOD_DCD gives the
-                                      start-pose points only. */
+                                      point touches when phi <= margin (default 0). ::SDFCCD_METHOD_DCD: the discrete
+                                      baseline (the end pose's query decides whether the step has contact). */
     double vertex_distance;      /**< The vertices of a triangle the CCD finds in contact are points too when they are
-                                      within this of the margin at its time of impact (a face landing flat gives its
-                                      corners). m, >= 0. Default 1e-3. */
+                                      within this (or query.contact_slop, the larger) of the margin at its time of
+                                      impact (a face landing flat gives its corners). m, >= 0. Default 0.02. */
     double same_place_distance;  /**< Points whose surface points are closer than this are one place: the reduction
-                                      keeps one (sdfccd_reduce_contacts()). m, >= 0. Default 1e-4. */
+                                      keeps one. m, >= 0; 0 (default): a thousandth of the mesh's radius, at least 1e-6 m. */
+    double feature_size;         /**< The SDF's smallest feature (m, >= 0): when > 0 and query.subdivision is on, the
+                                      face search (sdfccd_search_faces(), regions of 0.4 x this) adds the points of
+                                      faces larger than the features. Default 0 (off). */
+    int32_t reduced_count;       /**< Points of the reduction (>= 0; 0, the default: the whole capacity). The rest of the
+                                      capacity is for cover points (cover_depth). */
+    double cover_depth;          /**< When > 0: after the reduction, cover points (sdfccd_cover_contacts()) with this
+                                      depth and the body's turn over the step fill the rest of the capacity. m, >= 0.
+                                      Default 0 (none). */
     int32_t internal_value;      /**< Set by sdfccd_default_contact_params(); do not change. */
 } sdfccd_ContactParams;
 
@@ -301,37 +310,75 @@ SDFCCD_API sdfccd_ContactParams sdfccd_default_contact_params(void);
 
 /** Summary of a contact set. */
 typedef struct sdfccd_ContactSet {
-    int32_t count;               /**< Points written: the reduction of the candidates to the caller's capacity. */
+    int32_t count;               /**< Points written: the reduction of the candidates to the caller's capacity, then
+                                      any cover points. */
     int32_t candidates;          /**< Candidates found before the reduction. */
     int32_t started_in_contact;  /**< 1 when a point of the start pose was within the margin (the CCD is then not
                                       run: it could only report contact at t0). */
     int32_t ccd_ran;             /**< 1 when the CCD ran over the step. */
     sdfccd_ResultState ccd_state; /**< Its state (::SDFCCD_STATE_NO_HIT when it did not run). */
     double toi;                  /**< The CCD's first time of impact; t0 when started in contact; t1 when none. */
-    int64_t sdf_evaluations;     /**< SDF evaluations of the call. */
+    int64_t sdf_evaluations;     /**< SDF evaluations of the call (all of them). */
+    int32_t reduced;             /**< The first `reduced` points are the reduction, the rest (count - reduced) cover points. */
+    int32_t discrete_queries;    /**< Discrete mesh queries run (start pose, end pose). */
+    int64_t own_evaluations;     /**< Of sdf_evaluations, those outside the mesh queries and the face search (the
+                                      closest surface points at t0 of the discrete queries' points and vertices). */
+    int64_t face_regions;        /**< Regions the face search visited. */
 } sdfccd_ContactSet;
 
 /** The contact set an engine needs for one mesh against one SDF over a step [t0, t1]: points with
  * normal, signed gap at t0, time of impact, triangle and a feature id stable across steps (see
- * ::sdfccd_ContactPoint). The candidates:
- *  - the start pose within the step's reach: every triangle whose deepest point (DCD, with adaptive
- *    subdivision when query.subdivision is on) at t0 lies within margin + the farthest any point can
- *    travel in the step, and those triangles' vertices within that distance, each held by its own
- *    closest surface point at t0;
- *  - unless one of those already touches (gap <= margin), the CCD's contact set at the first time of
- *    impact (sdfccd_query_mesh_ws()) and the vertices of its triangles within vertex_distance of the
- *    margin then, each held by the surface point and normal it touches there, its gap measured at t0
- *    along that normal (a speculative contact: the solver may close at most the gap in the step).
- * When nothing lies within reach at t0, the step has no contact and the call costs one broad-phase
- * pass. The candidates are reduced to `capacity` points by sdfccd_reduce_contacts() (deepest first,
- * then area; never a prefix of the set). Uses the workspace: no allocation after a first call of a
- * given size. Errors: as sdfccd_query_mesh_ws(), params not from sdfccd_default_contact_params(),
- * vertex_distance or same_place_distance not finite and >= 0, out_points NULL with capacity > 0;
- * on error nothing is written. */
+ * ::sdfccd_ContactPoint), each held by a surface point and normal found at some time in the step
+ * and expressed at t0 (a speculative contact: the solver may close at most the gap in the step).
+ * Let R be the mesh's radius (the largest distance of a vertex from its centre of rotation) and
+ * the reach the farthest any point can travel relative to the SDF in the step. In order:
+ *  1. a discrete query (DCD, subdivision regions not below (0.1 R)^2) at t0 with margin + reach:
+ *     when its broad phase culls every triangle the step has no contact (nothing else runs);
+ *  2. with feature_size > 0 and query.subdivision on, the face search at t0 within margin + reach;
+ *  3. unless a point of 1 or 2 is already within the margin, the CCD over the step: its contact set
+ *     at the first time of impact (each point held by the surface point and normal it touches
+ *     there) and the vertices of those triangles within vertex_distance of the margin then. No hit:
+ *     no contact (but the face search's points and then 1's count);
+ *  4. the points of 1 and those of a discrete query at t1 within the margin, and the vertices of
+ *     their triangles within the same distance at that pose, each held by its own closest surface
+ *     point at t0 (1's within margin + reach; with a start in contact, at least margin + vertex_distance).
+ * With query.method ::SDFCCD_METHOD_DCD, 3's query is the end pose's and 1 runs after it when the
+ * step has contact; with t1 == t0 only 3 runs (closest points at that pose).
+ * The candidates are reduced to min(capacity, reduced_count) points by the weighted reduction
+ * (sdfccd_reduce_contacts_weighted() with depth scale min(0.1 R, 0.3 m); never a prefix of the
+ * set), then cover points fill the rest of the capacity when cover_depth > 0. With a static SDF
+ * (sdf_motion NULL or at rest) the field is evaluated in its own frame. Uses the workspace: no
+ * allocation after a first call of a given size. Errors: as sdfccd_query_mesh_ws(), params not from
+ * sdfccd_default_contact_params(), a distance not finite and >= 0, reduced_count < 0, out_points
+ * NULL with capacity > 0; on error nothing is written. */
 SDFCCD_API sdfccd_Status sdfccd_generate_contacts(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
                                                   sdfccd_MeshId mesh, const sdfccd_RigidMotion* motion, double t0, double t1,
                                                   const sdfccd_ContactParams* params, sdfccd_ContactPoint* out_points,
                                                   int32_t capacity, sdfccd_ContactSet* out_set);
+
+/** One pair of sdfccd_generate_contacts_batch(): the arguments of sdfccd_generate_contacts() and
+ * its status. */
+typedef struct sdfccd_ContactPair {
+    sdfccd_SdfId sdf;
+    const sdfccd_RigidMotion* sdf_motion; /**< NULL: a static SDF at the origin. */
+    sdfccd_MeshId mesh;
+    const sdfccd_RigidMotion* motion;
+    double t0, t1;
+    const sdfccd_ContactParams* params;
+    sdfccd_ContactPoint* out_points;
+    int32_t capacity;
+    sdfccd_ContactSet* out_set;
+    sdfccd_Status status;                 /**< Written: the pair's status. */
+} sdfccd_ContactPair;
+
+/** sdfccd_generate_contacts() for `count` pairs on `thread_count` threads (the calling thread and
+ * thread_count - 1 more), thread k with workspaces[k]: no allocation after a first call of a given
+ * size. Each pair's result is exactly the single call's, whatever the thread count. Returns the
+ * first failing pair's status (its message in sdfccd_last_error()), the others are still run.
+ * Errors (::SDFCCD_INVALID_ARGUMENT): pairs or workspaces NULL (pairs may be NULL when count is 0),
+ * count < 0, thread_count outside [1, 256], a NULL workspace. */
+SDFCCD_API sdfccd_Status sdfccd_generate_contacts_batch(sdfccd_Workspace* const* workspaces, int32_t thread_count,
+                                                        sdfccd_ContactPair* pairs, int32_t count);
 
 /** sdfccd_generate_contacts() for a deforming mesh (cloth, soft bodies): the mesh's topology with
  * per-vertex world positions at t0 (`start`) and t1 (`end`), vertex_count each, moving linearly. */
