@@ -359,15 +359,16 @@ SDFCCD_API sdfccd_Status sdfccd_generate_contacts(sdfccd_Workspace* ws, sdfccd_S
 /** One pair of sdfccd_generate_contacts_batch(): the arguments of sdfccd_generate_contacts() and
  * its status. */
 typedef struct sdfccd_ContactPair {
-    sdfccd_SdfId sdf;
+    sdfccd_SdfId sdf;                     /**< The SDF. */
     const sdfccd_RigidMotion* sdf_motion; /**< NULL: a static SDF at the origin. */
-    sdfccd_MeshId mesh;
-    const sdfccd_RigidMotion* motion;
-    double t0, t1;
-    const sdfccd_ContactParams* params;
-    sdfccd_ContactPoint* out_points;
-    int32_t capacity;
-    sdfccd_ContactSet* out_set;
+    sdfccd_MeshId mesh;                   /**< The mesh. */
+    const sdfccd_RigidMotion* motion;     /**< The mesh's rigid motion over [t0, t1]. */
+    double t0;                            /**< Start of the step (s). */
+    double t1;                            /**< End of the step (s). */
+    const sdfccd_ContactParams* params;   /**< From sdfccd_default_contact_params(). */
+    sdfccd_ContactPoint* out_points;      /**< Room for `capacity` points (the reduction when the set is larger). */
+    int32_t capacity;                     /**< Size of out_points. */
+    sdfccd_ContactSet* out_set;           /**< Written: the set's summary. */
     sdfccd_Status status;                 /**< Written: the pair's status. */
 } sdfccd_ContactPair;
 
