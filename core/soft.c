@@ -67,6 +67,24 @@ int scc_triangle_lower_bound(const scc_sdf* sdf, scc_vec3 p0, scc_vec3 p1, scc_v
     return 1;
 }
 
+int scc_guard_point(const scc_sdf* sdf, const scc_cert* cert, scc_vec3 s, scc_vec3 e, double tol, double L, int* out_clear,
+                    double* out_level, double* out_f, scc_vec3* out_grad, int64_t* io_evals)
+{
+    *out_level = -tol;
+    *out_clear = scc_cert_bound(cert, &s, &e, 1, L) >= -tol;
+    if (*out_clear) return 0;
+    const double phi_s = scc_sdf_eval(sdf, s, NULL);
+    ++*io_evals;
+    if (phi_s < -tol) *out_level = phi_s - 0.1 * tol; /* no deeper than it started */
+    double f, phi, fh, phih;
+    scc_vec3 g, gh;
+    if (!scc_point_first_hit(sdf, s, e, *out_level, L, &f, &phi, &g, NULL, io_evals)) return 0;
+    if (scc_point_first_hit(sdf, s, e, *out_level + 0.5 * tol, L, &fh, &phih, &gh, NULL, io_evals) && fh < f) f = fh;
+    *out_f = f;
+    *out_grad = g;
+    return 1;
+}
+
 int scc_face_clear(const scc_sdf* sdf, scc_cert* cert, const scc_vec3 s[3], const scc_vec3 e[3], double need, double L,
                    int64_t* io_evals)
 {

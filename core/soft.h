@@ -39,4 +39,13 @@ int scc_triangle_lower_bound(const scc_sdf* sdf, scc_vec3 p0, scc_vec3 p1, scc_v
 int scc_face_clear(const scc_sdf* sdf, scc_cert* cert, const scc_vec3 s[3], const scc_vec3 e[3], double need, double L,
                    int64_t* io_evals);
 
+/* The guard of one node moving linearly from s to e (L-Lipschitz phi): its path may not go below
+ * level = -tol, or, when it starts deeper than tol, below its start depth minus 0.1 tol. Returns 1
+ * when the path crosses its level, with *out_f the first reach of level + tol / 2 when that comes
+ * earlier than the first reach of the level (so the next step does not start at the level), else
+ * of the level, and *out_grad phi's gradient at the first reach of the level. *out_clear = 1 when
+ * *cert alone keeps the path above -tol (no evaluation; *out_level = -tol). */
+int scc_guard_point(const scc_sdf* sdf, const scc_cert* cert, scc_vec3 s, scc_vec3 e, double tol, double L, int* out_clear,
+                    double* out_level, double* out_f, scc_vec3* out_grad, int64_t* io_evals);
+
 #endif

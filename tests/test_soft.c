@@ -196,6 +196,61 @@ START_TEST(test_face_interior_crossing_not_certified)
 }
 END_TEST
 
+/* The guard of one node against a half-space z >= 0 (tolerance 0.01), every answer in closed form:
+ * a node falling through goes back to where it came within half the tolerance of -tolerance; a node
+ * starting 5 cm deep may not end deeper than it started (minus a tenth of the tolerance) and goes
+ * back to its start, or stays where it went when it rises; a certificate clears a resting node
+ * with no evaluation. */
+START_TEST(test_guard_point_half_space)
+{
+    sdfccd_SdfId plane;
+    ck_assert(sdfccd_create_half_space(v3(0, 0, 1), 0, &plane) == SDFCCD_OK);
+    const double tol = 0.01;
+    const sdfccd_DistanceCert none = sdfccd_empty_distance_cert();
+    sdfccd_PointGuard g;
+    int64_t evals = 0;
+    ck_assert_msg(sdfccd_guard_point(plane, &none, v3(0.2, 0.1, 0.5), v3(0.2, 0.1, -0.5), tol, 1.0, &g, &evals) == SDFCCD_OK, "%s",
+                  sdfccd_last_error());
+    ck_assert_int_eq(g.clear, 0);
+    ck_assert_double_eq(g.level, -tol);
+    ck_assert_int_eq(g.hit, 1);
+    ck_assert_double_eq_tol(g.fraction, (0.5 + 0.5 * tol) / 1.0, 1e-9); /* z = -tol / 2, not z = -tol */
+    ck_assert_double_eq_tol(g.gradient.z, 1.0, 1e-12);
+    ck_assert_int_eq(evals, 5); /* the start's depth, then two paths of two evaluations */
+    /* Starting 5 cm deep, sinking to 20 cm: held at -0.051, back to the start. */
+    ck_assert(sdfccd_guard_point(plane, &none, v3(0, 0, -0.05), v3(0, 0, -0.2), tol, 1.0, &g, NULL) == SDFCCD_OK);
+    ck_assert_double_eq_tol(g.level, -0.05 - 0.1 * tol, 1e-15);
+    ck_assert_int_eq(g.hit, 1);
+    ck_assert_double_eq(g.fraction, 0.0);
+    /* Starting as deep but rising: no hit at its level. */
+    ck_assert(sdfccd_guard_point(plane, &none, v3(0, 0, -0.05), v3(0, 0, 0.3), tol, 1.0, &g, NULL) == SDFCCD_OK);
+    ck_assert_double_eq_tol(g.level, -0.05 - 0.1 * tol, 1e-15);
+    ck_assert_int_eq(g.hit, 0);
+    /* A resting node: a certificate phi >= 1 at z = 1 clears a 20 cm motion (1 - 0.2 >= -tol) with no
+     * evaluation; without it the node costs evaluations and is not hit. */
+    sdfccd_DistanceCert c = sdfccd_empty_distance_cert();
+    c.anchor[0] = v3(0, 0, 1);
+    c.bound = 1.0;
+    evals = 0;
+    ck_assert(sdfccd_guard_point(plane, &c, v3(0, 0, 1), v3(0, 0, 0.8), tol, 1.0, &g, &evals) == SDFCCD_OK);
+    ck_assert_int_eq(g.clear, 1);
+    ck_assert_int_eq(g.hit, 0);
+    ck_assert_int_eq(evals, 0);
+    ck_assert(sdfccd_guard_point(plane, &none, v3(0, 0, 1), v3(0, 0, 0.8), tol, 1.0, &g, &evals) == SDFCCD_OK);
+    ck_assert_int_eq(g.clear, 0);
+    ck_assert_int_eq(g.hit, 0);
+    ck_assert_int_gt(evals, 0);
+    /* Bad input: nothing written. */
+    memset(&g, 0x5a, sizeof g);
+    const sdfccd_PointGuard before = g;
+    ck_assert_int_eq(sdfccd_guard_point(plane, &none, v3(0, 0, 1), v3(0, 0, 0.8), 0.0, 1.0, &g, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_point(plane, &none, v3(0, 0, NAN), v3(0, 0, 0.8), tol, 1.0, &g, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_point(plane, NULL, v3(0, 0, 1), v3(0, 0, 0.8), tol, 1.0, &g, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(memcmp(&g, &before, sizeof g) == 0);
+    ck_assert(sdfccd_destroy_sdf(plane) == SDFCCD_OK);
+}
+END_TEST
+
 START_TEST(test_soft_bad_input)
 {
     sdfccd_SdfId s = sphere(1.0);
@@ -250,6 +305,7 @@ int main(void)
     tcase_add_test(tc, test_face_far_certified);
     tcase_add_test(tc, test_face_near_certified_by_splitting);
     tcase_add_test(tc, test_face_interior_crossing_not_certified);
+    tcase_add_test(tc, test_guard_point_half_space);
     tcase_add_test(tc, test_soft_bad_input);
     suite_add_tcase(s, tc);
     return test_run_suite(s);

@@ -414,19 +414,6 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     std::vector<double> level((size_t)nn, -tol);
     std::vector<D3> S((size_t)nn);
     rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
-    std::vector<char> clear((size_t)nn, 0);
-    for (int i = 0; i < nn; ++i) {
-        S[(size_t)i] = F0.toLocal(rec.start[(size_t)i]);
-        const D3 e = F.toLocal(d3(psb->m_nodes[i].m_x));
-        Cert& cert = rec.node_certs[(size_t)i];
-        if (certBound(cert, &S[(size_t)i], &e, 1, L) >= -tol) {
-            clear[(size_t)i] = 1; // its whole path stays above -tol
-            continue;
-        }
-        double phi;
-        if (sdfccd_sdf_eval(rec.sdf, sv(S[(size_t)i]), &phi, nullptr) == SDFCCD_OK && phi < -tol) level[(size_t)i] = phi - 0.1 * tol; // no deeper than it started
-        ++evals;
-    }
     auto endOf = [&](int i) { return F.toLocal(d3(psb->m_nodes[i].m_x)); };
     std::vector<char> touched((size_t)nn, 0), touched_next((size_t)nn, 0);
     // Bullet's own rule after its position solve: v = (x - q) / dt, damped by kDP.
@@ -440,19 +427,16 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
         moved[(size_t)i] = 1;
         touched_next[(size_t)i] = 1;
     };
-    // Nodes.
+    // Nodes (sdfccd_guard_point: each one's level, and where it goes back to).
     for (int i = 0; i < nn; ++i) {
-        if (clear[(size_t)i]) continue;
-        double f, phi;
-        D3 g;
+        S[(size_t)i] = F0.toLocal(rec.start[(size_t)i]);
         const D3 e = endOf(i);
-        if (!pointHit(rec.sdf, S[(size_t)i], e, level[(size_t)i], L, &f, &phi, &g, &evals)) continue;
-        // Back to where it first reached half that depth, so the next step does not start at its level.
-        double fh, phih;
-        D3 gh;
-        if (pointHit(rec.sdf, S[(size_t)i], e, level[(size_t)i] + 0.5 * tol, L, &fh, &phih, &gh, &evals) && fh < f) f = fh;
-        setEnd(i, S[(size_t)i] + (e - S[(size_t)i]) * f);
-        stopInto(psb->m_nodes[i], F.dirToWorld(unit(g)));
+        sdfccd_PointGuard pg;
+        if (sdfccd_guard_point(rec.sdf, &rec.node_certs[(size_t)i], sv(S[(size_t)i]), sv(e), tol, L, &pg, &evals) != SDFCCD_OK) continue;
+        level[(size_t)i] = pg.level;
+        if (!pg.hit) continue;
+        setEnd(i, S[(size_t)i] + (e - S[(size_t)i]) * pg.fraction);
+        stopInto(psb->m_nodes[i], F.dirToWorld(unit(fromSv(pg.gradient))));
     }
     // Faces, repeated while a pass moves nodes (a moved node changes its faces' motion).
     const double dt = psb->m_sst.sdt > 0 ? psb->m_sst.sdt : 1.0;

@@ -113,3 +113,36 @@ sdfccd_Status sdfccd_triangle_clear(sdfccd_SdfId sdf, sdfccd_DistanceCert* cert,
 {
     SDFCCD__HELD_CALL(triangle_clear_held(sdf, cert, start, end, level, lipschitz, out_clear, io_sdf_evaluations));
 }
+
+static sdfccd_Status guard_point_held(sdfccd_SdfId sdf, const sdfccd_DistanceCert* cert, sdfccd_Vec3 start, sdfccd_Vec3 end, double tol,
+                                     double lipschitz, sdfccd_PointGuard* out, int64_t* io_evals)
+{
+    static const char fn[] = "sdfccd_guard_point";
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(cert, "sdfccd_guard_point: cert")) || (st = sdfccd__check_ptr(out, "sdfccd_guard_point: out")) ||
+        (st = sdfccd__check_vec(start, "sdfccd_guard_point: start")) || (st = sdfccd__check_vec(end, "sdfccd_guard_point: end")) ||
+        (st = check_lipschitz(lipschitz, fn)))
+        return st;
+    if (!(isfinite(tol) && tol > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: tolerance = %g is not finite and > 0", fn, tol);
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
+    if (!s) return SDFCCD_INVALID_HANDLE;
+    int64_t evals = 0;
+    int clear = 0;
+    double level = -tol, f = 0;
+    scc_vec3 g = scc_v3(0, 0, 0);
+    const scc_cert c = to_cert(cert);
+    const int hit = scc_guard_point(s->sdf, &c, sdfccd__v(start), sdfccd__v(end), tol, lipschitz, &clear, &level, &f, &g, &evals);
+    out->clear = clear;
+    out->level = level;
+    out->hit = hit;
+    out->fraction = hit ? f : 0;
+    out->gradient = hit ? sdfccd__pv(g) : sdfccd__pv(scc_v3(0, 0, 0));
+    if (io_evals) *io_evals += evals;
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_guard_point(sdfccd_SdfId sdf, const sdfccd_DistanceCert* cert, sdfccd_Vec3 start, sdfccd_Vec3 end, double tolerance,
+                                 double lipschitz, sdfccd_PointGuard* out, int64_t* io_sdf_evaluations)
+{
+    SDFCCD__HELD_CALL(guard_point_held(sdf, cert, start, end, tolerance, lipschitz, out, io_sdf_evaluations));
+}

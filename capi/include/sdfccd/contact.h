@@ -406,6 +406,26 @@ SDFCCD_API sdfccd_Status sdfccd_triangle_clear(sdfccd_SdfId sdf, sdfccd_Distance
                                                const sdfccd_Vec3 end[3], double level, double lipschitz, int32_t* out_clear,
                                                int64_t* io_sdf_evaluations);
 
+/** The guard's verdict on one node over a step (sdfccd_guard_point()). */
+typedef struct sdfccd_PointGuard {
+    int32_t clear;        /**< 1 when the certificate alone keeps the path above -tolerance (no SDF evaluation) */
+    double level;         /**< the level the path is held to: -tolerance, or (a start deeper than the tolerance) the start's phi - 0.1 tolerance */
+    int32_t hit;          /**< 1 when the path goes below `level`: the node goes back to `fraction` */
+    double fraction;      /**< where it goes back to, in [0, 1]: the first reach of level + tolerance / 2 when earlier than the first reach of level (0 when not hit) */
+    sdfccd_Vec3 gradient; /**< the SDF's gradient at the first reach of `level` (SDF frame, not normalised; the direction to stop the node's velocity along) */
+} sdfccd_PointGuard;
+
+/** The no-tunnelling guard for one point moving linearly from start to end (SDF frame): its path may
+ * not go deeper than the tolerance, nor, when it starts deeper, deeper than it started (minus a tenth
+ * of the tolerance). A path that does goes back to where it first came within half the tolerance of
+ * that level (sdfccd_point_first_hit(), so never late). `cert` (e.g. from a previous step's
+ * sdfccd_point_first_hit() start distance, anchored at that start) skips every evaluation when it
+ * keeps the path above -tolerance. Adds the SDF evaluations to *io_sdf_evaluations (may be NULL).
+ * Errors (nothing written): INVALID_HANDLE, INVALID_ARGUMENT for a NULL cert or out, start or end
+ * not finite, tolerance or lipschitz not finite and > 0. */
+SDFCCD_API sdfccd_Status sdfccd_guard_point(sdfccd_SdfId sdf, const sdfccd_DistanceCert* cert, sdfccd_Vec3 start, sdfccd_Vec3 end,
+                                            double tolerance, double lipschitz, sdfccd_PointGuard* out, int64_t* io_sdf_evaluations);
+
 #ifdef __cplusplus
 }
 #endif
