@@ -85,6 +85,28 @@ int scc_guard_point(const scc_sdf* sdf, const scc_cert* cert, scc_vec3 s, scc_ve
     return 1;
 }
 
+int scc_segment_first_hit(const scc_sdf* sdf, scc_vec3 s0, scc_vec3 s1, scc_vec3 e0, scc_vec3 e1, double level, double spacing, double L,
+                          double* out_f, scc_vec3* out_grad, int64_t* io_evals)
+{
+    const double longest = max2(scc_dist(s1, s0), scc_dist(e1, e0));
+    const int n = 1 + (int)ceil(longest / spacing);
+    double first = 2;
+    for (int k = 1; k < n; ++k) {
+        const double w = (double)k / n, h = longest / n;
+        double f, phi;
+        scc_vec3 g;
+        if (scc_point_first_hit(sdf, scc_add(scc_scale(s0, 1 - w), scc_scale(s1, w)), scc_add(scc_scale(e0, 1 - w), scc_scale(e1, w)),
+                                level + 0.5 * L * h, L, &f, &phi, &g, NULL, io_evals) &&
+            f < first) {
+            first = f;
+            *out_grad = g;
+        }
+    }
+    if (first > 1) return 0;
+    *out_f = first;
+    return 1;
+}
+
 int scc_face_clear(const scc_sdf* sdf, scc_cert* cert, const scc_vec3 s[3], const scc_vec3 e[3], double need, double L,
                    int64_t* io_evals)
 {

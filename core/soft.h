@@ -36,6 +36,13 @@ int scc_triangle_lower_bound(const scc_sdf* sdf, scc_vec3 p0, scc_vec3 p1, scc_v
 /* Is the triangle moving linearly from s[] to e[] certified above need? First by *cert, else by a
  * new bound at s[] (scc_triangle_lower_bound, depth 3, need raised by L times the largest corner
  * motion), which then replaces *cert. Returns 1 when certified, 0 otherwise (*cert unchanged). */
+/* The first fraction where points of a segment moving linearly (s0 s1 -> e0 e1) reach `level`:
+ * n - 1 inner points every h <= spacing along it (n = 1 + ceil(longest length / spacing)), each path
+ * held to level + L h / 2, so no point between two of them goes below level earlier. Returns 1 with
+ * *out_f and *out_grad (phi's gradient there), 0 when none reaches it. */
+int scc_segment_first_hit(const scc_sdf* sdf, scc_vec3 s0, scc_vec3 s1, scc_vec3 e0, scc_vec3 e1, double level, double spacing, double L,
+                          double* out_f, scc_vec3* out_grad, int64_t* io_evals);
+
 int scc_face_clear(const scc_sdf* sdf, scc_cert* cert, const scc_vec3 s[3], const scc_vec3 e[3], double need, double L,
                    int64_t* io_evals);
 

@@ -251,6 +251,37 @@ START_TEST(test_guard_point_half_space)
 }
 END_TEST
 
+/* A 4 m link lying flat 2 m above a unit sphere's centre sinks to 0.5 m: its ends stay 1 m clear
+ * while its middle crosses. The first hit comes no later than the middle point's first reach of the
+ * level (closed form: z = 1 + level) and no earlier than its reach of level + L spacing. */
+START_TEST(test_segment_sphere_closed_form)
+{
+    sdfccd_SdfId s = sphere(1.0);
+    const double level = 0.05, spacing = 0.1, z0 = 2.0, z1 = 0.5;
+    const sdfccd_Vec3 st[2] = { v3(-2, 0, z0), v3(2, 0, z0) }, en[2] = { v3(-2, 0, z1), v3(2, 0, z1) };
+    sdfccd_PointHit h;
+    int64_t evals = 0;
+    ck_assert_msg(sdfccd_segment_first_hit(s, st, en, level, spacing, 1.0, &h, &evals) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert_int_eq(h.hit, 1);
+    const double late = (z0 - (1 + level)) / (z0 - z1), early = (z0 - (1 + level + spacing)) / (z0 - z1);
+    ck_assert_msg(h.fraction <= late && h.fraction >= early, "fraction %.17g outside [%.17g, %.17g]", h.fraction, early, late);
+    ck_assert(h.gradient.z > 0.99);
+    ck_assert_int_gt(evals, 40); /* 41 points along the link */
+    /* Passing 0.2 beside the sphere never reaches level 0.05. */
+    const sdfccd_Vec3 st2[2] = { v3(-2, 1.2, z0), v3(2, 1.2, z0) }, en2[2] = { v3(-2, 1.2, -z0), v3(2, 1.2, -z0) };
+    ck_assert(sdfccd_segment_first_hit(s, st2, en2, level, spacing, 1.0, &h, NULL) == SDFCCD_OK);
+    ck_assert_int_eq(h.hit, 0);
+    /* Bad input: nothing written. */
+    memset(&h, 0x5a, sizeof h);
+    const sdfccd_PointHit before = h;
+    ck_assert_int_eq(sdfccd_segment_first_hit(s, st, en, level, 0.0, 1.0, &h, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_segment_first_hit(s, st, en, level, 1e-9, 1.0, &h, NULL), SDFCCD_INVALID_ARGUMENT); /* 4e9 points */
+    ck_assert_int_eq(sdfccd_segment_first_hit(s, NULL, en, level, spacing, 1.0, &h, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(memcmp(&h, &before, sizeof h) == 0);
+    ck_assert(sdfccd_destroy_sdf(s) == SDFCCD_OK);
+}
+END_TEST
+
 START_TEST(test_soft_bad_input)
 {
     sdfccd_SdfId s = sphere(1.0);
@@ -306,6 +337,7 @@ int main(void)
     tcase_add_test(tc, test_face_near_certified_by_splitting);
     tcase_add_test(tc, test_face_interior_crossing_not_certified);
     tcase_add_test(tc, test_guard_point_half_space);
+    tcase_add_test(tc, test_segment_sphere_closed_form);
     tcase_add_test(tc, test_soft_bad_input);
     suite_add_tcase(s, tc);
     return test_run_suite(s);

@@ -456,20 +456,11 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
             const D3 s[3] = { S[(size_t)a], S[(size_t)b], S[(size_t)b] }, e[3] = { endOf(a), endOf(b), endOf(b) };
             const double lev = std::min(level[(size_t)a], level[(size_t)b]);
             if (faceClear(rec.sdf, rec.face_certs[(size_t)(psb->m_faces.size() + li)], s, e, lev, L, &evals)) continue;
-            const int n = 1 + (int)std::ceil(std::max(len(s[1] - s[0]), len(e[1] - e[0])) / (0.5 * tol));
-            double first = 2;
-            D3 grad{ 0, 0, 1 };
-            for (int k = 1; k < n; ++k) {
-                const double w = (double)k / n, h = std::max(len(s[1] - s[0]), len(e[1] - e[0])) / n;
-                double f, phi;
-                D3 g;
-                if (pointHit(rec.sdf, s[0] * (1 - w) + s[1] * w, e[0] * (1 - w) + e[1] * w, lev + 0.5 * L * h, L, &f, &phi, &g, &evals) &&
-                    f < first) {
-                    first = f;
-                    grad = g;
-                }
-            }
-            if (first > 1) continue;
+            const sdfccd_Vec3 ss[2] = { sv(s[0]), sv(s[1]) }, ee[2] = { sv(e[0]), sv(e[1]) };
+            sdfccd_PointHit hit;
+            if (sdfccd_segment_first_hit(rec.sdf, ss, ee, lev, 0.5 * tol, L, &hit, &evals) != SDFCCD_OK || !hit.hit) continue;
+            const double first = hit.fraction;
+            const D3 grad = fromSv(hit.gradient);
             const double f = pass >= passes ? 0.0 : first;
             for (int k = 0; k < 2; ++k) {
                 setEnd(k ? b : a, s[k] + (e[k] - s[k]) * f);

@@ -146,3 +146,40 @@ sdfccd_Status sdfccd_guard_point(sdfccd_SdfId sdf, const sdfccd_DistanceCert* ce
 {
     SDFCCD__HELD_CALL(guard_point_held(sdf, cert, start, end, tolerance, lipschitz, out, io_sdf_evaluations));
 }
+
+static sdfccd_Status segment_first_hit_held(sdfccd_SdfId sdf, const sdfccd_Vec3* start, const sdfccd_Vec3* end, double level, double spacing,
+                                           double lipschitz, sdfccd_PointHit* out, int64_t* io_evals)
+{
+    static const char fn[] = "sdfccd_segment_first_hit";
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(start, "sdfccd_segment_first_hit: start")) || (st = sdfccd__check_ptr(end, "sdfccd_segment_first_hit: end")) ||
+        (st = sdfccd__check_ptr(out, "sdfccd_segment_first_hit: out")) || (st = sdfccd__check_finite(level, "sdfccd_segment_first_hit: level")) ||
+        (st = check_lipschitz(lipschitz, fn)))
+        return st;
+    for (int k = 0; k < 2; ++k)
+        if ((st = sdfccd__check_vec(start[k], "sdfccd_segment_first_hit: a start end")) || (st = sdfccd__check_vec(end[k], "sdfccd_segment_first_hit: an end end")))
+            return st;
+    if (!(isfinite(spacing) && spacing > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: spacing = %g is not finite and > 0", fn, spacing);
+    const scc_vec3 s0 = sdfccd__v(start[0]), s1 = sdfccd__v(start[1]), e0 = sdfccd__v(end[0]), e1 = sdfccd__v(end[1]);
+    const double longest = fmax(scc_dist(s1, s0), scc_dist(e1, e0));
+    if (!(longest / spacing <= 1e6)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %g points (at most 1e6)", fn, longest / spacing);
+    sdfccd__sdf* s = sdfccd__sdf_acquire(sdf);
+    if (!s) return SDFCCD_INVALID_HANDLE;
+    int64_t evals = 0;
+    double f = 0;
+    scc_vec3 g = scc_v3(0, 0, 0);
+    const int hit = scc_segment_first_hit(s->sdf, s0, s1, e0, e1, level, spacing, lipschitz, &f, &g, &evals);
+    out->hit = hit;
+    out->fraction = hit ? f : 0;
+    out->distance = 0;
+    out->gradient = hit ? sdfccd__pv(g) : sdfccd__pv(scc_v3(0, 0, 0));
+    out->start_distance = 0;
+    if (io_evals) *io_evals += evals;
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_segment_first_hit(sdfccd_SdfId sdf, const sdfccd_Vec3 start[2], const sdfccd_Vec3 end[2], double level, double spacing,
+                                       double lipschitz, sdfccd_PointHit* out, int64_t* io_sdf_evaluations)
+{
+    SDFCCD__HELD_CALL(segment_first_hit_held(sdf, start, end, level, spacing, lipschitz, out, io_sdf_evaluations));
+}

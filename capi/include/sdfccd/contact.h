@@ -426,6 +426,17 @@ typedef struct sdfccd_PointGuard {
 SDFCCD_API sdfccd_Status sdfccd_guard_point(sdfccd_SdfId sdf, const sdfccd_DistanceCert* cert, sdfccd_Vec3 start, sdfccd_Vec3 end,
                                             double tolerance, double lipschitz, sdfccd_PointGuard* out, int64_t* io_sdf_evaluations);
 
+/** Where a segment moving linearly (its ends from start[0], start[1] to end[0], end[1], SDF frame;
+ * a rope's link) first comes down to `level`: its inner points every h <= spacing (h = the longer of
+ * its start and end lengths / n, n = 1 + ceil(that length / spacing)), each path checked by
+ * sdfccd_point_first_hit() at level + lipschitz h / 2, so that no point between two of them reaches
+ * the level first. The ends themselves are not checked (they are nodes). out->start_distance is 0.
+ * Adds the SDF evaluations to *io_sdf_evaluations (may be NULL). Errors (nothing written):
+ * INVALID_HANDLE, INVALID_ARGUMENT for a NULL pointer, an end or level not finite, spacing or
+ * lipschitz not finite and > 0, more than 1e6 points. */
+SDFCCD_API sdfccd_Status sdfccd_segment_first_hit(sdfccd_SdfId sdf, const sdfccd_Vec3 start[2], const sdfccd_Vec3 end[2], double level,
+                                                  double spacing, double lipschitz, sdfccd_PointHit* out, int64_t* io_sdf_evaluations);
+
 #ifdef __cplusplus
 }
 #endif
