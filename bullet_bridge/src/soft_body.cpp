@@ -62,13 +62,9 @@ struct Frame {
     D3 toWorld(D3 p) const { return dirToWorld(p) + o; }
 };
 
-// A lower bound `c` of phi over a triangle (or a point: a[0]) with corners a[] in the SDF's frame:
-// any triangle whose corners stay within d of a[] has phi >= c - L d (L-Lipschitz field). Kept from
-// step to step, so resting nodes and faces cost no SDF evaluation.
-struct Cert {
-    D3 a[3];
-    double c = -HUGE_VAL;
-};
+// A lower bound of phi near a triangle's corners (or a point's) in the SDF's frame (contact.h). Kept
+// from step to step, so resting nodes and faces cost no SDF evaluation.
+using Cert = sdfccd_DistanceCert;
 
 // The step of one (soft body, SDF body) pair, kept for the guard: the nodes' start positions and the
 // SDF body's pose; the certificates of its nodes and faces.
@@ -87,18 +83,18 @@ struct SoftRecord {
     }
     void sizeCerts(int nodes, int faces)
     {
-        if (node_certs.size() != (size_t)nodes) node_certs.assign((size_t)nodes, Cert());
-        if (face_certs.size() != (size_t)faces) face_certs.assign((size_t)faces, Cert());
+        if (node_certs.size() != (size_t)nodes) node_certs.assign((size_t)nodes, sdfccd_empty_distance_cert());
+        if (face_certs.size() != (size_t)faces) face_certs.assign((size_t)faces, sdfccd_empty_distance_cert());
     }
 };
 
-// The certificate's bound over the motion of n corners from x0[] to x1[] (linear: their distance to
-// a[] is largest at an end).
+// The certificate's bound over the motion of n corners from x0[] to x1[] (sdfccd_distance_cert_bound).
 double certBound(const Cert& cert, const D3* x0, const D3* x1, int n, double L)
 {
-    double d = 0;
-    for (int k = 0; k < n; ++k) d = std::max(d, std::max(len(x0[k] - cert.a[k]), len(x1[k] - cert.a[k])));
-    return cert.c - L * d;
+    sdfccd_Vec3 s[3], e[3];
+    for (int k = 0; k < n; ++k) s[k] = sv(x0[k]), e[k] = sv(x1[k]);
+    double b;
+    return sdfccd_distance_cert_bound(&cert, s, e, n, L, &b) == SDFCCD_OK ? b : -HUGE_VAL;
 }
 
 struct SoftState;
@@ -177,35 +173,19 @@ double lipschitzOf(sdfccd_SdfId sdf)
     return info.lipschitz;
 }
 
-// First point of the segment a -> b (SDF frame) where phi <= level + 1e-6, by conservative
-// advancement (phi is `L`-Lipschitz, so a step of (phi - level) / (L |b - a|) cannot jump over the
-// level). Returns false when the segment stays above. Iteration cap: the point reached counts as a
-// hit (early, never late).
+// First point of the segment a -> b (SDF frame) where phi <= level + 1e-6 (sdfccd_point_first_hit:
+// conservative advancement, early, never late); false when the segment stays above. *phi_a: phi at a.
 bool pointHit(sdfccd_SdfId sdf, D3 a, D3 b, double level, double L, double* out_f, double* out_phi, D3* out_grad, int64_t* evals,
               double* phi_a = nullptr)
 {
-    if (phi_a) *phi_a = -HUGE_VAL;
-    const D3 d = b - a;
-    const double length = len(d);
-    double t = 0;
-    for (int it = 0; it < 200; ++it) {
-        sdfccd_Vec3 g;
-        double phi;
-        if (sdfccd_sdf_eval(sdf, sv(a + d * t), &phi, &g) != SDFCCD_OK) return false;
-        ++*evals;
-        if (it == 0 && phi_a) *phi_a = phi;
-        const double gap = phi - level;
-        if (gap <= 1e-6 || it == 199) {
-            *out_f = t;
-            *out_phi = phi;
-            *out_grad = fromSv(g);
-            return true;
-        }
-        if (length * L * (1 - t) < gap) return false;
-        t += gap / (L * length);
-        if (t > 1) return false;
-    }
-    return false;
+    sdfccd_PointHit h;
+    const bool ok = sdfccd_point_first_hit(sdf, sv(a), sv(b), level, L, &h, evals) == SDFCCD_OK;
+    if (phi_a) *phi_a = ok ? h.start_distance : -HUGE_VAL;
+    if (!ok || !h.hit) return false;
+    *out_f = h.fraction;
+    *out_phi = h.distance;
+    *out_grad = fromSv(h.gradient);
+    return true;
 }
 
 D3 unit(D3 v)
@@ -266,39 +246,13 @@ sdfccd_QueryParams faceParams(const BridgeImpl* impl, double level)
     return p;
 }
 
-// A lower bound of phi over the triangle p0 p1 p2: phi at the centroid minus L times the farthest
-// corner, split into four up to `depth` times where that is below `need`; -HUGE_VAL when a piece
-// stays below it (the face is near the surface: the CCD checks it).
-double certify(sdfccd_SdfId sdf, D3 p0, D3 p1, D3 p2, double need, double L, int depth, int64_t* evals)
-{
-    const D3 c = (p0 + p1 + p2) * (1.0 / 3);
-    const double r = std::max(len(p0 - c), std::max(len(p1 - c), len(p2 - c)));
-    double phi;
-    if (sdfccd_sdf_eval(sdf, sv(c), &phi, nullptr) != SDFCCD_OK) return -HUGE_VAL;
-    ++*evals;
-    if (phi - L * r >= need) return phi - L * r;
-    if (depth == 0 || phi < need) return -HUGE_VAL;
-    const D3 m01 = (p0 + p1) * 0.5, m12 = (p1 + p2) * 0.5, m20 = (p2 + p0) * 0.5;
-    const D3 kids[4][3] = { { p0, m01, m20 }, { m01, p1, m12 }, { m20, m12, p2 }, { m01, m12, m20 } };
-    double b = HUGE_VAL;
-    for (const auto& t : kids) {
-        b = std::min(b, certify(sdf, t[0], t[1], t[2], need, L, depth - 1, evals));
-        if (b == -HUGE_VAL) break;
-    }
-    return b;
-}
-
-// Is the face moving from s[] to e[] certified above `need` (an old certificate, or a new one at s[])?
+// Is the face moving from s[] to e[] certified above `need` (an old certificate, or a new one at s[];
+// sdfccd_triangle_clear)?
 bool faceClear(sdfccd_SdfId sdf, Cert& cert, const D3 s[3], const D3 e[3], double need, double L, int64_t* evals)
 {
-    if (certBound(cert, s, e, 3, L) >= need) return true;
-    double move = 0;
-    for (int k = 0; k < 3; ++k) move = std::max(move, len(e[k] - s[k]));
-    const double b = certify(sdf, s[0], s[1], s[2], need + L * move, L, 3, evals);
-    if (b == -HUGE_VAL) return false;
-    for (int k = 0; k < 3; ++k) cert.a[k] = s[k];
-    cert.c = b;
-    return true;
+    const sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
+    int32_t clear = 0;
+    return sdfccd_triangle_clear(sdf, &cert, ss, ee, need, L, &clear, evals) == SDFCCD_OK && clear;
 }
 
 // The SDF body's pose at the start of the step: a kinematic body (or, after the rigid step, any
@@ -364,8 +318,8 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
         const D3 b = F.toLocal(d3(n.m_x)), a = dcd ? b : F.toLocal(d3(n.m_q));
         Cert& cert = rec.node_certs[(size_t)i];
         if (certBound(cert, &a, &b, 1, L) >= margin) continue;
-        const bool hit = pointHit(sdf, a, b, margin, L, &f, &phi, &g, &evals, &cert.c);
-        cert.a[0] = a;
+        const bool hit = pointHit(sdf, a, b, margin, L, &f, &phi, &g, &evals, &cert.bound);
+        cert.anchor[0] = sv(a);
         if (!hit) continue;
         const D3 p = a + (b - a) * f;
         const D3 nl = unit(g);
@@ -460,19 +414,6 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     std::vector<double> level((size_t)nn, -tol);
     std::vector<D3> S((size_t)nn);
     rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
-    std::vector<char> clear((size_t)nn, 0);
-    for (int i = 0; i < nn; ++i) {
-        S[(size_t)i] = F0.toLocal(rec.start[(size_t)i]);
-        const D3 e = F.toLocal(d3(psb->m_nodes[i].m_x));
-        Cert& cert = rec.node_certs[(size_t)i];
-        if (certBound(cert, &S[(size_t)i], &e, 1, L) >= -tol) {
-            clear[(size_t)i] = 1; // its whole path stays above -tol
-            continue;
-        }
-        double phi;
-        if (sdfccd_sdf_eval(rec.sdf, sv(S[(size_t)i]), &phi, nullptr) == SDFCCD_OK && phi < -tol) level[(size_t)i] = phi - 0.1 * tol; // no deeper than it started
-        ++evals;
-    }
     auto endOf = [&](int i) { return F.toLocal(d3(psb->m_nodes[i].m_x)); };
     std::vector<char> touched((size_t)nn, 0), touched_next((size_t)nn, 0);
     // Bullet's own rule after its position solve: v = (x - q) / dt, damped by kDP.
@@ -486,19 +427,16 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
         moved[(size_t)i] = 1;
         touched_next[(size_t)i] = 1;
     };
-    // Nodes.
+    // Nodes (sdfccd_guard_point: each one's level, and where it goes back to).
     for (int i = 0; i < nn; ++i) {
-        if (clear[(size_t)i]) continue;
-        double f, phi;
-        D3 g;
+        S[(size_t)i] = F0.toLocal(rec.start[(size_t)i]);
         const D3 e = endOf(i);
-        if (!pointHit(rec.sdf, S[(size_t)i], e, level[(size_t)i], L, &f, &phi, &g, &evals)) continue;
-        // Back to where it first reached half that depth, so the next step does not start at its level.
-        double fh, phih;
-        D3 gh;
-        if (pointHit(rec.sdf, S[(size_t)i], e, level[(size_t)i] + 0.5 * tol, L, &fh, &phih, &gh, &evals) && fh < f) f = fh;
-        setEnd(i, S[(size_t)i] + (e - S[(size_t)i]) * f);
-        stopInto(psb->m_nodes[i], F.dirToWorld(unit(g)));
+        sdfccd_PointGuard pg;
+        if (sdfccd_guard_point(rec.sdf, &rec.node_certs[(size_t)i], sv(S[(size_t)i]), sv(e), tol, L, &pg, &evals) != SDFCCD_OK) continue;
+        level[(size_t)i] = pg.level;
+        if (!pg.hit) continue;
+        setEnd(i, S[(size_t)i] + (e - S[(size_t)i]) * pg.fraction);
+        stopInto(psb->m_nodes[i], F.dirToWorld(unit(fromSv(pg.gradient))));
     }
     // Faces, repeated while a pass moves nodes (a moved node changes its faces' motion).
     const double dt = psb->m_sst.sdt > 0 ? psb->m_sst.sdt : 1.0;
@@ -518,20 +456,11 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
             const D3 s[3] = { S[(size_t)a], S[(size_t)b], S[(size_t)b] }, e[3] = { endOf(a), endOf(b), endOf(b) };
             const double lev = std::min(level[(size_t)a], level[(size_t)b]);
             if (faceClear(rec.sdf, rec.face_certs[(size_t)(psb->m_faces.size() + li)], s, e, lev, L, &evals)) continue;
-            const int n = 1 + (int)std::ceil(std::max(len(s[1] - s[0]), len(e[1] - e[0])) / (0.5 * tol));
-            double first = 2;
-            D3 grad{ 0, 0, 1 };
-            for (int k = 1; k < n; ++k) {
-                const double w = (double)k / n, h = std::max(len(s[1] - s[0]), len(e[1] - e[0])) / n;
-                double f, phi;
-                D3 g;
-                if (pointHit(rec.sdf, s[0] * (1 - w) + s[1] * w, e[0] * (1 - w) + e[1] * w, lev + 0.5 * L * h, L, &f, &phi, &g, &evals) &&
-                    f < first) {
-                    first = f;
-                    grad = g;
-                }
-            }
-            if (first > 1) continue;
+            const sdfccd_Vec3 ss[2] = { sv(s[0]), sv(s[1]) }, ee[2] = { sv(e[0]), sv(e[1]) };
+            sdfccd_PointHit hit;
+            if (sdfccd_segment_first_hit(rec.sdf, ss, ee, lev, 0.5 * tol, L, &hit, &evals) != SDFCCD_OK || !hit.hit) continue;
+            const double first = hit.fraction;
+            const D3 grad = fromSv(hit.gradient);
             const double f = pass >= passes ? 0.0 : first;
             for (int k = 0; k < 2; ++k) {
                 setEnd(k ? b : a, s[k] + (e[k] - s[k]) * f);

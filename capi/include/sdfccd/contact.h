@@ -397,6 +397,94 @@ SDFCCD_API sdfccd_Status sdfccd_guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId 
                                              double t1, const sdfccd_GuardParams* params, sdfccd_GuardResult* out,
                                              sdfccd_Vec3* out_positions);
 
+/* ---- Per-vertex linear motion (soft bodies, cloth): a point's path to a level and distance
+ * certificates, the steps an engine bridge takes before a face query (Section 4, each vertex moving
+ * linearly; core/soft.c). Every position is in the SDF's frame. ---- */
+
+/** A remembered lower bound of the SDF near some anchors: any point set whose corners each lie
+ * within d of their anchor (a point: anchor[0] alone) has phi >= bound - lipschitz * d. Kept from
+ * step to step, a node or face that stays far from the surface needs no SDF evaluation. Start
+ * from sdfccd_empty_distance_cert() (never a zeroed struct: bound 0 would claim phi >= 0). */
+typedef struct sdfccd_DistanceCert {
+    sdfccd_Vec3 anchor[3]; /**< the corners the bound was found at (SDF frame, length units) */
+    double bound;          /**< phi >= bound at the anchors and minus lipschitz * d within d; -INFINITY: certifies nothing */
+} sdfccd_DistanceCert;
+
+/** A certificate that certifies nothing (bound -INFINITY, anchors at the origin). */
+SDFCCD_API sdfccd_DistanceCert sdfccd_empty_distance_cert(void);
+
+/** The lower bound of phi that `cert` gives over `count` (1..3) corners moving linearly from start[k]
+ * to end[k]: cert->bound - lipschitz * (the largest distance of a corner to its anchor at either end
+ * of its path; linear paths are farthest from a point at an end). No SDF evaluation.
+ * Errors (INVALID_ARGUMENT, nothing written): a NULL pointer, count outside 1..3, lipschitz not
+ * finite and > 0, a start or end corner not finite. */
+SDFCCD_API sdfccd_Status sdfccd_distance_cert_bound(const sdfccd_DistanceCert* cert, const sdfccd_Vec3* start, const sdfccd_Vec3* end,
+                                                    int32_t count, double lipschitz, double* out_bound);
+
+/** Where a point moving linearly first reaches a level of the SDF (sdfccd_point_first_hit()). */
+typedef struct sdfccd_PointHit {
+    int32_t hit;           /**< 1 when the path reaches phi <= level + 1e-6, 0 when it stays above */
+    double fraction;       /**< the first such fraction of the path, in [0, 1] (0 when not hit) */
+    double distance;       /**< phi there */
+    sdfccd_Vec3 gradient;  /**< the SDF's gradient there (SDF frame, not normalised) */
+    double start_distance; /**< phi at the start of the path (always evaluated) */
+} sdfccd_PointHit;
+
+/** The first point of the path start -> end (SDF frame) where phi <= level + 1e-6, by conservative
+ * advancement: with phi `lipschitz`-Lipschitz (at least the SDF's own bound, sdfccd_sdf_get_info()),
+ * a step of (phi - level) / lipschitz along the path cannot jump over the level, so a hit is never
+ * missed and never late. At most 200 evaluations; after them the point reached counts as the hit
+ * (early, never late). A path that starts at or below the level hits at fraction 0. Adds the SDF
+ * evaluations to *io_sdf_evaluations (may be NULL). Errors (nothing written): INVALID_HANDLE,
+ * INVALID_ARGUMENT for out NULL, start, end or level not finite, lipschitz not finite and > 0. */
+SDFCCD_API sdfccd_Status sdfccd_point_first_hit(sdfccd_SdfId sdf, sdfccd_Vec3 start, sdfccd_Vec3 end, double level, double lipschitz,
+                                                sdfccd_PointHit* out, int64_t* io_sdf_evaluations);
+
+/** Is a triangle moving linearly from start[] to end[] (SDF frame) certified to keep phi >= level
+ * everywhere on it over the whole motion? First by *cert (no evaluation); else by a new lower bound
+ * of phi over the start triangle: phi at its centroid minus lipschitz times its radius, split into
+ * four pieces at the edge midpoints (up to 3 times, at most 85 evaluations) where that is too low,
+ * against level + lipschitz times the largest corner motion. A new bound replaces *cert (anchored
+ * at start[]). *out_clear = 0 means "not certified" (the triangle may come near the surface: run
+ * the CCD), never "it hits"; a triangle whose interior comes near the surface while its corners
+ * stay far is never certified. Adds the SDF evaluations to *io_sdf_evaluations (may be NULL).
+ * Errors (nothing written): INVALID_HANDLE, INVALID_ARGUMENT for a NULL pointer, a corner or level
+ * not finite, lipschitz not finite and > 0. */
+SDFCCD_API sdfccd_Status sdfccd_triangle_clear(sdfccd_SdfId sdf, sdfccd_DistanceCert* cert, const sdfccd_Vec3 start[3],
+                                               const sdfccd_Vec3 end[3], double level, double lipschitz, int32_t* out_clear,
+                                               int64_t* io_sdf_evaluations);
+
+/** The guard's verdict on one node over a step (sdfccd_guard_point()). */
+typedef struct sdfccd_PointGuard {
+    int32_t clear;        /**< 1 when the certificate alone keeps the path above -tolerance (no SDF evaluation) */
+    double level;         /**< the level the path is held to: -tolerance, or (a start deeper than the tolerance) the start's phi - 0.1 tolerance */
+    int32_t hit;          /**< 1 when the path goes below `level`: the node goes back to `fraction` */
+    double fraction;      /**< where it goes back to, in [0, 1]: the first reach of level + tolerance / 2 when earlier than the first reach of level (0 when not hit) */
+    sdfccd_Vec3 gradient; /**< the SDF's gradient at the first reach of `level` (SDF frame, not normalised; the direction to stop the node's velocity along) */
+} sdfccd_PointGuard;
+
+/** The no-tunnelling guard for one point moving linearly from start to end (SDF frame): its path may
+ * not go deeper than the tolerance, nor, when it starts deeper, deeper than it started (minus a tenth
+ * of the tolerance). A path that does goes back to where it first came within half the tolerance of
+ * that level (sdfccd_point_first_hit(), so never late). `cert` (e.g. from a previous step's
+ * sdfccd_point_first_hit() start distance, anchored at that start) skips every evaluation when it
+ * keeps the path above -tolerance. Adds the SDF evaluations to *io_sdf_evaluations (may be NULL).
+ * Errors (nothing written): INVALID_HANDLE, INVALID_ARGUMENT for a NULL cert or out, start or end
+ * not finite, tolerance or lipschitz not finite and > 0. */
+SDFCCD_API sdfccd_Status sdfccd_guard_point(sdfccd_SdfId sdf, const sdfccd_DistanceCert* cert, sdfccd_Vec3 start, sdfccd_Vec3 end,
+                                            double tolerance, double lipschitz, sdfccd_PointGuard* out, int64_t* io_sdf_evaluations);
+
+/** Where a segment moving linearly (its ends from start[0], start[1] to end[0], end[1], SDF frame;
+ * a rope's link) first comes down to `level`: its inner points every h <= spacing (h = the longer of
+ * its start and end lengths / n, n = 1 + ceil(that length / spacing)), each path checked by
+ * sdfccd_point_first_hit() at level + lipschitz h / 2, so that no point between two of them reaches
+ * the level first. The ends themselves are not checked (they are nodes). out->start_distance is 0.
+ * Adds the SDF evaluations to *io_sdf_evaluations (may be NULL). Errors (nothing written):
+ * INVALID_HANDLE, INVALID_ARGUMENT for a NULL pointer, an end or level not finite, spacing or
+ * lipschitz not finite and > 0, more than 1e6 points. */
+SDFCCD_API sdfccd_Status sdfccd_segment_first_hit(sdfccd_SdfId sdf, const sdfccd_Vec3 start[2], const sdfccd_Vec3 end[2], double level,
+                                                  double spacing, double lipschitz, sdfccd_PointHit* out, int64_t* io_sdf_evaluations);
+
 #ifdef __cplusplus
 }
 #endif
