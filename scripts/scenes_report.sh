@@ -4,7 +4,7 @@
 # the Bullet re-creations bridge vs stock, and a gallery of snapshots.
 #   scripts/scenes_report.sh [BUILD_DIR] [OUT_DIR]      (defaults: build samples/report)
 # Writes OUT_DIR/scenes.md and OUT_DIR/scenes/*.png. About 10 minutes on 2 cores (cloth-1ms and
-# the 200-body landscape are most of it); set SCENES_REPORT_FAST=1 to skip those two.
+# the 200-body landscapes are most of it); set SCENES_REPORT_FAST=1 to skip those.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 B=${1:-build}
@@ -131,7 +131,7 @@ echo "| scene | variant | max pen. mm | tunnelled | moving at end | rest speed m
 echo "|---|---|---|---|---|---|---|---|"
 } >> "$MD"
 bullet_scenes="gimpact-demo gimpact-shot-50 gimpact-shot-200 gimpact-shot-500 sdf-box sdf-box-btsdf sdf-box-torus sdf-box-btsdf-torus"
-[ "${SCENES_REPORT_FAST:-0}" = 1 ] || bullet_scenes="$bullet_scenes landscape"
+[ "${SCENES_REPORT_FAST:-0}" = 1 ] || bullet_scenes="$bullet_scenes landscape landscape-grid"
 for scene in $bullet_scenes; do
   for v in "bridge:" "stock:--stock"; do
     label=${v%%:*}; args=${v#*:}
