@@ -10,23 +10,14 @@
 set -euo pipefail
 out=${1:?usage: bench_report.sh OUTDIR [--quick|--smoke] [--build BUILDDIR] [--only "names"]}
 shift
-mode=""
-build="$(cd "$(dirname "$0")/.." && pwd)/build"
+. "$(dirname "$0")/lib.sh"
 only="dataset brute accuracy kinds kinds_front front targets scaling batch cost"
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --quick|--smoke) mode="$1" ;;
-    --build) build="$2"; shift ;;
-    --only) only="$2"; shift ;;
-    *) echo "bench_report.sh: unknown option $1" >&2; exit 2 ;;
-  esac
-  shift
-done
+report_options bench_report.sh "--quick --smoke --build --only" "$@"
 bench="$build/samples/sdfccd_bench"
 mkdir -p "$out"
 # The commit line first: writing machine.txt below would itself count as an uncommitted change
 # when OUTDIR is the committed samples/report.
-commit="$(git -C "$(dirname "$0")/.." rev-parse --short=12 HEAD 2>/dev/null || echo unknown)$(git -C "$(dirname "$0")/.." status --porcelain --untracked-files=no 2>/dev/null | grep -q . && echo ' (with uncommitted changes)' || true)"
+commit="$(commit_stamp)"
 {
   echo "Machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'), $(nproc) logical CPUs, $(uname -sr); shared with other users: compare ratios from one run"
   echo "Load average at the start: $(cut -d" " -f1-3 /proc/loadavg) (on $(nproc) CPUs); above the CPU count, timings are contended: trust SDF-evaluation counts and same-run ratios"

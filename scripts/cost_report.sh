@@ -7,16 +7,10 @@
 set -euo pipefail
 out=${1:?usage: cost_report.sh OUTDIR [--build BUILDDIR]}
 shift
-build="$(cd "$(dirname "$0")/.." && pwd)/build"
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build) build="$2"; shift ;;
-    *) echo "cost_report.sh: unknown option $1" >&2; exit 2 ;;
-  esac
-  shift
-done
+. "$(dirname "$0")/lib.sh"
+report_options cost_report.sh "--build" "$@"
 bench="$build/samples/sdfccd_bench"
-commit="$(git -C "$(dirname "$0")/.." rev-parse --short=12 HEAD)$(git -C "$(dirname "$0")/.." status --porcelain --untracked-files=no | grep -q . && echo ' (with uncommitted changes)' || true)"
+commit="$(commit_stamp)"
 note="sdfccd_bench scaling --baseline and cost, then sdfccd_bench_report (scripts/cost_report.sh; the other sections are from earlier runs); Load average at the start: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) CPUs; the code of commit $commit"
 for e in scaling cost; do
   echo "== sdfccd_bench $e --baseline" >&2

@@ -7,18 +7,10 @@
 set -euo pipefail
 out=${1:?usage: kinds_report.sh OUTDIR [--build BUILDDIR] [--before BENCH]}
 shift
-build="$(cd "$(dirname "$0")/.." && pwd)/build"
-before=""
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build) build="$2"; shift ;;
-    --before) before="$2"; shift ;;
-    *) echo "kinds_report.sh: unknown option $1" >&2; exit 2 ;;
-  esac
-  shift
-done
+. "$(dirname "$0")/lib.sh"
+report_options kinds_report.sh "--build --before" "$@"
 bench="$build/samples/sdfccd_bench"
-commit="$(git -C "$(dirname "$0")/.." rev-parse --short=12 HEAD)$(git -C "$(dirname "$0")/.." status --porcelain --untracked-files=no | grep -q . && echo ' (with uncommitted changes)' || true)"
+commit="$(commit_stamp)"
 note="sdfccd_bench kinds --baseline and kinds_front, then sdfccd_bench_report (the other sections are from the earlier full run above); Load average at the start: $(cut -d' ' -f1-3 /proc/loadavg); the code of commit $commit"
 "$bench" kinds --dataset "$out/dataset" --baseline > "$out/kinds.csv.tmp"
 if [ -n "$before" ]; then
