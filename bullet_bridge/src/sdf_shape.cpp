@@ -13,15 +13,18 @@
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
+using detail::kNullSdf;
+
 namespace {
 
-const sdfccd_SdfId kNullSdf = { 0, 0 };
+double coord(const sdfccd_Vec3& v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
 
-bool finiteBox(const btVector3& lo, const btVector3& hi)
+// Destroys the scaled query SDF, if any.
+void dropScaled(sdfccd_SdfId& scaled, bool& valid)
 {
-    for (int i = 0; i < 3; ++i)
-        if (!std::isfinite((double)lo[i]) || !std::isfinite((double)hi[i]) || !(hi[i] >= lo[i])) return false;
-    return true;
+    if (scaled.index1 != 0) sdfccd_destroy_sdf(scaled);
+    scaled = kNullSdf;
+    valid = false;
 }
 
 } // namespace
@@ -40,12 +43,9 @@ SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type)
         m_lo.setValue(0, 0, 0);
         m_hi.setValue(0, 0, 0);
     } else {
-        const double blo[3] = { info.bounds.lo.x, info.bounds.lo.y, info.bounds.lo.z };
-        const double bhi[3] = { info.bounds.hi.x, info.bounds.hi.y, info.bounds.hi.z };
-        const double dlo[3] = { info.domain.lo.x, info.domain.lo.y, info.domain.lo.z };
-        const double dhi[3] = { info.domain.hi.x, info.domain.hi.y, info.domain.hi.z };
-        for (int i = 0; i < 3; ++i) {
-            double lo = std::max(blo[i], dlo[i]), hi = std::min(bhi[i], dhi[i]);
+        for (int i = 0; i < 3; ++i) { // the bounds within the domain
+            const double lo = std::max(coord(info.bounds.lo, i), coord(info.domain.lo, i));
+            const double hi = std::min(coord(info.bounds.hi, i), coord(info.domain.hi, i));
             if (std::isfinite(lo)) m_lo[i] = (btScalar)lo;
             if (std::isfinite(hi)) m_hi[i] = (btScalar)hi;
         }
@@ -68,9 +68,7 @@ SdfShape::~SdfShape()
 
 void SdfShape::dropDerived() const
 {
-    if (m_scaled.index1 != 0) sdfccd_destroy_sdf(m_scaled);
-    m_scaled = kNullSdf;
-    m_scaledValid = false;
+    dropScaled(m_scaled, m_scaledValid);
     delete m_bvh;
     m_bvh = nullptr;
     delete m_meshInterface;
@@ -101,9 +99,9 @@ double SdfShape::getFeatureSize() const
 
 bool SdfShape::hasFiniteBounds() const
 {
-    for (int i = 0; i < 3; ++i)
-        if (!(m_lo[i] > -BT_LARGE_FLOAT && m_hi[i] < BT_LARGE_FLOAT)) return false;
-    return finiteBox(m_lo, m_hi);
+    for (int i = 0; i < 3; ++i) // (NaN fails every comparison)
+        if (!(m_lo[i] > -BT_LARGE_FLOAT && m_hi[i] < BT_LARGE_FLOAT && m_hi[i] >= m_lo[i])) return false;
+    return true;
 }
 
 void SdfShape::setTriangulationResolution(int cells)
@@ -119,11 +117,7 @@ void SdfShape::setLocalScaling(const btVector3& scaling)
         if (!(s[i] > btScalar(0))) s[i] = btScalar(1); // zero or NaN scaling is meaningless here
     if (s == m_scaling) return;
     m_scaling = s;
-    // The triangulation is in unscaled coordinates (the internal BVH shape applies the scaling),
-    // so only the scaled query SDF depends on it.
-    if (m_scaled.index1 != 0) sdfccd_destroy_sdf(m_scaled);
-    m_scaled = kNullSdf;
-    m_scaledValid = false;
+    dropScaled(m_scaled, m_scaledValid); // (the triangulation is unscaled: its BVH shape scales)
     if (m_bvh) m_bvh->setLocalScaling(m_scaling);
 }
 
