@@ -27,6 +27,23 @@ void dropScaled(sdfccd_SdfId& scaled, bool& valid)
     valid = false;
 }
 
+double stretchEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
+{
+    // phi(x) = min(s) * phi_child(x / s): never above the distance to the stretched solid.
+    const SdfShape* shape = static_cast<const SdfShape*>(user);
+    const btVector3& sc = shape->getLocalScaling();
+    const double s[3] = { (double)sc.x(), (double)sc.y(), (double)sc.z() }, smin = std::min(s[0], std::min(s[1], s[2]));
+    sdfccd_Vec3 q = { p.x / s[0], p.y / s[1], p.z / s[2] };
+    double v = 0.0;
+    sdfccd_Vec3 g = { 0, 0, 1 };
+    if (sdfccd_sdf_eval(shape->sdf(), q, &v, &g) != SDFCCD_OK) v = INFINITY;
+    if (out_grad) {
+        sdfccd_Vec3 h = { g.x * smin / s[0], g.y * smin / s[1], g.z * smin / s[2] };
+        *out_grad = h;
+    }
+    return smin * v;
+}
+
 } // namespace
 
 SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type)
@@ -121,10 +138,6 @@ void SdfShape::setLocalScaling(const btVector3& scaling)
     if (m_bvh) m_bvh->setLocalScaling(m_scaling);
 }
 
-namespace {
-double stretchEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user);
-}
-
 sdfccd_SdfId SdfShape::querySdf() const
 {
     if (m_scaling == btVector3(1, 1, 1)) return m_sdf;
@@ -138,38 +151,15 @@ sdfccd_SdfId SdfShape::querySdf() const
         sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
         def.eval = stretchEval;
         def.user = const_cast<SdfShape*>(this);
-        def.lipschitz = 1.0;
-        def.bounds.lo.x = m_lo.x() * sx; def.bounds.hi.x = m_hi.x() * sx;
-        def.bounds.lo.y = m_lo.y() * sy; def.bounds.hi.y = m_hi.y() * sy;
-        def.bounds.lo.z = m_lo.z() * sz; def.bounds.hi.z = m_hi.z() * sz;
-        if (!hasFiniteBounds()) {
-            def.bounds.lo.x = def.bounds.lo.y = def.bounds.lo.z = -INFINITY;
-            def.bounds.hi.x = def.bounds.hi.y = def.bounds.hi.z = INFINITY;
+        if (hasFiniteBounds()) { // (else the default's infinite bounds)
+            def.bounds.lo = sdfccd_Vec3{ m_lo.x() * sx, m_lo.y() * sy, m_lo.z() * sz };
+            def.bounds.hi = sdfccd_Vec3{ m_hi.x() * sx, m_hi.y() * sy, m_hi.z() * sz };
         }
         st = sdfccd_create_callback_sdf(&def, &m_scaled);
     }
     if (st != SDFCCD_OK) m_scaled = kNullSdf;
     return m_scaled;
 }
-
-namespace {
-double stretchEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
-{
-    // phi(x) = min(s) * phi_child(x / s): never above the distance to the stretched solid.
-    const SdfShape* shape = static_cast<const SdfShape*>(user);
-    const btVector3& sc = shape->getLocalScaling();
-    const double s[3] = { (double)sc.x(), (double)sc.y(), (double)sc.z() }, smin = std::min(s[0], std::min(s[1], s[2]));
-    sdfccd_Vec3 q = { p.x / s[0], p.y / s[1], p.z / s[2] };
-    double v = 0.0;
-    sdfccd_Vec3 g = { 0, 0, 1 };
-    if (sdfccd_sdf_eval(shape->sdf(), q, &v, &g) != SDFCCD_OK) v = INFINITY;
-    if (out_grad) {
-        sdfccd_Vec3 h = { g.x * smin / s[0], g.y * smin / s[1], g.z * smin / s[2] };
-        *out_grad = h;
-    }
-    return smin * v;
-}
-} // namespace
 
 void SdfShape::getAabb(const btTransform& t, btVector3& aabbMin, btVector3& aabbMax) const
 {

@@ -291,7 +291,6 @@ sdfccd_SdfId ShapeCache::btSdfFor(const btSdfCollisionShape* shape)
     sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
     def.eval = btSdfEval;
     def.user = &e;
-    def.lipschitz = 1.0;
     def.bounds.lo = v3(e.lo);
     def.bounds.hi = v3(e.hi);
     if (sdfccd_create_callback_sdf(&def, &e.id) != SDFCCD_OK) e.id = kNullSdf;
