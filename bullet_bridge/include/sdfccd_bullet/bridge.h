@@ -1,13 +1,9 @@
 // SPDX-License-Identifier: MIT
 /** @file bridge.h  Registers sdfccd's triangle-SDF continuous collision detection in Bullet.
  *
- * What it does (Bullet 3.24):
- *  - registers ONE collision algorithm, AFTER btGImpactCollisionAlgorithm::registerAlgorithm
- *    (which it calls itself), for these pairs in both body orders, in the contact-point and the
- *    closest-point tables (so contactTest/contactPairTest work):
- *      btGImpactMeshShape (top level or a child of a btCompoundShape) vs SdfShape, and vs
- *      Bullet's btSdfCollisionShape (type 29, sampled through queryPoint; Config::handle_bt_sdf_shape);
- *      any convex shape (btBoxShape, spheres, hulls...) vs SdfShape (Config::convex_shapes),
+ *  - one collision algorithm, in both body orders and both of Bullet's tables (contactTest too):
+ *      btGImpactMeshShape (alone or in a btCompoundShape) vs SdfShape and btSdfCollisionShape;
+ *      any convex shape vs SdfShape (Config::convex_shapes),
  *      as triangles: a box's 12, other shapes' btShapeHull hull;
  *      SdfShape vs SdfShape (Config::sdf_pairs): the moving one's isosurface triangulation
  *      against the other's field.
@@ -47,7 +43,6 @@ class btCollisionDispatcher;
 class btCollisionShape;
 class btCollisionWorld;
 class btCollisionObject;
-class btDiscreteDynamicsWorld;
 
 class btSdfCollisionShape;
 
@@ -56,15 +51,12 @@ SDFCCD_BULLET_NAMESPACE_BEGIN
 /** Outcome of registration and verification. */
 enum class Status {
     Ok = 0,
-    AlreadyRegistered, /**< This bridge, or another one, is already registered with the dispatcher. */
-    TooLate,           /**< The world already holds GImpact or SDF bodies: their pairs may keep the
-                            algorithm they were created with. Register right after creating the world. */
-    Overwritten,       /**< verify(): the dispatcher no longer finds our algorithm for GImpact vs SDF,
-                            e.g. btGImpactCollisionAlgorithm::registerAlgorithm was called after us. */
-    NotRegistered,     /**< verify() before a successful registerWith(). */
-    InvalidArgument,   /**< NULL world/dispatcher, a dispatcher that is not a btCollisionDispatcher,
-                            or a shape type id that is not concave. */
-    InvalidShape       /**< check(): an SdfShape in the world wraps a null or destroyed sdfccd handle. */
+    AlreadyRegistered, /**< A bridge is already registered with the dispatcher. */
+    TooLate,           /**< The world already holds GImpact or SDF bodies: register right after creating it. */
+    Overwritten,       /**< Something replaced our algorithm after registration (e.g. GImpact's registerAlgorithm). */
+    NotRegistered,     /**< No successful registerWith() yet. */
+    InvalidArgument,   /**< A NULL or unsupported world or dispatcher, or a shape type id that is not concave. */
+    InvalidShape       /**< An SdfShape wraps a null or destroyed sdfccd handle. */
 };
 
 /** Constant name of a status, e.g. "TooLate". */
