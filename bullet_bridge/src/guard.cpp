@@ -1,14 +1,10 @@
 // SPDX-License-Identifier: MIT
-// sdfccd Bullet bridge: the no-tunnelling guarantee (paper, Section 4: the simulation never
-// advances past a time of impact). An action (btActionInterface, run by Bullet after it
-// integrates a step) hands the EXECUTED motion of every dynamic body that can reach an SDF (its
-// start pose of the step to the pose the solver produced) to sdfccd_guard_step_rigid (the
-// certificate, the CCD, the safe time), puts a body it rolls back at its safe pose and sets its
-// velocity with sdfccd_guard_response. This file only gathers bodies and poses and writes back.
-// Start poses: taken at the step's first narrow-phase call of the bridge (world transforms are the
-// start poses then), otherwise Bullet's integration undone (the end pose moved back by the body's
-// velocities).
+// sdfccd Bullet bridge: the no-tunnelling guarantee (paper, Section 4). After Bullet integrates a
+// step, an action hands each dynamic body's executed motion to sdfccd_guard_step_rigid and puts a
+// body it rolls back at its safe pose, with sdfccd_guard_response's velocity.
 #include "internal.h"
+
+#include <LinearMath/btAabbUtil2.h>
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
@@ -53,12 +49,6 @@ void sweptBox(const btCollisionShape* s, const btTransform& t0, const btTransfor
     lo.setMin(hi); // (never inverted)
 }
 
-bool overlaps(const btVector3& alo, const btVector3& ahi, const btVector3& blo, const btVector3& bhi)
-{
-    return alo.x() <= bhi.x() && blo.x() <= ahi.x() && alo.y() <= bhi.y() && blo.y() <= ahi.y() && alo.z() <= bhi.z() &&
-           blo.z() <= ahi.z();
-}
-
 // The mesh parts of a shape with their offsets in the body frame: the shape itself, or the
 // children of a btCompoundShape (nested compounds followed).
 void leaves(const btCollisionShape* s, const btTransform& offset, std::vector<std::pair<const btCollisionShape*, btTransform>>& out)
@@ -82,14 +72,14 @@ sdfccd_BodyState bodyState(const btRigidBody* b)
     return s;
 }
 
-} // namespace
-
+// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
 sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out)
 {
     const sdfccd_Pose pa = toPose(a), pb = toPose(b);
     return sdfccd_rigid_motion_from_poses(&pa, &pb, v3(c), 0, dt, out);
 }
 
+} // namespace
 
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world)
 {
@@ -189,7 +179,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             const SdfObject* best_sdf = nullptr;
             btTransform best_part;
             for (const SdfObject& o : sdfs) {
-                if (o.co == body || !overlaps(lo, hi, o.lo, o.hi)) continue;
+                if (o.co == body || !TestAabbAgainstAabb2(lo, hi, o.lo, o.hi)) continue;
                 if (t0 == t1 && o.t0 == o.t1) { // neither moved (a sleeping body): nothing went deeper
                     stats.guard_skipped++;
                     continue;

@@ -59,15 +59,13 @@ struct MeshEntry {
     bool ok = false;
 };
 
-// btSdfCollisionShape sampled through queryPoint, as an sdfccd callback SDF.
-struct BtSdfData {
-    btSdfCollisionShape* shape;
-    btVector3 lo, hi;
-    double hole_value;
-};
+// A btSdfCollisionShape's field: its grid (Bridge::setBtSdfData), else a callback SDF sampling
+// queryPoint in the shape's box (`hole_value` where it has no data).
 struct BtSdfEntry {
     sdfccd_SdfId id = { 0, 0 };
-    std::unique_ptr<BtSdfData> data;
+    btSdfCollisionShape* shape = nullptr;
+    btVector3 lo, hi;
+    double hole_value = 0;
 };
 
 // Packed meshes and SDF handles per Bullet shape (keyed by address; see Bridge::invalidateShape).
@@ -175,8 +173,6 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported);
 // removed by unregister().
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world);
 void guardDetach(BridgeImpl* impl);
-// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
-sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out);
 // soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones.
 void softRegister(BridgeImpl* impl, btCollisionDispatcher* d);
 void softAttach(BridgeImpl* impl, btCollisionWorld* world);

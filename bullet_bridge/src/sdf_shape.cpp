@@ -13,15 +13,35 @@
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
+using detail::kNullSdf;
+
 namespace {
 
-const sdfccd_SdfId kNullSdf = { 0, 0 };
+double coord(const sdfccd_Vec3& v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
 
-bool finiteBox(const btVector3& lo, const btVector3& hi)
+// Destroys the scaled query SDF, if any.
+void dropScaled(sdfccd_SdfId& scaled, bool& valid)
 {
-    for (int i = 0; i < 3; ++i)
-        if (!std::isfinite((double)lo[i]) || !std::isfinite((double)hi[i]) || !(hi[i] >= lo[i])) return false;
-    return true;
+    if (scaled.index1 != 0) sdfccd_destroy_sdf(scaled);
+    scaled = kNullSdf;
+    valid = false;
+}
+
+double stretchEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
+{
+    // phi(x) = min(s) * phi_child(x / s): never above the distance to the stretched solid.
+    const SdfShape* shape = static_cast<const SdfShape*>(user);
+    const btVector3& sc = shape->getLocalScaling();
+    const double s[3] = { (double)sc.x(), (double)sc.y(), (double)sc.z() }, smin = std::min(s[0], std::min(s[1], s[2]));
+    sdfccd_Vec3 q = { p.x / s[0], p.y / s[1], p.z / s[2] };
+    double v = 0.0;
+    sdfccd_Vec3 g = { 0, 0, 1 };
+    if (sdfccd_sdf_eval(shape->sdf(), q, &v, &g) != SDFCCD_OK) v = INFINITY;
+    if (out_grad) {
+        sdfccd_Vec3 h = { g.x * smin / s[0], g.y * smin / s[1], g.z * smin / s[2] };
+        *out_grad = h;
+    }
+    return smin * v;
 }
 
 } // namespace
@@ -40,12 +60,9 @@ SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type)
         m_lo.setValue(0, 0, 0);
         m_hi.setValue(0, 0, 0);
     } else {
-        const double blo[3] = { info.bounds.lo.x, info.bounds.lo.y, info.bounds.lo.z };
-        const double bhi[3] = { info.bounds.hi.x, info.bounds.hi.y, info.bounds.hi.z };
-        const double dlo[3] = { info.domain.lo.x, info.domain.lo.y, info.domain.lo.z };
-        const double dhi[3] = { info.domain.hi.x, info.domain.hi.y, info.domain.hi.z };
-        for (int i = 0; i < 3; ++i) {
-            double lo = std::max(blo[i], dlo[i]), hi = std::min(bhi[i], dhi[i]);
+        for (int i = 0; i < 3; ++i) { // the bounds within the domain
+            const double lo = std::max(coord(info.bounds.lo, i), coord(info.domain.lo, i));
+            const double hi = std::min(coord(info.bounds.hi, i), coord(info.domain.hi, i));
             if (std::isfinite(lo)) m_lo[i] = (btScalar)lo;
             if (std::isfinite(hi)) m_hi[i] = (btScalar)hi;
         }
@@ -68,9 +85,7 @@ SdfShape::~SdfShape()
 
 void SdfShape::dropDerived() const
 {
-    if (m_scaled.index1 != 0) sdfccd_destroy_sdf(m_scaled);
-    m_scaled = kNullSdf;
-    m_scaledValid = false;
+    dropScaled(m_scaled, m_scaledValid);
     delete m_bvh;
     m_bvh = nullptr;
     delete m_meshInterface;
@@ -101,9 +116,9 @@ double SdfShape::getFeatureSize() const
 
 bool SdfShape::hasFiniteBounds() const
 {
-    for (int i = 0; i < 3; ++i)
-        if (!(m_lo[i] > -BT_LARGE_FLOAT && m_hi[i] < BT_LARGE_FLOAT)) return false;
-    return finiteBox(m_lo, m_hi);
+    for (int i = 0; i < 3; ++i) // (NaN fails every comparison)
+        if (!(m_lo[i] > -BT_LARGE_FLOAT && m_hi[i] < BT_LARGE_FLOAT && m_hi[i] >= m_lo[i])) return false;
+    return true;
 }
 
 void SdfShape::setTriangulationResolution(int cells)
@@ -119,16 +134,8 @@ void SdfShape::setLocalScaling(const btVector3& scaling)
         if (!(s[i] > btScalar(0))) s[i] = btScalar(1); // zero or NaN scaling is meaningless here
     if (s == m_scaling) return;
     m_scaling = s;
-    // The triangulation is in unscaled coordinates (the internal BVH shape applies the scaling),
-    // so only the scaled query SDF depends on it.
-    if (m_scaled.index1 != 0) sdfccd_destroy_sdf(m_scaled);
-    m_scaled = kNullSdf;
-    m_scaledValid = false;
+    dropScaled(m_scaled, m_scaledValid); // (the triangulation is unscaled: its BVH shape scales)
     if (m_bvh) m_bvh->setLocalScaling(m_scaling);
-}
-
-namespace {
-double stretchEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user);
 }
 
 sdfccd_SdfId SdfShape::querySdf() const
@@ -144,38 +151,15 @@ sdfccd_SdfId SdfShape::querySdf() const
         sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
         def.eval = stretchEval;
         def.user = const_cast<SdfShape*>(this);
-        def.lipschitz = 1.0;
-        def.bounds.lo.x = m_lo.x() * sx; def.bounds.hi.x = m_hi.x() * sx;
-        def.bounds.lo.y = m_lo.y() * sy; def.bounds.hi.y = m_hi.y() * sy;
-        def.bounds.lo.z = m_lo.z() * sz; def.bounds.hi.z = m_hi.z() * sz;
-        if (!hasFiniteBounds()) {
-            def.bounds.lo.x = def.bounds.lo.y = def.bounds.lo.z = -INFINITY;
-            def.bounds.hi.x = def.bounds.hi.y = def.bounds.hi.z = INFINITY;
+        if (hasFiniteBounds()) { // (else the default's infinite bounds)
+            def.bounds.lo = sdfccd_Vec3{ m_lo.x() * sx, m_lo.y() * sy, m_lo.z() * sz };
+            def.bounds.hi = sdfccd_Vec3{ m_hi.x() * sx, m_hi.y() * sy, m_hi.z() * sz };
         }
         st = sdfccd_create_callback_sdf(&def, &m_scaled);
     }
     if (st != SDFCCD_OK) m_scaled = kNullSdf;
     return m_scaled;
 }
-
-namespace {
-double stretchEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
-{
-    // phi(x) = min(s) * phi_child(x / s): never above the distance to the stretched solid.
-    const SdfShape* shape = static_cast<const SdfShape*>(user);
-    const btVector3& sc = shape->getLocalScaling();
-    const double s[3] = { (double)sc.x(), (double)sc.y(), (double)sc.z() }, smin = std::min(s[0], std::min(s[1], s[2]));
-    sdfccd_Vec3 q = { p.x / s[0], p.y / s[1], p.z / s[2] };
-    double v = 0.0;
-    sdfccd_Vec3 g = { 0, 0, 1 };
-    if (sdfccd_sdf_eval(shape->sdf(), q, &v, &g) != SDFCCD_OK) v = INFINITY;
-    if (out_grad) {
-        sdfccd_Vec3 h = { g.x * smin / s[0], g.y * smin / s[1], g.z * smin / s[2] };
-        *out_grad = h;
-    }
-    return smin * v;
-}
-} // namespace
 
 void SdfShape::getAabb(const btTransform& t, btVector3& aabbMin, btVector3& aabbMax) const
 {

@@ -170,7 +170,7 @@ int sourceCount(const btCollisionShape* shape)
 
 double btSdfEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
 {
-    BtSdfData* d = static_cast<BtSdfData*>(user);
+    BtSdfEntry* d = static_cast<BtSdfEntry*>(user);
     btVector3 x = bt(p);
     btVector3 eps = (d->hi - d->lo) * btScalar(1e-6);
     btVector3 q = x;
@@ -198,14 +198,22 @@ double btSdfEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
     return phi;
 }
 
+// queryPoint as a sample of the field (sdfccd_sdf_compare_samples).
+int32_t queryPointSample(sdfccd_Vec3 p, double* out_value, void* shape)
+{
+    btScalar d = 0;
+    btVector3 n;
+    if (!static_cast<btSdfCollisionShape*>(shape)->queryPoint(bt(p), d, n)) return 0;
+    *out_value = (double)d;
+    return 1;
+}
+
 } // namespace
 
 ShapeCache::~ShapeCache()
 {
-    for (auto& m : m_meshes)
-        if (m.second.id.index1) sdfccd_destroy_mesh(m.second.id);
-    for (auto& s : m_bt_sdfs)
-        if (s.second.id.index1) sdfccd_destroy_sdf(s.second.id);
+    while (!m_meshes.empty()) invalidate(m_meshes.begin()->first);
+    while (!m_bt_sdfs.empty()) invalidate(m_bt_sdfs.begin()->first);
 }
 
 const MeshEntry* ShapeCache::meshFor(const btCollisionShape* shape)
@@ -226,8 +234,7 @@ const MeshEntry* ShapeCache::meshFor(const btCollisionShape* shape)
         const MeshEntry& e = it->second;
         if (e.scaling == shape->getLocalScaling() && e.margin == shape->getMargin() && e.source_count == count)
             return e.ok ? &e : nullptr;
-        if (e.id.index1) sdfccd_destroy_mesh(e.id);
-        m_meshes.erase(it);
+        invalidate(shape);
     }
     MeshEntry& e = m_meshes[shape];
     e.scaling = shape->getLocalScaling();
@@ -275,19 +282,17 @@ sdfccd_SdfId ShapeCache::btSdfFor(const btSdfCollisionShape* shape)
 {
     auto it = m_bt_sdfs.find(shape);
     if (it != m_bt_sdfs.end()) return it->second.id;
-    BtSdfEntry& e = m_bt_sdfs[shape];
-    e.data.reset(new BtSdfData);
-    e.data->shape = const_cast<btSdfCollisionShape*>(shape); // queryPoint is non-const but only reads
+    BtSdfEntry& e = m_bt_sdfs[shape]; // (a map node: its address is the callback's, for life)
+    e.shape = const_cast<btSdfCollisionShape*>(shape); // queryPoint is non-const but only reads
     btTransform id;
     id.setIdentity();
-    shape->getAabb(id, e.data->lo, e.data->hi);
-    e.data->hole_value = 0.05 * (double)(e.data->hi - e.data->lo).length();
+    shape->getAabb(id, e.lo, e.hi);
+    e.hole_value = 0.05 * (double)(e.hi - e.lo).length();
     sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
     def.eval = btSdfEval;
-    def.user = e.data.get();
-    def.lipschitz = 1.0;
-    def.bounds.lo = v3(e.data->lo);
-    def.bounds.hi = v3(e.data->hi);
+    def.user = &e;
+    def.bounds.lo = v3(e.lo);
+    def.bounds.hi = v3(e.hi);
     if (sdfccd_create_callback_sdf(&def, &e.id) != SDFCCD_OK) e.id = kNullSdf;
     return e.id;
 }
@@ -296,23 +301,15 @@ bool ShapeCache::setBtSdfData(const btSdfCollisionShape* shape, const void* data
 {
     sdfccd_SdfId grid;
     if (!shape || !data || sdfccd_load_grid_memory(data, size, &grid) != SDFCCD_OK) return false;
-    // The same field as the shape's (queryPoint) at 125 points of its domain, to the float build's precision.
+    // The same field as the shape's (queryPoint) at 125 points of its box, to the float build's precision.
     btTransform id;
     id.setIdentity();
     btVector3 lo, hi;
     shape->getAabb(id, lo, hi);
-    const double tol = 1e-5 * (double)(hi - lo).length();
-    bool same = true;
-    for (int k = 0; k < 125 && same; ++k) {
-        const btVector3 f((btScalar)(0.1 + 0.2 * (k % 5)), (btScalar)(0.1 + 0.2 * (k / 5 % 5)), (btScalar)(0.1 + 0.2 * (k / 25)));
-        const btVector3 x = lo + (hi - lo) * f;
-        btScalar theirs = 0;
-        btVector3 n;
-        double ours = 0;
-        if (const_cast<btSdfCollisionShape*>(shape)->queryPoint(x, theirs, n))
-            same = sdfccd_sdf_eval(grid, v3(x), &ours, nullptr) == SDFCCD_OK && std::fabs(ours - (double)theirs) <= tol;
-    }
-    if (!same) {
+    const sdfccd_Aabb box = { v3(lo), v3(hi) };
+    double diff = 0;
+    if (sdfccd_sdf_compare_samples(grid, queryPointSample, const_cast<btSdfCollisionShape*>(shape), box, 5, &diff, nullptr) != SDFCCD_OK ||
+        !(diff <= 1e-5 * (double)(hi - lo).length())) {
         sdfccd_destroy_sdf(grid);
         return false;
     }

@@ -250,6 +250,9 @@ private:
             delete s;
             return nullptr;
         }
+        // The bridge reads the same bytes with sdfccd's grid evaluator (not queryPoint).
+        if (m_bridge && m_bridge->setBtSdfData(s, m_file.data(), m_file.size()) != sdfccd_bullet::Status::Ok)
+            std::fprintf(stderr, "cloth: Bridge::setBtSdfData failed\n");
         return s;
     }
 

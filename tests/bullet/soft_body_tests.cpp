@@ -532,6 +532,29 @@ static void test_btsdf_tray()
         (with ? z_bridge : z_stock) = minZ(cloth);
         if (with) checkNoErrors(bridge, "btsdf_tray");
     }
+    // Given the bytes (setBtSdfData), the soft path evaluates sdfccd's grid of the file: the run on an
+    // SdfShape of that grid, evaluation for evaluation (through queryPoint it is not).
+    double z_run[2];
+    int64_t evals[2];
+    for (int k = 0; k < 2; ++k) {
+        btSdfCollisionShape cdf;
+        SdfShape shape(grid);
+        CHECK(cdf.initializeSDF(bytes.data(), (int)bytes.size()), "initializeSDF");
+        Bridge bridge;
+        if (k == 0) CHECK(bridge.setBtSdfData(&cdf, bytes.data(), bytes.size()) == Status::Ok, "setBtSdfData");
+        SoftWorld w(&bridge);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(k == 0 ? static_cast<btCollisionShape*>(&cdf) : &shape, id);
+        btSoftBody* cloth = w.addCloth(0.6, 0.5, 0.4, 0.3, -2.0);
+        for (int s = 0; s < 90; ++s) w.step();
+        z_run[k] = minZ(cloth);
+        evals[k] = sdfccd_bullet::softBodyStats(bridge).sdf_evaluations;
+        checkNoErrors(bridge, "btsdf_tray");
+    }
+    std::printf("  with setBtSdfData: lowest node %.4f, %lld SDF evaluations; on an SdfShape of the grid: %.4f, %lld\n", z_run[0],
+                (long long)evals[0], z_run[1], (long long)evals[1]);
+    CHECK(evals[0] == evals[1] && z_run[0] == z_run[1], "setBtSdfData: the soft path did not run on the grid");
     sdfccd_destroy_sdf(grid);
     std::printf("  cloth on btSdfCollisionShape tray (top z = 0.1): lowest node after 1.5 s: stock %.3f, bridge %.4f; bridge max "
                 "penetration %.4f mm (the grid's interpolated phi)\n", z_stock, z_bridge, worst * 1e3);

@@ -1,16 +1,9 @@
 // SPDX-License-Identifier: MIT
 /** @file config.h  Precision check and namespace of the sdfccd Bullet bridge.
  *
- * Bullet's btScalar is float or double depending on BT_USE_DOUBLE_PRECISION, and nothing in
- * Bullet's installed headers records which one a library was built with. The bridge is built
- * once per precision (targets sdfccd_bullet for pkg-config `bullet`, sdfccd_bullet_f64 for
- * `bullet-float64`), and each target publishes SDFCCD_BULLET_SCALAR_BYTES (4 or 8). Two checks
- * follow from that:
- *  - compile time: the static_assert below fails when code includes these headers with a
- *    BT_USE_DOUBLE_PRECISION setting that differs from the bridge target it uses;
- *  - link time: every bridge symbol lives in the inline namespace sdfccd_bullet::f32 or
- *    sdfccd_bullet::f64, so linking a float consumer against the double library (or the
- *    reverse) fails with undefined symbols instead of corrupting memory.
+ * The bridge is built once per btScalar (sdfccd_bullet for pkg-config `bullet`, sdfccd_bullet_f64
+ * for `bullet-float64`). A mismatch with BT_USE_DOUBLE_PRECISION fails to compile (static_assert
+ * on SDFCCD_BULLET_SCALAR_BYTES) and to link (inline namespace f32 or f64).
  */
 #ifndef SDFCCD_BULLET_CONFIG_H
 #define SDFCCD_BULLET_CONFIG_H

@@ -12,5 +12,6 @@
 #include "grid.h"
 #include "contact.h"
 #include "cases.h"
+#include "sampled.h"
 
 #endif
