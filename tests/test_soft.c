@@ -325,6 +325,85 @@ START_TEST(test_soft_bad_input)
 }
 END_TEST
 
+/* The guard's face rule (sdfccd_guard_face) on closed forms. A flat triangle falling through the
+ * half-space z >= 0 from z = 0.5 to -0.5 goes back to where it came within half the tolerance of
+ * -tolerance (z = -tol / 2: fraction 0.505), to its start on the last pass; one starting 5 cm deep
+ * may not end deeper than it started (back to its start, no stop) but may rise; a triangle whose
+ * corners stay 2.6 m clear of a unit sphere while its interior sinks onto it is stopped at z = 0.995
+ * (its corners alone, sdfccd_guard_point, are not); a certified face costs no query. */
+START_TEST(test_guard_face_closed_form)
+{
+    sdfccd_SdfId plane;
+    ck_assert(sdfccd_create_half_space(v3(0, 0, 1), 0, &plane) == SDFCCD_OK);
+    const double tol = 0.01;
+    const sdfccd_QueryParams qp = sdfccd_default_query_params();
+    sdfccd_DistanceCert c = sdfccd_empty_distance_cert();
+    const sdfccd_Vec3 s[3] = { v3(0, 0, 0.5), v3(0.3, 0, 0.5), v3(0, 0.3, 0.5) }, e[3] = { v3(0, 0, -0.5), v3(0.3, 0, -0.5), v3(0, 0.3, -0.5) };
+    sdfccd_FaceGuard g;
+    int64_t evals = 0;
+    ck_assert_msg(sdfccd_guard_face(plane, &c, s, e, -tol, tol, 1.0, &qp, 0.01, 0, &g, &evals) == SDFCCD_OK, "%s", sdfccd_last_error());
+    ck_assert_int_eq(g.hit, 1);
+    ck_assert_int_eq(g.stop, 1);
+    ck_assert_msg(fabs(g.fraction - 0.505) <= 1e-6, "fraction %.17g, not 0.505", g.fraction);
+    ck_assert_double_eq_tol(g.normal.z, 1.0, 1e-9);
+    ck_assert_int_eq(g.queries, 2);
+    ck_assert_int_gt(evals, 0);
+    c = sdfccd_empty_distance_cert();
+    ck_assert(sdfccd_guard_face(plane, &c, s, e, -tol, tol, 1.0, &qp, 0.01, 1, &g, NULL) == SDFCCD_OK);
+    ck_assert_int_eq(g.hit, 1);
+    ck_assert_double_eq(g.fraction, 0.0);
+    /* 5 cm deep, sinking to 20 cm: back to the start; rising to 3 cm: kept. */
+    const sdfccd_Vec3 d[3] = { v3(0, 0, -0.05), v3(0.3, 0, -0.05), v3(0, 0.3, -0.05) };
+    const sdfccd_Vec3 sink[3] = { v3(0, 0, -0.2), v3(0.3, 0, -0.2), v3(0, 0.3, -0.2) }, rise[3] = { v3(0, 0, -0.03), v3(0.3, 0, -0.03), v3(0, 0.3, -0.03) };
+    c = sdfccd_empty_distance_cert();
+    ck_assert(sdfccd_guard_face(plane, &c, d, sink, -tol, tol, 1.0, &qp, 0.01, 0, &g, NULL) == SDFCCD_OK);
+    ck_assert_int_eq(g.hit, 1);
+    ck_assert_int_eq(g.stop, 0);
+    ck_assert_double_eq(g.fraction, 0.0);
+    ck_assert(sdfccd_guard_face(plane, &c, d, rise, -tol, tol, 1.0, &qp, 0.01, 0, &g, NULL) == SDFCCD_OK);
+    ck_assert_int_eq(g.hit, 0);
+    /* Resting 1 m up: the certificate made on the first call clears the second with no evaluation. */
+    const sdfccd_Vec3 up[3] = { v3(0, 0, 1), v3(0.3, 0, 1), v3(0, 0.3, 1) };
+    c = sdfccd_empty_distance_cert();
+    ck_assert(sdfccd_guard_face(plane, &c, up, up, -tol, tol, 1.0, &qp, 0.01, 0, &g, NULL) == SDFCCD_OK);
+    ck_assert_int_eq(g.hit, 0);
+    ck_assert_int_eq(g.queries, 0);
+    evals = 0;
+    ck_assert(sdfccd_guard_face(plane, &c, up, up, -tol, tol, 1.0, &qp, 0.01, 0, &g, &evals) == SDFCCD_OK);
+    ck_assert_int_eq(g.queries, 0);
+    ck_assert_int_eq(evals, 0);
+    ck_assert(sdfccd_destroy_sdf(plane) == SDFCCD_OK);
+
+    sdfccd_SdfId ball = sphere(1.0);
+    const sdfccd_Vec3 bs[3] = { v3(-3, -2, 2.0), v3(3, -2, 2.0), v3(0, 3, 2.0) }, be[3] = { v3(-3, -2, 0.5), v3(3, -2, 0.5), v3(0, 3, 0.5) };
+    c = sdfccd_empty_distance_cert();
+    ck_assert(sdfccd_guard_face(ball, &c, bs, be, -tol, tol, 1.0, &qp, 0.01, 0, &g, NULL) == SDFCCD_OK);
+    ck_assert_int_eq(g.hit, 1);
+    ck_assert_msg(fabs(g.fraction - (2.0 - 0.995) / 1.5) <= 1e-6, "fraction %.17g, not %.17g", g.fraction, (2.0 - 0.995) / 1.5);
+    ck_assert(g.normal.z > 0.999);
+    for (int k = 0; k < 3; ++k) {
+        sdfccd_PointGuard pg;
+        const sdfccd_DistanceCert none = sdfccd_empty_distance_cert();
+        ck_assert(sdfccd_guard_point(ball, &none, bs[k], be[k], tol, 1.0, &pg, NULL) == SDFCCD_OK);
+        ck_assert_int_eq(pg.hit, 0);
+    }
+    /* Bad input: nothing written. */
+    memset(&g, 0x5a, sizeof g);
+    const sdfccd_FaceGuard before = g;
+    sdfccd_Vec3 bad[3] = { bs[0], v3(NAN, 0, 0), bs[2] };
+    ck_assert_int_eq(sdfccd_guard_face(ball, &c, bs, be, -tol, 0.0, 1.0, &qp, 0.01, 0, &g, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_face(ball, &c, bs, be, -tol, tol, 1.0, &qp, 0.0, 0, &g, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_face(ball, &c, bad, be, -tol, tol, 1.0, &qp, 0.01, 0, &g, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_face(ball, &c, bs, be, NAN, tol, 1.0, &qp, 0.01, 0, &g, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_face(ball, &c, bs, be, -tol, tol, 1.0, NULL, 0.01, 0, &g, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_face(ball, &c, bs, be, -tol, tol, 1.0, &qp, 0.01, 0, NULL, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(sdfccd_destroy_sdf(ball) == SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_guard_face(ball, &c, bs, be, -tol, tol, 1.0, &qp, 0.01, 0, &g, NULL), SDFCCD_INVALID_HANDLE);
+    ck_assert(strlen(sdfccd_last_error()) > 0);
+    ck_assert(memcmp(&g, &before, sizeof g) == 0);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("soft");
@@ -339,6 +418,7 @@ int main(void)
     tcase_add_test(tc, test_guard_point_half_space);
     tcase_add_test(tc, test_segment_sphere_closed_form);
     tcase_add_test(tc, test_soft_bad_input);
+    tcase_add_test(tc, test_guard_face_closed_form);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -480,48 +480,19 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
                 lev = std::min(lev, level[(size_t)idx[k]]);
             }
             if (pass > 0 && !touched[(size_t)idx[0]] && !touched[(size_t)idx[1]] && !touched[(size_t)idx[2]]) continue;
-            if (faceClear(rec.sdf, rec.face_certs[(size_t)fi], s, e, lev, L, &evals)) continue;
-            sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
-            sdfccd_QueryResult res;
-            sdfccd_Status status = SDFCCD_OK;
-            const sdfccd_QueryParams qp = faceParams(st->impl, lev);
-            status = sdfccd_query_triangle_linear(rec.sdf, nullptr, ss, ee, 0.0, dt, &qp, st->contacts.data(), 8, &res);
-            ++st->stats.face_queries;
-            if (status == SDFCCD_OK && res.state == SDFCCD_STATE_PENETRATING && res.contact_count > 0) {
-                // A face that starts deeper than its level may not end deeper than it started (a
-                // level of start depth minus the tolerance would let it sink that much every step).
-                evals += res.sdf_evaluations;
-                double deepest = lev;
-                for (int j = 0; j < res.contact_count; ++j) deepest = std::min(deepest, st->contacts[(size_t)j].distance);
-                const sdfccd_QueryParams qd = faceParams(st->impl, deepest - 0.1 * tol);
-                status = sdfccd_query_triangle_linear(rec.sdf, nullptr, ee, ee, 0.0, dt, &qd, st->contacts.data(), 8, &res);
-                ++st->stats.face_queries;
-                if (status == SDFCCD_OK && res.hit) {
-                    for (int k = 0; k < 3; ++k) setEnd(idx[k], s[k]);
-                    changed = true;
-                }
-                continue;
-            }
+            const sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
+            sdfccd_FaceGuard fg;
+            const sdfccd_Status status = sdfccd_guard_face(rec.sdf, &rec.face_certs[(size_t)fi], ss, ee, lev, tol, L, &st->impl->cfg.query,
+                                                           dt, pass >= passes, &fg, &evals);
             if (status != SDFCCD_OK) {
                 if (status != SDFCCD_DEGENERATE) ++st->stats.query_errors;
                 continue;
             }
-            if (!res.hit) continue;
-            // The last pass: the face goes back to its start, where the previous check left it.
-            const D3 nw = F.dirToWorld(unit(fromSv(st->contacts[0].normal)));
-            double f = pass >= passes ? 0.0 : res.fraction;
-            if (f > 0) { // back to where the face first reached half that depth (see the nodes)
-                const sdfccd_QueryParams qh = faceParams(st->impl, lev + 0.5 * tol);
-                sdfccd_QueryResult rh;
-                if (sdfccd_query_triangle_linear(rec.sdf, nullptr, ss, ee, 0.0, dt, &qh, st->contacts.data(), 8, &rh) == SDFCCD_OK) {
-                    ++st->stats.face_queries;
-                    evals += rh.sdf_evaluations;
-                    if (rh.hit) f = std::min(f, rh.state == SDFCCD_STATE_PENETRATING ? 0.0 : rh.fraction);
-                }
-            }
+            st->stats.face_queries += fg.queries;
+            if (!fg.hit) continue;
             for (int k = 0; k < 3; ++k) {
-                setEnd(idx[k], s[k] + (e[k] - s[k]) * f);
-                stopInto(*face.m_n[k], nw);
+                setEnd(idx[k], s[k] + (e[k] - s[k]) * fg.fraction);
+                if (fg.stop) stopInto(*face.m_n[k], F.dirToWorld(unit(fromSv(fg.normal))));
             }
             changed = true;
         }

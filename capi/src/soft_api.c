@@ -183,3 +183,63 @@ sdfccd_Status sdfccd_segment_first_hit(sdfccd_SdfId sdf, const sdfccd_Vec3 start
 {
     SDFCCD__HELD_CALL(segment_first_hit_held(sdf, start, end, level, spacing, lipschitz, out, io_sdf_evaluations));
 }
+
+/* The soft guard's face rule (the bridge's guard, per face; Section 4 with per-vertex linear motion):
+ * composed of the public certificate and triangle query, so the engine bridge only moves nodes. */
+static sdfccd_Status guard_face_held(sdfccd_SdfId sdf, sdfccd_DistanceCert* cert, const sdfccd_Vec3* s, const sdfccd_Vec3* e, double level,
+                                     double tol, double lipschitz, const sdfccd_QueryParams* params, double duration, int32_t last_pass,
+                                     sdfccd_FaceGuard* out, int64_t* io_evals)
+{
+    static const char fn[] = "sdfccd_guard_face";
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(params, "sdfccd_guard_face: params")) || (st = sdfccd__check_ptr(out, "sdfccd_guard_face: out")))
+        return st;
+    if (!(isfinite(tol) && tol > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: tolerance = %g is not finite and > 0", fn, tol);
+    if (!(isfinite(duration) && duration > 0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: duration = %g is not finite and > 0", fn, duration);
+    int32_t clear = 0;
+    int64_t evals = 0;
+    if ((st = sdfccd_triangle_clear(sdf, cert, s, e, level, lipschitz, &clear, &evals))) return st;
+    sdfccd_FaceGuard r = { 0, 0.0, 0, { 0, 0, 1 }, 0 };
+    sdfccd_Contact c[8];
+    sdfccd_QueryResult res;
+    sdfccd_QueryParams qp = *params;
+    qp.margin = level;
+    if (!clear) {
+        ++r.queries;
+        if ((st = sdfccd_query_triangle_linear(sdf, NULL, s, e, 0.0, duration, &qp, c, 8, &res))) return st;
+        evals += res.sdf_evaluations;
+        if (res.state == SDFCCD_STATE_PENETRATING && res.contact_count > 0) {
+            /* Started below the level: no deeper than its deepest start point (a level of start depth
+             * minus the tolerance would let it sink that much every step). */
+            double deepest = level;
+            for (int j = 0; j < res.contact_count; ++j) deepest = fmin(deepest, c[j].distance);
+            qp.margin = deepest - 0.1 * tol;
+            ++r.queries;
+            if ((st = sdfccd_query_triangle_linear(sdf, NULL, e, e, 0.0, duration, &qp, c, 8, &res))) return st;
+            evals += res.sdf_evaluations;
+            r.hit = res.hit ? 1 : 0;
+        } else if (res.hit) {
+            r.hit = r.stop = 1;
+            r.normal = c[0].normal;
+            r.fraction = last_pass ? 0.0 : res.fraction;
+            if (r.fraction > 0) { /* back to where the face first came within half the tolerance */
+                qp.margin = level + 0.5 * tol;
+                ++r.queries;
+                if ((st = sdfccd_query_triangle_linear(sdf, NULL, s, e, 0.0, duration, &qp, c, 8, &res))) return st;
+                evals += res.sdf_evaluations;
+                if (res.hit) r.fraction = fmin(r.fraction, res.state == SDFCCD_STATE_PENETRATING ? 0.0 : res.fraction);
+            }
+        }
+    }
+    *out = r;
+    if (io_evals) *io_evals += evals;
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_guard_face(sdfccd_SdfId sdf, sdfccd_DistanceCert* cert, const sdfccd_Vec3 start[3], const sdfccd_Vec3 end[3], double level,
+                                double tolerance, double lipschitz, const sdfccd_QueryParams* params, double duration, int32_t last_pass, sdfccd_FaceGuard* out,
+                                int64_t* io_sdf_evaluations)
+{
+    SDFCCD__HELD_CALL(guard_face_held(sdf, cert, start, end, level, tolerance, lipschitz, params, duration, last_pass, out, io_sdf_evaluations));
+}

@@ -485,6 +485,31 @@ SDFCCD_API sdfccd_Status sdfccd_guard_point(sdfccd_SdfId sdf, const sdfccd_Dista
 SDFCCD_API sdfccd_Status sdfccd_segment_first_hit(sdfccd_SdfId sdf, const sdfccd_Vec3 start[2], const sdfccd_Vec3 end[2], double level,
                                                   double spacing, double lipschitz, sdfccd_PointHit* out, int64_t* io_sdf_evaluations);
 
+/** The guard's verdict on one face over a step (sdfccd_guard_face()). */
+typedef struct sdfccd_FaceGuard {
+    int32_t hit;         /**< 1: the face's corners go back to `fraction` of their motion */
+    double fraction;     /**< in [0, 1] (0: back to the start; 0 when not hit) */
+    int32_t stop;        /**< 1: a crossing; the corners lose their velocity into `normal` there */
+    sdfccd_Vec3 normal;  /**< the SDF's normal at the crossing (SDF frame, unit; valid when stop is 1) */
+    int32_t queries;     /**< triangle queries run (sdfccd_query_triangle_linear()) */
+} sdfccd_FaceGuard;
+
+/** The no-tunnelling guard for one face whose corners move linearly from start[] to end[] (SDF
+ * frame): no point of it may go below `level` (<= 0; a soft body: the lowest of its nodes' levels,
+ * sdfccd_guard_point()). Skipped without a query when sdfccd_triangle_clear() certifies it (with
+ * `cert`). A face that starts below `level` may not end deeper than its deepest start point minus a
+ * tenth of the tolerance (else back to its start, stop 0). A face that crosses goes back to where it
+ * first came within half the tolerance of the level (or to its start when `last_pass` is non-zero:
+ * an engine repeating the guard over the faces whose nodes it moved ends that way). `params`: the
+ * query settings (the margin is the guard's own), its time tolerances against the step's `duration`
+ * (s, > 0). Adds the SDF evaluations to
+ * *io_sdf_evaluations (may be NULL). Errors (nothing written): INVALID_HANDLE, DEGENERATE for a
+ * zero-area start (its corners are checked on their own), INVALID_ARGUMENT for a NULL pointer, a
+ * corner or level not finite, tolerance, lipschitz or duration not finite and > 0, or a failing query's status. */
+SDFCCD_API sdfccd_Status sdfccd_guard_face(sdfccd_SdfId sdf, sdfccd_DistanceCert* cert, const sdfccd_Vec3 start[3], const sdfccd_Vec3 end[3],
+                                           double level, double tolerance, double lipschitz, const sdfccd_QueryParams* params,
+                                           double duration, int32_t last_pass, sdfccd_FaceGuard* out, int64_t* io_sdf_evaluations);
+
 #ifdef __cplusplus
 }
 #endif
