@@ -21,6 +21,7 @@
 #include "sdf_analytic.h"
 #include "grid.h"
 #include "grid_access.h"
+#include "grid_cell.h"
 #include <string.h>
 
 typedef struct region {
@@ -30,29 +31,44 @@ typedef struct region {
 
 SCC_MIN_HEAP(region_heap, region, ta)
 
-/* Whether phi is convex on `box`: the field's own answer or, for CSG (ours, issue 20), where one
- * operand decides phi on the whole box (the operands evaluated at its centre, their Lipschitz bounds
- * over its half-diagonal), that operand's answer: a cube minus a ball is the cube's convex distance
- * away from the carved ball, which lets the first-order bound prune sliding contacts there. */
-static int convex_on(const scc_sdf* sdf, const scc_aabb* box, int64_t* evals)
+/* A bound K >= 0 on how much sign * phi bends down inside the ball of radius `rad` around c (ours,
+ * issue 20): sign * phi(x) >= v + g.(x - c) - K |x - c|^2 / 2 there, with v = sign * phi(c) and g
+ * the gradient of sign * phi that scc_sdf_eval gives at c; INFINITY when unknown. `box` contains the
+ * ball. A convex phi bends by 0. The negated distance of a convex shape bends by at most 1 / d,
+ * d the smallest distance to the shape (less its inflation radius) inside the ball (the distance to
+ * a convex set has Hessian eigenvalues in [0, 1 / distance]). CSG: a max of operands is at least
+ * its active operand, so it bends as that one (the one whose gradient scc_sdf_eval gives); a min,
+ * only where one operand decides the whole ball. So a cube minus a ball bends by 1 / |x| where the
+ * ball's inside decides, and sliding along the carved sphere costs only that curvature term. */
+static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals)
 {
-    if (scc_sdf_convex_in(sdf, box)) return 1;
-    if (sdf->kind != SCC_SDF_CSG) return 0;
-    const scc_sdf_csg* s = (const scc_sdf_csg*)sdf;
-    const scc_vec3 c = scc_scale(scc_add(box->lo, box->hi), 0.5);
-    const double h = 0.5 * scc_dist(box->lo, box->hi);
-    double a = scc_sdf_eval(s->a, c, NULL), b = scc_sdf_eval(s->b, c, NULL);
-    *evals += 2;
-    const double ra = scc_sdf_lipschitz(s->a, box) * h, rb = scc_sdf_lipschitz(s->b, box) * h;
-    if (s->op == SCC_CSG_DIFFERENCE) b = -b; /* max(a, -b) */
-    if (s->op == SCC_CSG_UNION) { /* min(a, b) */
-        if (a + ra < b - rb) return scc_sdf_convex_in(s->a, box);
-        if (b + rb < a - ra) return scc_sdf_convex_in(s->b, box);
-        return 0;
+    if (sdf->kind == SCC_SDF_HALF_SPACE || (sign > 0 && scc_sdf_convex_in(sdf, box))) return 0.0;
+    if (sign < 0 && sdf->convex) {
+        double inflate;
+        switch (sdf->kind) {
+        case SCC_SDF_SPHERE: inflate = ((const scc_sdf_sphere*)sdf)->radius; break;
+        case SCC_SDF_ROUNDED_BOX: inflate = ((const scc_sdf_box*)sdf)->radius; break;
+        case SCC_SDF_CAPSULE: inflate = ((const scc_sdf_capsule*)sdf)->radius; break;
+        case SCC_SDF_BOX: case SCC_SDF_CYLINDER: inflate = 0.0; break;
+        default: return INFINITY;
+        }
+        const double d = -v + inflate - sdf->lipschitz * rad;
+        return d > 0.0 ? 1.0 / d : INFINITY;
     }
-    if (a - ra > b + rb) return scc_sdf_convex_in(s->a, box);
-    if (s->op == SCC_CSG_INTERSECTION && b - rb > a + ra) return scc_sdf_convex_in(s->b, box);
-    return 0;
+    if (sdf->kind != SCC_SDF_CSG) return INFINITY;
+    const scc_sdf_csg* s = (const scc_sdf_csg*)sdf;
+    const double a = scc_sdf_eval(s->a, c, NULL), b = scc_sdf_eval(s->b, c, NULL);
+    *evals += 2;
+    if (!(a == a && b == b)) return INFINITY;
+    /* sign * phi = M(sa a, sb b), M a max or a min; the operands' values at c and their reach */
+    const int sa = sign, sb = s->op == SCC_CSG_DIFFERENCE ? -sign : sign;
+    const int is_max = (s->op != SCC_CSG_UNION) == (sign > 0);
+    const double va = sa * a, vb = sb * b;
+    if (is_max) return va >= vb ? bend_bound(s->a, sa, box, c, rad, va, evals) : bend_bound(s->b, sb, box, c, rad, vb, evals);
+    const double ra = scc_sdf_lipschitz(s->a, box) * rad, rb = scc_sdf_lipschitz(s->b, box) * rad;
+    if (va + ra < vb - rb) return bend_bound(s->a, sa, box, c, rad, va, evals);
+    if (vb + rb < va - ra) return bend_bound(s->b, sb, box, c, rad, vb, evals);
+    return INFINITY;
 }
 
 static scc_vec3 corner(const scc_tri_state* st, double u, double v)
@@ -86,14 +102,6 @@ typedef struct grid_bound_ctx {
     cell_poly cell[CELL_CACHE];
 } grid_bound_ctx;
 
-/* Values at {-1,-1/3,1/3,1} -> cubic Bernstein coefficients on [-1,1] (as scc_cell_bernstein). */
-static const double k_to_bernstein[4][4] = {
-    { 1.0, 0.0, 0.0, 0.0 },
-    { -5.0 / 6.0, 3.0, -1.5, 1.0 / 3.0 },
-    { 1.0 / 3.0, -1.5, 3.0, -5.0 / 6.0 },
-    { 0.0, 0.0, 0.0, 1.0 },
-};
-
 /* The slot of the node at tensor point (i, j, k) of {-1,-1/3,1/3,1}^3, or -1 (a face or inner point). */
 static int tensor_slot(int i, int j, int k)
 {
@@ -124,7 +132,7 @@ static void cell_bernstein_of(const double v[32], double b[64])
         for (int s = 0; s < 64; ++s) {
             const int idx = (s / stride) % 4, base = s - idx * stride;
             double acc = 0.0;
-            for (int m = 0; m < 4; ++m) acc += k_to_bernstein[idx][m] * f[base + m * stride];
+            for (int m = 0; m < 4; ++m) acc += scc_cell_to_bernstein[idx][m] * f[base + m * stride];
             t[s] = acc;
         }
         memcpy(f, t, sizeof f);
@@ -428,14 +436,17 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         /* Which part of the bound's slack to refine: the Lipschitz ball's spatial and temporal
          * radii, or, for a convex phi, the spatial and temporal parts of the first-order bound. */
         double slack_space = rs, slack_time = rt;
-        if (convex_on(sdf, &box, &evals)) {
-            /* First-order bound of a convex phi: phi(x) >= phi(c) + g.(x - c) (first_order_terms).
-             * Tangential sliding therefore costs nothing, unlike in the Lipschitz ball. */
+        const double bend = grid ? INFINITY : bend_bound(sdf, 1, &box, c, rho, phi, &evals);
+        if (bend < INFINITY) {
+            /* First-order bound of a convex phi, less the bending term: phi(x) >= phi(c) + g.(x - c)
+             * - K rho^2 / 2 (first_order_terms, bend_bound). Tangential sliding costs only K. */
             const first_order f = first_order_terms(&st, &r, c, gc, accel);
-            if (phi + f.lin - f.curve > p->margin) continue;
-            if (phi + f.lin - f.curve > phi - L * rho) {
-                slack_space = -fmin(f.lin_space, 0.0);
-                slack_time = -fmin(f.lin_time, 0.0) + f.curve;
+            const double curv = 0.5 * bend * rho * rho;
+            const double bound = phi + f.lin - f.curve - curv;
+            if (bound > p->margin) continue;
+            if (bound > phi - L * rho) {
+                slack_space = -fmin(f.lin_space, 0.0) + (rho > 0.0 ? curv * rs / rho : 0.0);
+                slack_time = -fmin(f.lin_time, 0.0) + f.curve + (rho > 0.0 ? curv * rt / rho : 0.0);
             }
         } else if (grid) {
             /* a grid: the smallest of the per-cell first-order bounds (grid_region_bound) */
