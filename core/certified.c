@@ -385,8 +385,8 @@ static void stack_free(void* mem, size_t size, void* user)
 /* A seeded search (the check of FWGSS) looks for witnesses in every WITNESS_EVERY-th generation
  * of regions only (ours): while FWGSS's witness stands, which it does in nearly every check,
  * witnesses are 7 of a split region's 8 evaluations and find nothing; a region holding an earlier
- * contact is refined until a sampled generation finds it. Kinds data set, evaluations per query,
- * every 1 / 2 / 4 / 8 generations: csg-difference 3,608 / 3,149 / 3,325 / 4,268 (mean |dTOI| above
+ * contact is refined until a sampled generation finds it. Kinds data set, evaluations per query
+ * (check to 1e-7 s), every 1 / 2 / 4 / 8 generations: csg-difference 3,608 / 3,149 / 3,325 / 4,268 (mean |dTOI| above
  * 1e-8 s at 8), grid-spikes 10,906 / 8,569 / 7,351 / 6,919, box 639 / 562 / 522 / 490; 0 misses. */
 #define WITNESS_EVERY 4
 /* The search. `seed_t` (INFINITY: none) is a known contact (weights seed_b) that is the initial upper
@@ -599,7 +599,7 @@ static int verify_search(const scc_sdf* sdf, const scc_tri_motion* m, double ta,
         grid.g = (const scc_grid*)sdf;
         for (int i = 0; i < CELL_CACHE; ++i) grid.cell[i].l = UINT64_MAX;
     }
-    if (!certified_search(sdf, m, ta, io->hit ? io->toi : tb, p, &hooks, seed_t, io->bary, fmax(p->time_tol, SCC_VERIFY_TOL), budget,
+    if (!certified_search(sdf, m, ta, io->hit ? io->toi : tb, p, &hooks, seed_t, io->bary, fmax(SCC_VERIFY_TOL_FRACTION * p->time_tol, SCC_VERIFY_TOL), budget,
                           on_grid ? &grid : NULL, &c))
         return 0;
     io->evals += c.evals;

@@ -219,7 +219,7 @@ END_TEST
  * off misses 5, 33 and 3. */
 #define KINDS 4
 #define CASES_PER_KIND 250
-#define KINDS_MAX_EVALS_CSG_DIFFERENCE 6000 /* 3,220.1 at this commit; 13,059.3 with the Lipschitz ball (main at 0bf5a0b) */
+#define KINDS_MAX_EVALS_CSG_DIFFERENCE 6000 /* 2,656.4 now; 13,059.3 with the Lipschitz ball (main at 0bf5a0b) */
 
 static void surface_point(sdfccd_SdfId sdf, double box, test_rng* rng, sdfccd_Vec3* x, sdfccd_Vec3* n)
 {
