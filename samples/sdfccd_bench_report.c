@@ -234,7 +234,7 @@ static void section_kinds(FILE* md, const char* dir, const table* t, const table
                 "per-cell first-order Taylor bounds instead of the cells' Lipschitz bounds, where the cells along the path bound "
                 "|∇φ| above 2.25 (a crease); on analytic fields the check's first-order bound less a bending term (0 where phi is convex; "
                 "a CSG max bends as its active operand, the negated distance of a convex shape by 1/distance), its regions bounded only "
-                "up to 1e-7 s before FWGSS's witness, witnesses sampled in every 4th generation of regions; on convex fields without the guard's searches; "
+                "up to 3e-8 s before FWGSS's witness (it proves no earlier contact beyond that), witnesses sampled in every 4th generation of regions; on convex fields without the guard's searches; "
                 "on grids the guard's extra searches only when phi bends sharply at the earliest contact); FWGSS-before: the defaults of the commit in "
                 "`kinds_machine.txt` (when present: main before the check); FWGSS-guard-off: FWGSS before issue 20 (`fwgss_kink_guard` "
                 "0: no guard, no check); FWGSS-guard-2: the guard on every grid query too; FWGSS-baseline and "
