@@ -117,6 +117,10 @@ int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, dou
  * runs only where the cells the triangle sweeps have a gradient bound above
  * SCC_VERIFY_GRID_MIN_LIPSCHITZ (a crease; a smooth shape's grid stays near 1). */
 int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p);
+/* The bending bound of the certified search on analytic fields, for tests (certified.c): K >= 0 with
+ * phi(x) >= phi(c) + g.(x - c) - K |x - c|^2 / 2 for every x within rad of c, g the gradient
+ * scc_sdf_eval gives at c (0 where phi is convex); INFINITY when unknown. */
+double scc_sdf_bend_bound(const scc_sdf* sdf, scc_vec3 c, double rad);
 /* The lower bound of phi that the check uses on a grid, for tests: over the sub-triangle with weights
  * (u[i], v[i], 1 - u[i] - v[i]) of motion m over [ta, tb]; `local` 1: every cell's Hessian bound over
  * its part of the region's box (0: the whole cell's where the box lies inside it). Returns 0 when the

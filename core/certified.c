@@ -72,6 +72,13 @@ static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_
     return INFINITY;
 }
 
+double scc_sdf_bend_bound(const scc_sdf* sdf, scc_vec3 c, double rad)
+{
+    const scc_aabb box = { scc_sub(c, scc_v3(rad, rad, rad)), scc_add(c, scc_v3(rad, rad, rad)) };
+    int64_t evals = 0;
+    return bend_bound(sdf, 1, &box, c, rad, scc_sdf_eval(sdf, c, NULL), &evals);
+}
+
 static scc_vec3 corner(const scc_tri_state* st, double u, double v)
 {
     return scc_add(scc_add(scc_scale(st->x[0], u), scc_scale(st->x[1], v)), scc_scale(st->x[2], 1.0 - u - v));
