@@ -266,11 +266,13 @@ static void pose_at(const scc_mesh_motion* mm, double t, scc_rigid rests[2], scc
 
 static int is_zero(scc_vec3 v) { return v.x == 0.0 && v.y == 0.0 && v.z == 0.0; }
 
-/* The mesh's radius: the largest distance of a vertex from its centre of rotation (rigid), or half
- * the diagonal of the start positions' box (linear). */
+/* The mesh's radius: the largest distance of a vertex from its centre of rotation (rigid: from the
+ * mesh's cached radius about its origin, exact when the centre is the origin, else that radius plus
+ * the centre's offset, a bound), or half the diagonal of the start positions' box (linear). */
 static double mesh_radius(const scc_mesh_motion* mm)
 {
     double r2 = 0.0;
+    if (mm->body && mm->mesh->radius > 0.0) return mm->mesh->radius + scc_len(mm->body->c_local);
     if (mm->body) {
         for (uint32_t i = 0; i < mm->mesh->vertex_count; ++i) r2 = fmax(r2, scc_len2(scc_sub(mm->mesh->vertices[i], mm->body->c_local)));
         return sqrt(r2);
