@@ -68,10 +68,10 @@ public:
             m_manifold = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
             m_own = true;
         }
-        btPersistentManifold* all[1 + kExtraManifolds] = { m_manifold };
+        btPersistentManifold* all[1 + kMaxExtra] = { m_manifold };
         int count = 1;
         if (!m_closest && m_bridge->cfg.max_contacts >= MANIFOLD_CACHE_SIZE)
-            for (int i = 0; i < kExtraManifolds; ++i) {
+            for (int i = 0; i < kMaxExtra; ++i) {
                 if (!m_extra[i]) m_extra[i] = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
                 all[count++] = m_extra[i];
             }
@@ -93,11 +93,12 @@ public:
             if (m) manifoldArray.push_back(m);
     }
 
+    static const int kMaxExtra = 3;
 
 private:
     BridgeImpl* m_bridge;
     btPersistentManifold* m_manifold;
-    btPersistentManifold* m_extra[kExtraManifolds] = { nullptr, nullptr, nullptr }; // the cover points (contact_policy.cpp)
+    btPersistentManifold* m_extra[kMaxExtra] = { nullptr, nullptr, nullptr }; // the cover points (contact_policy.cpp)
     bool m_own;
     bool m_mesh_is_body1;
     bool m_closest;
@@ -150,11 +151,7 @@ BridgeImpl::BridgeImpl(const Config& c) : cfg(c)
     if (!(cfg.contact_margin >= 0)) cfg.contact_margin = 0;
 }
 
-BridgeImpl::~BridgeImpl()
-{
-    sdfccd_destroy_workspace(workspace);
-    for (sdfccd_Workspace* ws : batch_ws) sdfccd_destroy_workspace(ws);
-}
+BridgeImpl::~BridgeImpl() { sdfccd_destroy_workspace(workspace); }
 
 bool BridgeImpl::isOurSdf(const btCollisionShape* s) const
 {
@@ -575,7 +572,14 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported)
                   "Bullet's GImpact algorithm is colliding a GImpact mesh with an SdfShape, without CCD (it can pass through): %s; "
                   "Bridge::check(world) names the problem",
                   what);
-    callMisuseHandler(status, message, shape);
+    MisuseHandler h;
+    void* user;
+    {
+        std::lock_guard<std::mutex> lock(g_misuse_mutex);
+        h = g_misuse_handler ? g_misuse_handler : defaultMisuseHandler;
+        user = g_misuse_user;
+    }
+    h(status, message, shape, user);
 }
 
 } // namespace detail

@@ -82,14 +82,14 @@ sdfccd_BodyState bodyState(const btRigidBody* b)
     return s;
 }
 
-// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
+} // namespace
+
 sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out)
 {
     const sdfccd_Pose pa = toPose(a), pb = toPose(b);
     return sdfccd_rigid_motion_from_poses(&pa, &pb, v3(c), 0, dt, out);
 }
 
-} // namespace
 
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world)
 {

@@ -11,15 +11,16 @@
  *      as triangles: a box's 12, other shapes' btShapeHull hull;
  *      SdfShape vs SdfShape (Config::sdf_pairs): the moving one's isosurface triangulation
  *      against the other's field.
- *  - the contact model, per pair and step: the core's one generator, sdfccd_generate_contacts()
- *    (contact.h; start pose = world transform, end pose = interpolation transform): the features
- *    within the step's reach at the start pose, the CCD's contact set at the first time of impact
- *    and the features touching at the end pose, each written as a point held by its surface point
- *    and normal at the start of the step (a speculative contact with gap d > 0 lets the solver
- *    close at most d; restitution 0), reduced to the manifold's 4 points, with cover points in up
- *    to three more manifolds where the 4 leave the body free to turn into the surface. Points of
- *    the same material point as the last step's keep their warm-start impulses; Bullet's contact
- *    added, processed, started and ended callbacks fire as for its own manifolds.
+ *  - the contact model, per pair and step: the features within the step's reach at the start
+ *    pose, the CCD's contact set at the first time of impact of the predicted motion (start pose
+ *    = world transform, end pose = interpolation transform) and the features touching at the end
+ *    pose, each written as a point held by its surface point and normal at the start of the step
+ *    (a speculative contact with gap d > 0 lets the solver close at most d; restitution 0). The
+ *    set is reduced to the manifold's 4 points (deepest, then the largest contact area), and cover
+ *    points (sdfccd_cover_contacts) go into up to three more manifolds where the 4 leave the body
+ *    free to turn into the surface. Points of the same material point as the last step's keep
+ *    their warm-start impulses; Bullet's contact added, processed, started and ended callbacks
+ *    fire as for its own manifolds.
  *  - Bridge::check(world) reports misuse (not registered, registered too late, overwritten,
  *    an SdfShape with a dead handle); while a world steps, Bullet's
  *    GImpact algorithm colliding with an SdfShape (the bridge not in charge) goes to the misuse
@@ -148,15 +149,18 @@ struct Config {
      * against the other's field. Off: such pairs have no algorithm and pass through each other
      * (check() cannot see that; keep it on unless no two SDF bodies can meet). Default on. */
     bool sdf_pairs = true;
-    /** Threads for the contact sets of a step (1..256; default 1: each pair's set is made in the
-     * narrow phase, pair by pair, on Bullet's thread). With more, the first pair of each step that
-     * the bridge processes makes the sets of EVERY pair the world's broad phase holds for it
-     * (sdfccd_generate_contacts_batch on this many threads, a workspace each), and each pair then
-     * takes its own: bitwise the set it would have made itself, so the simulation does not depend
-     * on the count. Needs registerWith(btCollisionWorld*) (the pair cache is the world's). Not
-     * batched: compound children, a btSdfCollisionShape, closest-point queries. An SdfShape made
-     * from a callback SDF is then evaluated from several threads at once: its callback must be
-     * thread-safe (the library's built-in SDFs are). */
+    /** Threads for the queries of a step (1..256; default 1: every query runs in the narrow phase,
+     * pair by pair, on Bullet's thread). With more, the first pair of each step that the bridge
+     * processes runs the queries of EVERY pair the world's broad phase holds for it (the start-pose
+     * query, then the CCD queries, then the end-pose queries, each stage as one sdfccd_query_batch
+     * on this many threads), and each pair then takes its results from there. The results are
+     * bitwise those the pair would have computed itself, so the simulation is the same whatever the
+     * count. Needs registerWith(btCollisionWorld*) (the pair cache is the world's). Not batched,
+     * and queried in the narrow phase as before: compound children, pairs with the face search, a
+     * btSdfCollisionShape, the DCD baseline (query.method DCD), closest-point queries. An SdfShape
+     * made from a callback SDF is then evaluated from several threads at once: its callback must be
+     * thread-safe (the library's built-in SDFs are). Stats::batched_queries counts the queries used
+     * from a batch. */
     int batch_threads = 1;
     /** Query parameters passed to sdfccd_query_mesh (margin is replaced by contact_margin): the
      * library's defaults except fwgss_restarts (0): the bridge's discrete query over every
@@ -170,13 +174,14 @@ struct Config {
 
 /** Counters for measurements (all since construction or resetStats()). */
 struct Stats {
-    int64_t queries = 0;               /**< CCD queries over the step (sdfccd_ContactSet::ccd_ran). */
+    int64_t queries = 0;               /**< CCD queries (sdfccd_query_mesh over the step) made by the algorithm. */
     int64_t end_pose_queries = 0;      /**< Discrete queries (at the start pose over the step's reach, at the predicted end pose). */
-    int64_t queries_skipped = 0;       /**< Pair-steps without a CCD query: nothing within reach (the start-pose query's
-                                            broad phase proves no contact), or the step starts in contact. */
-    int64_t sdf_evaluations = 0;       /**< SDF evaluations of the mesh queries and the face search (the library's count). */
-    int64_t own_evaluations = 0;       /**< The other SDF evaluations of contact generation (closest points at the start of
-                                            the step; sdfccd_ContactSet::own_evaluations). */
+    int64_t queries_skipped = 0;       /**< CCD queries not run because the start-pose query settled them: nothing
+                                            within reach (its broad phase proves no contact), or the step starts in
+                                            contact (the CCD would report penetration at the start with the same features). */
+    int64_t requeries = 0;             /**< Queries repeated because the contact buffer was too small. */
+    int64_t sdf_evaluations = 0;       /**< SDF evaluations of all those queries (the library's count). */
+    int64_t own_evaluations = 0;       /**< The bridge's own SDF evaluations (closest points at the start of the step). */
     int64_t candidates = 0;            /**< Contact candidates before the reduction to 4 points. */
     double query_seconds = 0;          /**< Wall time inside all those calls. */
     int64_t hits = 0;                  /**< Pair-steps with contact: CCD hits and steps that start in contact. */
@@ -189,9 +194,9 @@ struct Stats {
     int64_t guard_skipped = 0;         /**< Checks the guarantee settled without a CCD: bodies that did not move,
                                             and motions sdfccd_guard_step_rigid's certificate proved clear. */
     int64_t face_regions = 0;          /**< Regions visited by the face search (SdfShape::setFeatureSize). */
-    int64_t batched_queries = 0;       /**< Queries of contact sets taken from a step's batch (Config::batch_threads);
+    int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
                                             they are counted in queries, end_pose_queries and sdf_evaluations too. */
-    int64_t batches = 0;               /**< sdfccd_generate_contacts_batch calls (Config::batch_threads; one per step). */
+    int64_t batches = 0;               /**< sdfccd_query_batch calls (Config::batch_threads; up to 3 per step). */
     double last_toi_fraction = 1;      /**< Fraction of the last hit (1 when none). */
     int last_state = 0;                /**< sdfccd_ResultState of the last query. */
 };
