@@ -408,11 +408,15 @@ static int candidates(gen* g, const scc_contact_params* cp, double radius)
         }
     }
 
-    /* 4. the start pose's features and the end pose's, each held from t0 */
+    /* 4. the start pose's features and the end pose's, each held from t0; no end-pose query when
+     *    the step's travel is within end_skip_travel (its features are the start pose's, moved by at
+     *    most that) */
     if (dt > 0.0) {
+        const int end_query = !(continuous && cp->end_skip_travel > 0.0 && travel <= cp->end_skip_travel);
         if (kept && !add_pose(g, kept, r0.contacts_found, &start, 1, touching ? fmax(start_margin, vertex_accept) : start_margin)) return 0;
         scc_query_summary r1;
         dp.margin = margin;
+        if (!end_query) return 1;
         sum->discrete_queries++;
         if (!query(g, &end, &dp, &r1)) return 0;
         if (r1.hit && !add_pose(g, slot_contacts(g), r1.contacts_found, &end, same_pose(&end, &start), margin)) return 0;

@@ -1097,6 +1097,16 @@ START_TEST(test_generate_rules_resting_closed_form)
         for (int32_t i = 0; i < cap; ++i) ck_assert(memcmp(&few[i], &c[i], sizeof few[i]) == 0);
     }
     assert_bottom_corners(few, 4, m.pose.position, 0.005);
+    /* end_skip_travel: the step's travel (0) is within it, so no end-pose query: the start pose's 22
+     * candidates and (10 + 20) evaluations, and the same 4 points (the end pose's were the same) */
+    sdfccd_ContactParams ps = p;
+    ps.end_skip_travel = 0.0005;
+    sdfccd_ContactSet s4 = generate_p(ws, floor, NULL, cube, &m, &ps, few, 4);
+    ck_assert_int_eq(s4.discrete_queries, 1);
+    ck_assert_int_eq(s4.candidates, 22);
+    ck_assert_int_eq(s4.own_evaluations, 30);
+    ck_assert_int_eq(s4.count, 4);
+    for (int32_t i = 0; i < 4; ++i) ck_assert(memcmp(&few[i], &c[i], sizeof few[i]) == 0);
     /* the same with the floor given as a motion at rest (moved and turned): the same points moved */
     sdfccd_RigidMotion sm = sdfccd_default_rigid_motion();
     sm.pose.position = (sdfccd_Vec3){ 1, 2, 3 };
@@ -1151,6 +1161,11 @@ START_TEST(test_generate_rules_falling_closed_form)
     ck_assert_int_eq(set.candidates, 94);
     ck_assert_int_eq(set.own_evaluations, 116);
     assert_bottom_corners(c, set.count, m.pose.position, 0.05);
+    /* a travel of 10/60 m is beyond end_skip_travel: the end pose is still queried, the same set */
+    p.end_skip_travel = 0.0005;
+    sdfccd_ContactSet s2 = generate_p(ws, floor, NULL, cube, &m, &p, c, 4);
+    ck_assert_int_eq(s2.discrete_queries, 2);
+    ck_assert_int_eq(s2.candidates, 94);
     sdfccd_destroy_workspace(ws);
     ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
     ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
