@@ -109,14 +109,15 @@ static scc_vec3 point_at(const scc_mesh_motion* mm, uint32_t t, const double bar
     return scc_tri_point_at(&m, bary, at, NULL);
 }
 
-/* The material point held by its own closest surface point at t0. */
-static int add_from_start(gen* g, uint32_t t, const double bary[3])
+/* The material point held by its own closest surface point at t0 (none when phi there is above
+ * `accept`). */
+static int add_from_start(gen* g, uint32_t t, const double bary[3], double accept)
 {
     const scc_vec3 x0 = point_at(g->mm, t, bary, g->mm->t0);
     scc_vec3 grad;
     const double phi = scc_sdf_eval(g->sdf, x0, &grad);
     g->sum->own_evals++;
-    if (!isfinite(phi)) return 1;
+    if (!isfinite(phi) || !(phi <= accept)) return 1;
     const scc_vec3 n = scc_normalize_or(grad, scc_v3(0, 0, 0));
     if (!(scc_len2(n) > 0.0)) return 1;
     return add(g, t, bary, x0, scc_sub(x0, scc_scale(n, phi)), n, g->mm->t0);
@@ -167,20 +168,25 @@ static int corner_of(const scc_mesh* mesh, const vertex_ref* r)
 static const double unit_bary[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
 
 /* The contacts of a discrete query at pose `pose` (a motion at rest at that time), each held from
- * t0, and the vertices of their triangles whose phi at that pose is at most `accept`. */
-static int add_pose(gen* g, const scc_contact* cs, int count, const scc_mesh_motion* pose, double accept)
+ * t0, and the vertices of their triangles whose phi at that pose is at most `accept`. At the start
+ * pose (`at_start`) a vertex is evaluated once: the test and its closest point from one value. */
+static int add_pose(gen* g, const scc_contact* cs, int count, const scc_mesh_motion* pose, int at_start, double accept)
 {
     const scc_mesh* mesh = g->mm->mesh;
     for (int i = 0; i < count; ++i)
-        if (cs[i].triangle < mesh->triangle_count && !add_from_start(g, cs[i].triangle, cs[i].bary)) return 0;
+        if (cs[i].triangle < mesh->triangle_count && !add_from_start(g, cs[i].triangle, cs[i].bary, INFINITY)) return 0;
     size_t n = 0;
     const vertex_ref* v = contact_vertices(g, cs, count, &n);
     if (!v) return 0;
     for (size_t i = 0; i < n; ++i) {
         const int k = corner_of(mesh, &v[i]);
+        if (at_start) {
+            if (!add_from_start(g, v[i].triangle, unit_bary[k], accept)) return 0;
+            continue;
+        }
         const double phi = scc_sdf_eval(g->sdf, point_at(pose, v[i].triangle, unit_bary[k], pose->t0), NULL);
         g->sum->own_evals++;
-        if (phi <= accept && !add_from_start(g, v[i].triangle, unit_bary[k])) return 0;
+        if (phi <= accept && !add_from_start(g, v[i].triangle, unit_bary[k], INFINITY)) return 0;
     }
     return 1;
 }
@@ -266,11 +272,26 @@ static void pose_at(const scc_mesh_motion* mm, double t, scc_rigid rests[2], scc
 
 static int is_zero(scc_vec3 v) { return v.x == 0.0 && v.y == 0.0 && v.z == 0.0; }
 
-/* The mesh's radius: the largest distance of a vertex from its centre of rotation (rigid), or half
- * the diagonal of the start positions' box (linear). */
+static int same_rigid_pose(const scc_rigid* a, const scc_rigid* b)
+{
+    if (!a || !b) return a == b;
+    return a->q0.w == b->q0.w && a->q0.x == b->q0.x && a->q0.y == b->q0.y && a->q0.z == b->q0.z && a->p0.x == b->p0.x &&
+           a->p0.y == b->p0.y && a->p0.z == b->p0.z;
+}
+
+/* 1 when two poses of pose_at() are the same (a step at rest: its end pose is its start). */
+static int same_pose(const scc_mesh_motion* a, const scc_mesh_motion* b)
+{
+    return (a->body ? same_rigid_pose(a->body, b->body) : a->start == b->start) && same_rigid_pose(a->sdf, b->sdf);
+}
+
+/* The mesh's radius: the largest distance of a vertex from its centre of rotation (rigid: from the
+ * mesh's cached radius about its origin, exact when the centre is the origin, else that radius plus
+ * the centre's offset, a bound), or half the diagonal of the start positions' box (linear). */
 static double mesh_radius(const scc_mesh_motion* mm)
 {
     double r2 = 0.0;
+    if (mm->body && mm->mesh->radius > 0.0) return mm->mesh->radius + scc_len(mm->body->c_local);
     if (mm->body) {
         for (uint32_t i = 0; i < mm->mesh->vertex_count; ++i) r2 = fmax(r2, scc_len2(scc_sub(mm->mesh->vertices[i], mm->body->c_local)));
         return sqrt(r2);
@@ -376,7 +397,7 @@ static int candidates(gen* g, const scc_contact_params* cp, double radius)
         sum->ccd_ran = 1;
         sum->ccd_state = s.state;
         if (!s.hit) /* clear: only the face search can have found what the CCD missed; the start pose's features then count too */
-            return face_found > 0 && kept ? add_pose(g, kept, r0.contacts_found, &start, start_margin) : 1;
+            return face_found > 0 && kept ? add_pose(g, kept, r0.contacts_found, &start, 1, start_margin) : 1;
         sum->toi = s.toi;
         if (!add_ccd(g, slot_contacts(g), s.contacts_found, vertex_accept)) return 0;
         if (dt > 0.0 && !start_ran && (s.toi > mm->t0 || travel > margin)) { /* the DCD baseline */
@@ -387,14 +408,18 @@ static int candidates(gen* g, const scc_contact_params* cp, double radius)
         }
     }
 
-    /* 4. the start pose's features and the end pose's, each held from t0 */
+    /* 4. the start pose's features and the end pose's, each held from t0; no end-pose query when
+     *    the step's travel is within end_skip_travel (its features are the start pose's, moved by at
+     *    most that) */
     if (dt > 0.0) {
-        if (kept && !add_pose(g, kept, r0.contacts_found, &start, touching ? fmax(start_margin, vertex_accept) : start_margin)) return 0;
+        const int end_query = !(continuous && cp->end_skip_travel > 0.0 && travel <= cp->end_skip_travel);
+        if (kept && !add_pose(g, kept, r0.contacts_found, &start, 1, touching ? fmax(start_margin, vertex_accept) : start_margin)) return 0;
         scc_query_summary r1;
         dp.margin = margin;
+        if (!end_query) return 1;
         sum->discrete_queries++;
         if (!query(g, &end, &dp, &r1)) return 0;
-        if (r1.hit && !add_pose(g, slot_contacts(g), r1.contacts_found, &end, margin)) return 0;
+        if (r1.hit && !add_pose(g, slot_contacts(g), r1.contacts_found, &end, same_pose(&end, &start), margin)) return 0;
     }
     return 1;
 }

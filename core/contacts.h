@@ -42,6 +42,7 @@ typedef struct scc_contact_params {
     double feature_size;     /* the SDF's smallest feature (> 0 with subdivision: the face search) */
     int reduced;             /* points of the reduction (0: the whole capacity); the rest of the capacity: cover points */
     double cover_depth;      /* the cover points' depth (m; 0: none) */
+    double end_skip_travel;  /* > 0 (continuous): no end-pose query when the step's travel is at most this */
 } scc_contact_params;
 
 /* The feature (vertex, edge or face) of triangle t at barycentric weights b, and its stable id,

@@ -14,6 +14,8 @@ typedef struct scc_mesh {
     uint32_t vertex_count;
     uint32_t triangle_count;
     scc_aabb bounds;            /* local-frame box of the vertices */
+    double radius;              /* largest distance of a vertex from the local origin, cached at creation;
+                                   0 on a mesh made without it (the contact generator then computes it) */
     /* Optional prebuilt bounding-sphere hierarchy (bsh.h) over these triangles; NULL: the mesh
      * query builds a temporary one when params->broad_phase is set. */
     const struct scc_bsh* bsh;

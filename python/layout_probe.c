@@ -221,6 +221,7 @@ int main(void)
     OFF(sdfccd_ContactParams, feature_size);
     OFF(sdfccd_ContactParams, reduced_count);
     OFF(sdfccd_ContactParams, cover_depth);
+    OFF(sdfccd_ContactParams, end_skip_travel);
     OFF(sdfccd_ContactParams, internal_value);
     SIZE(sdfccd_ContactSet);
     OFF(sdfccd_ContactSet, count);

@@ -1061,7 +1061,8 @@ static sdfccd_ContactSet generate_p(sdfccd_Workspace* ws, sdfccd_SdfId sdf, cons
  * bottom (bottom and sides, each at gap 5 mm), so the step starts in contact and the CCD is skipped;
  * the end-pose query (the same pose) holds them again. Each gives 10 points and, of their faces' 20
  * vertices, the 12 at the bottom (the others are 10.5 cm away): 2 x 22 = 44 candidates and
- * 2 x (10 + 20 + 12) = 84 closest-point evaluations of our own. */
+ * 2 x (10 + 20) = 60 closest-point evaluations of our own (the step is at rest, so both poses are
+ * the start: a vertex's test and its closest point come from one evaluation; 84 when evaluated twice). */
 START_TEST(test_generate_rules_resting_closed_form)
 {
     sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
@@ -1081,7 +1082,7 @@ START_TEST(test_generate_rules_resting_closed_form)
     ck_assert_int_eq(set.ccd_ran, 0);
     ck_assert_int_eq(set.discrete_queries, 2);
     ck_assert_int_eq(set.candidates, 44);
-    ck_assert_int_eq(set.own_evaluations, 84);
+    ck_assert_int_eq(set.own_evaluations, 60);
     for (int i = 0; i < set.count; ++i) {
         ck_assert_double_near(c[i].gap, 0.005, 1e-9);
         ck_assert_double_near(c[i].point.z, 0.005, 1e-9);
@@ -1096,6 +1097,16 @@ START_TEST(test_generate_rules_resting_closed_form)
         for (int32_t i = 0; i < cap; ++i) ck_assert(memcmp(&few[i], &c[i], sizeof few[i]) == 0);
     }
     assert_bottom_corners(few, 4, m.pose.position, 0.005);
+    /* end_skip_travel: the step's travel (0) is within it, so no end-pose query: the start pose's 22
+     * candidates and (10 + 20) evaluations, and the same 4 points (the end pose's were the same) */
+    sdfccd_ContactParams ps = p;
+    ps.end_skip_travel = 0.0005;
+    sdfccd_ContactSet s4 = generate_p(ws, floor, NULL, cube, &m, &ps, few, 4);
+    ck_assert_int_eq(s4.discrete_queries, 1);
+    ck_assert_int_eq(s4.candidates, 22);
+    ck_assert_int_eq(s4.own_evaluations, 30);
+    ck_assert_int_eq(s4.count, 4);
+    for (int32_t i = 0; i < 4; ++i) ck_assert(memcmp(&few[i], &c[i], sizeof few[i]) == 0);
     /* the same with the floor given as a motion at rest (moved and turned): the same points moved */
     sdfccd_RigidMotion sm = sdfccd_default_rigid_motion();
     sm.pose.position = (sdfccd_Vec3){ 1, 2, 3 };
@@ -1127,7 +1138,8 @@ END_TEST
  * (5 cm / 10 m/s), with the bottom and side triangles (10 points) and, of their 20 vertices, the 12
  * at the bottom; then the start pose's 12 triangles and 24 vertices (all within 5 cm + reach), and
  * the end pose's 12 triangles and 24 vertices (all below the floor): 22 + 36 + 36 = 94 candidates;
- * own evaluations 20 (the vertices at the TOI) + 2 x (12 + 24 + 24) = 140. */
+ * own evaluations 20 (the vertices at the TOI) + (12 + 24) at the start pose (a vertex's test and
+ * its closest point from one evaluation) + (12 + 24 + 24) at the end pose = 116. */
 START_TEST(test_generate_rules_falling_closed_form)
 {
     sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 1, 1, 1);
@@ -1147,8 +1159,13 @@ START_TEST(test_generate_rules_falling_closed_form)
     ck_assert_double_near(set.toi, 0.005, 1e-7);
     ck_assert_int_eq(set.discrete_queries, 2);
     ck_assert_int_eq(set.candidates, 94);
-    ck_assert_int_eq(set.own_evaluations, 140);
+    ck_assert_int_eq(set.own_evaluations, 116);
     assert_bottom_corners(c, set.count, m.pose.position, 0.05);
+    /* a travel of 10/60 m is beyond end_skip_travel: the end pose is still queried, the same set */
+    p.end_skip_travel = 0.0005;
+    sdfccd_ContactSet s2 = generate_p(ws, floor, NULL, cube, &m, &p, c, 4);
+    ck_assert_int_eq(s2.discrete_queries, 2);
+    ck_assert_int_eq(s2.candidates, 94);
     sdfccd_destroy_workspace(ws);
     ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
     ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);

@@ -236,12 +236,12 @@ static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, cons
     sdfccd_Status st;
     if (!in) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
     if ((st = sdfccd__check_def(in->internal_value, fn, "params were", "sdfccd_default_contact_params"))) return st;
-    const double d[4] = { in->vertex_distance, in->same_place_distance, in->feature_size, in->cover_depth };
-    for (int i = 0; i < 4; ++i)
+    const double d[5] = { in->vertex_distance, in->same_place_distance, in->feature_size, in->cover_depth, in->end_skip_travel };
+    for (int i = 0; i < 5; ++i)
         if (!isfinite(d[i]) || d[i] < 0.0)
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT,
-                                 "%s: params->vertex_distance, same_place_distance, feature_size and cover_depth must be finite and >= 0 "
-                                 "(got %g, %g, %g, %g)", fn, d[0], d[1], d[2], d[3]);
+                                 "%s: params->vertex_distance, same_place_distance, feature_size, cover_depth and end_skip_travel must "
+                                 "be finite and >= 0 (got %g, %g, %g, %g, %g)", fn, d[0], d[1], d[2], d[3], d[4]);
     if (in->reduced_count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->reduced_count (%d) < 0", fn, in->reduced_count);
     if ((st = sdfccd__convert_params(&in->query, fn, &out->query))) return st;
     out->vertex_distance = in->vertex_distance;
@@ -249,6 +249,7 @@ static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, cons
     out->feature_size = in->feature_size;
     out->reduced = in->reduced_count;
     out->cover_depth = in->cover_depth;
+    out->end_skip_travel = in->end_skip_travel;
     return SDFCCD_OK;
 }
 

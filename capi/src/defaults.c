@@ -119,5 +119,6 @@ sdfccd_ContactParams sdfccd_default_contact_params(void)
     c.feature_size = 0.0;
     c.reduced_count = 0;
     c.cover_depth = 0.0;
+    c.end_skip_travel = 0.0;
     return c;
 }

@@ -49,10 +49,12 @@ sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count,
     scc_vec3* v = block;
     uint32_t* idx = (uint32_t*)((char*)block + vbytes);
     scc_aabb box = { { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY } };
+    double r2 = 0.0;
     for (uint32_t i = 0; i < vertex_count; ++i) {
         v[i] = scc_v3(vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2]);
         box.lo = scc_vmin(box.lo, v[i]);
         box.hi = scc_vmax(box.hi, v[i]);
+        r2 = fmax(r2, scc_len2(v[i]));
     }
     uint32_t k = 0;
     for (uint32_t t = 0; t < triangle_count; ++t) {
@@ -68,6 +70,7 @@ sdfccd_Status sdfccd__mesh_create(const double* vertices, uint32_t vertex_count,
     m->mesh.vertex_count = vertex_count;
     m->mesh.triangle_count = kept;
     m->mesh.bounds = box;
+    m->mesh.radius = sqrt(r2);
     m->dropped_triangles = triangle_count - kept;
     m->refs = 1;
     m->bsh = scc_bsh_build(&m->mesh, sdfccd__allocator()); /* broad phase of the mesh query */

@@ -302,6 +302,7 @@ class ContactParams(C.Structure):
         ("feature_size", C.c_double),
         ("reduced_count", C.c_int32),
         ("cover_depth", C.c_double),
+        ("end_skip_travel", C.c_double),
         ("internal_value", C.c_int32),
     ]
 

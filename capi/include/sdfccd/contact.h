@@ -302,6 +302,10 @@ typedef struct sdfccd_ContactParams {
     double cover_depth;          /**< When > 0: after the reduction, cover points (sdfccd_cover_contacts()) with this
                                       depth and the body's turn over the step fill the rest of the capacity. m, >= 0.
                                       Default 0 (none). */
+    double end_skip_travel;      /**< When > 0 (continuous methods): a step whose travel (the farthest a mesh point can
+                                      move relative to the SDF) is at most this runs no end-pose query, whose features
+                                      are then the start pose's moved by at most this. The Bullet bridge passes its
+                                      guarantee's tolerance. m, >= 0. Default 0 (always run). */
     int32_t internal_value;      /**< Set by sdfccd_default_contact_params(); do not change. */
 } sdfccd_ContactParams;
 
