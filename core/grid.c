@@ -345,9 +345,91 @@ SCC_CELL_INLINE void eval_batch_direct(const scc_grid* g, const scc_vec3* p, siz
 /* The direct grid's evaluation compiled for AVX: three-operand instructions spare the register
  * copies of the two-operand SSE2 code (about a quarter of the kernel's instructions). No FMA (it
  * is not in the "avx" target): the same operations in the same order, so the same bits. */
+/* Four points of a batch inside the domain, one per lane of scc_cell_eval4: their indices, cells'
+ * blocks, local coordinates and gradient scales. */
+typedef struct grid_quad {
+    size_t idx[4];
+    const double* b[4][8];
+    double xi[3][4], c0[3][4];
+    int count;
+} grid_quad;
+
+/* Fills q with the next (up to) four points from *next that lie inside the domain, evaluating
+ * the others on the way (scc_grid_eval), and requests their blocks; unused lanes repeat lane 0. */
+__attribute__((target("avx"))) static void quad_fill(const scc_grid* g, const scc_vec3* p, size_t n, size_t* next, grid_quad* q, uint64_t* last,
+                                                      const double** lastb, double* out_v, scc_vec3* out_g)
+{
+    q->count = 0;
+    while (q->count < 4 && *next < n) {
+        const size_t i = (*next)++;
+        if (!inside_domain(g, p[i])) {
+            out_v[i] = scc_grid_eval(&g->base, p[i], out_g ? &out_g[i] : NULL);
+            continue;
+        }
+        const int k = q->count++;
+        uint32_t ijk[3];
+        const uint64_t l = locate(g, p[i], ijk);
+        double c0[3];
+        const scc_vec3 xi = cell_local(g, ijk, p[i], c0);
+        q->idx[k] = i;
+        q->xi[0][k] = xi.x; q->xi[1][k] = xi.y; q->xi[2][k] = xi.z;
+        q->c0[0][k] = c0[0]; q->c0[1][k] = c0[1]; q->c0[2][k] = c0[2];
+        if (l == *last) { /* the cell before: its blocks are known and requested */
+            memcpy(q->b[k], lastb, sizeof q->b[k]);
+            continue;
+        }
+        cell_blocks_of(g, ijk, q->b[k]);
+        for (int c = 0; c < 8; ++c) { __builtin_prefetch(q->b[k][c]); __builtin_prefetch(q->b[k][c] + 6); }
+        *last = l;
+        memcpy(lastb, q->b[k], sizeof q->b[k]);
+    }
+    for (int k = q->count; k < 4 && q->count > 0; ++k) {
+        memcpy(q->b[k], q->b[0], sizeof q->b[k]);
+        for (int d = 0; d < 3; ++d) { q->xi[d][k] = q->xi[d][0]; q->c0[d][k] = q->c0[d][0]; }
+    }
+}
+
+/* scc_cell_eval4 on a filled quad; writes the values (and gradients) of its points. */
+__attribute__((target("avx"))) static void quad_eval(const grid_quad* q, double* out_v, scc_vec3* out_g)
+{
+    const double* const(*b)[8] = q->b;
+#define LANES(c, o) ((scc_d4){ b[0][c][o], b[1][c][o], b[2][c][o], b[3][c][o] })
+    const scc_d4 c[8] = { LANES(0, 0), LANES(1, 0), LANES(2, 0), LANES(3, 0), LANES(4, 0), LANES(5, 0), LANES(6, 0), LANES(7, 0) };
+    /* the edge pairs of scc_cell_eval_at: x from blocks 0 4 2 6 (+1), y from 0 1 4 5 (+3), z from 0 2 1 3 (+5) */
+    const scc_d4 ex[4][2] = { { LANES(0, 1), LANES(0, 2) }, { LANES(4, 1), LANES(4, 2) }, { LANES(2, 1), LANES(2, 2) }, { LANES(6, 1), LANES(6, 2) } };
+    const scc_d4 ey[4][2] = { { LANES(0, 3), LANES(0, 4) }, { LANES(1, 3), LANES(1, 4) }, { LANES(4, 3), LANES(4, 4) }, { LANES(5, 3), LANES(5, 4) } };
+    const scc_d4 ez[4][2] = { { LANES(0, 5), LANES(0, 6) }, { LANES(2, 5), LANES(2, 6) }, { LANES(1, 5), LANES(1, 6) }, { LANES(3, 5), LANES(3, 6) } };
+#undef LANES
+    scc_d4 xi[3], c0[3];
+    memcpy(xi, q->xi, sizeof xi);
+    memcpy(c0, q->c0, sizeof c0);
+    scc_d4 v, gr[3];
+    scc_cell_eval4(c, ex, ey, ez, xi, &v, gr);
+    double vv[4], gg[3][4];
+    memcpy(vv, &v, sizeof vv);
+    for (int d = 0; d < 3; ++d) {
+        const scc_d4 s = gr[d] * c0[d];
+        memcpy(gg[d], &s, sizeof gg[d]);
+    }
+    for (int k = 0; k < q->count; ++k) {
+        out_v[q->idx[k]] = vv[k];
+        if (out_g) out_g[q->idx[k]] = scc_v3(gg[0][k], gg[1][k], gg[2][k]);
+    }
+}
+
+/* The direct grid's batch in quads: the next quad's blocks are requested while this one is
+ * computed. The numbers are eval_direct's (scc_cell_eval4). */
 __attribute__((target("avx"))) static void eval_batch_avx(const scc_grid* g, const scc_vec3* p, size_t n, double* out_v, scc_vec3* out_g)
 {
-    eval_batch_direct(g, p, n, out_v, out_g);
+    grid_quad q[2];
+    size_t next = 0;
+    uint64_t last = UINT64_MAX;
+    const double* lastb[8];
+    quad_fill(g, p, n, &next, &q[0], &last, lastb, out_v, out_g);
+    for (int k = 0; q[k].count > 0; k ^= 1) {
+        quad_fill(g, p, n, &next, &q[k ^ 1], &last, lastb, out_v, out_g);
+        quad_eval(&q[k], out_v, out_g);
+    }
 }
 
 __attribute__((target("avx"))) double scc_grid_eval_avx(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
