@@ -345,19 +345,21 @@ SCC_CELL_INLINE void eval_batch_direct(const scc_grid* g, const scc_vec3* p, siz
 /* The direct grid's evaluation compiled for AVX: three-operand instructions spare the register
  * copies of the two-operand SSE2 code (about a quarter of the kernel's instructions). No FMA (it
  * is not in the "avx" target): the same operations in the same order, so the same bits. */
-/* Four points of a batch inside the domain, one per lane of scc_cell_eval4: their indices, cells'
- * blocks, local coordinates and gradient scales. */
+/* Four points of a batch inside the domain, one per lane of scc_cell_eval4: their indices, the
+ * first of their cell's 8 vertex blocks (the others lie at the grid's fixed offsets), local
+ * coordinates and gradient scales. */
 typedef struct grid_quad {
     size_t idx[4];
-    const double* b[4][8];
+    const double* b0[4];
     double xi[3][4], c0[3][4];
     int count;
 } grid_quad;
 
 /* Fills q with the next (up to) four points from *next that lie inside the domain, evaluating
- * the others on the way (scc_grid_eval), and requests their blocks; unused lanes repeat lane 0. */
-__attribute__((target("avx"))) static void quad_fill(const scc_grid* g, const scc_vec3* p, size_t n, size_t* next, grid_quad* q, uint64_t* last,
-                                                      const double** lastb, double* out_v, scc_vec3* out_g)
+ * the others on the way (scc_grid_eval), and requests their blocks (a cell requested just before
+ * is not requested again); unused lanes repeat lane 0. off: the 8 blocks' offsets from the first. */
+__attribute__((target("avx"))) static void quad_fill(const scc_grid* g, const scc_vec3* p, size_t n, size_t* next, grid_quad* q, const ptrdiff_t off[8],
+                                                      uint64_t* last, double* out_v, scc_vec3* out_g)
 {
     q->count = 0;
     while (q->count < 4 && *next < n) {
@@ -374,26 +376,24 @@ __attribute__((target("avx"))) static void quad_fill(const scc_grid* g, const sc
         q->idx[k] = i;
         q->xi[0][k] = xi.x; q->xi[1][k] = xi.y; q->xi[2][k] = xi.z;
         q->c0[0][k] = c0[0]; q->c0[1][k] = c0[1]; q->c0[2][k] = c0[2];
-        if (l == *last) { /* the cell before: its blocks are known and requested */
-            memcpy(q->b[k], lastb, sizeof q->b[k]);
-            continue;
-        }
-        cell_blocks_of(g, ijk, q->b[k]);
-        for (int c = 0; c < 8; ++c) { __builtin_prefetch(q->b[k][c]); __builtin_prefetch(q->b[k][c] + 6); }
+        const double* b0 = g->blocks + 7 * (ijk[0] + ((uint64_t)g->res[0] + 1) * (ijk[1] + ((uint64_t)g->res[1] + 1) * ijk[2]));
+        q->b0[k] = b0;
+        if (l == *last) continue;
         *last = l;
-        memcpy(lastb, q->b[k], sizeof q->b[k]);
+        /* blocks 2c and 2c + 1 are neighbours: 14 values, at most 3 lines */
+        for (int c = 0; c < 8; c += 2) { __builtin_prefetch(b0 + off[c]); __builtin_prefetch(b0 + off[c] + 7); __builtin_prefetch(b0 + off[c] + 13); }
     }
     for (int k = q->count; k < 4 && q->count > 0; ++k) {
-        memcpy(q->b[k], q->b[0], sizeof q->b[k]);
+        q->b0[k] = q->b0[0];
         for (int d = 0; d < 3; ++d) { q->xi[d][k] = q->xi[d][0]; q->c0[d][k] = q->c0[d][0]; }
     }
 }
 
 /* scc_cell_eval4 on a filled quad; writes the values (and gradients) of its points. */
-__attribute__((target("avx"))) static void quad_eval(const grid_quad* q, double* out_v, scc_vec3* out_g)
+__attribute__((target("avx"))) static void quad_eval(const grid_quad* q, const ptrdiff_t off[8], double* out_v, scc_vec3* out_g)
 {
-    const double* const(*b)[8] = q->b;
-#define LANES(c, o) ((scc_d4){ b[0][c][o], b[1][c][o], b[2][c][o], b[3][c][o] })
+    const double *const b0 = q->b0[0], *const b1 = q->b0[1], *const b2 = q->b0[2], *const b3 = q->b0[3];
+#define LANES(c, o) ((scc_d4){ b0[off[c] + o], b1[off[c] + o], b2[off[c] + o], b3[off[c] + o] })
     const scc_d4 c[8] = { LANES(0, 0), LANES(1, 0), LANES(2, 0), LANES(3, 0), LANES(4, 0), LANES(5, 0), LANES(6, 0), LANES(7, 0) };
     /* the edge pairs of scc_cell_eval_at: x from blocks 0 4 2 6 (+1), y from 0 1 4 5 (+3), z from 0 2 1 3 (+5) */
     const scc_d4 ex[4][2] = { { LANES(0, 1), LANES(0, 2) }, { LANES(4, 1), LANES(4, 2) }, { LANES(2, 1), LANES(2, 2) }, { LANES(6, 1), LANES(6, 2) } };
@@ -421,14 +421,15 @@ __attribute__((target("avx"))) static void quad_eval(const grid_quad* q, double*
  * computed. The numbers are eval_direct's (scc_cell_eval4). */
 __attribute__((target("avx"))) static void eval_batch_avx(const scc_grid* g, const scc_vec3* p, size_t n, double* out_v, scc_vec3* out_g)
 {
+    const ptrdiff_t sy = (ptrdiff_t)g->res[0] + 1, sz = sy * ((ptrdiff_t)g->res[1] + 1);
+    const ptrdiff_t off[8] = { 0, 7, 7 * sy, 7 * (sy + 1), 7 * sz, 7 * (sz + 1), 7 * (sz + sy), 7 * (sz + sy + 1) }; /* cell_blocks_of's */
     grid_quad q[2];
     size_t next = 0;
     uint64_t last = UINT64_MAX;
-    const double* lastb[8];
-    quad_fill(g, p, n, &next, &q[0], &last, lastb, out_v, out_g);
+    quad_fill(g, p, n, &next, &q[0], off, &last, out_v, out_g);
     for (int k = 0; q[k].count > 0; k ^= 1) {
-        quad_fill(g, p, n, &next, &q[k ^ 1], &last, lastb, out_v, out_g);
-        quad_eval(&q[k], out_v, out_g);
+        quad_fill(g, p, n, &next, &q[k ^ 1], off, &last, out_v, out_g);
+        quad_eval(&q[k], off, out_v, out_g);
     }
 }
 
