@@ -12,6 +12,9 @@
 
 #include <float.h>
 #include <string.h>
+#if SCC_GRID_AVX
+#include <immintrin.h>
+#endif
 
 /* ------------------------------------------------------------------------------------------
  * Grid data
@@ -358,10 +361,16 @@ typedef struct grid_quad {
 /* Fills q with the next (up to) four points from *next that lie inside the domain, evaluating
  * the others on the way (scc_grid_eval), and requests their blocks (a cell requested just before
  * is not requested again); unused lanes repeat lane 0. off: the 8 blocks' offsets from the first. */
+__attribute__((target("avx"))) static int quad_fill4(const scc_grid* g, const scc_vec3* p, size_t i0, grid_quad* q, const ptrdiff_t off[8], uint64_t* last);
+
 __attribute__((target("avx"))) static void quad_fill(const scc_grid* g, const scc_vec3* p, size_t n, size_t* next, grid_quad* q, const ptrdiff_t off[8],
                                                       uint64_t* last, double* out_v, scc_vec3* out_g)
 {
     q->count = 0;
+    if (*next + 4 <= n && quad_fill4(g, p, *next, q, off, last)) {
+        *next += 4;
+        return;
+    }
     while (q->count < 4 && *next < n) {
         const size_t i = (*next)++;
         if (!inside_domain(g, p[i])) {
@@ -389,22 +398,87 @@ __attribute__((target("avx"))) static void quad_fill(const scc_grid* g, const sc
     }
 }
 
+/* quad_fill's common case: the four points from i0 all inside the domain (else returns 0 and
+ * changes nothing), located and their local coordinates computed four at a time: the same
+ * operations as locate and cell_local per lane, so the same cells and bits. */
+__attribute__((target("avx"))) static int quad_fill4(const scc_grid* g, const scc_vec3* p, size_t i0, grid_quad* q, const ptrdiff_t off[8], uint64_t* last)
+{
+    const scc_vec3* a = p + i0;
+    const __m256d x = _mm256_setr_pd(a[0].x, a[1].x, a[2].x, a[3].x);
+    const __m256d y = _mm256_setr_pd(a[0].y, a[1].y, a[2].y, a[3].y);
+    const __m256d z = _mm256_setr_pd(a[0].z, a[1].z, a[2].z, a[3].z);
+    const __m256d lx = _mm256_set1_pd(g->lo.x), ly = _mm256_set1_pd(g->lo.y), lz = _mm256_set1_pd(g->lo.z);
+    __m256d in = _mm256_and_pd(_mm256_cmp_pd(x, lx, _CMP_GE_OQ), _mm256_cmp_pd(x, _mm256_set1_pd(g->hi.x), _CMP_LE_OQ));
+    in = _mm256_and_pd(in, _mm256_and_pd(_mm256_cmp_pd(y, ly, _CMP_GE_OQ), _mm256_cmp_pd(y, _mm256_set1_pd(g->hi.y), _CMP_LE_OQ)));
+    in = _mm256_and_pd(in, _mm256_and_pd(_mm256_cmp_pd(z, lz, _CMP_GE_OQ), _mm256_cmp_pd(z, _mm256_set1_pd(g->hi.z), _CMP_LE_OQ)));
+    if (_mm256_movemask_pd(in) != 15) return 0;
+    /* locate: r = (p - lo) / h clamped to [0, res - 1] and truncated (r >= 0 inside the domain) */
+    const __m256d zero = _mm256_setzero_pd();
+    int32_t ijk[3][4];
+    const __m256d r[3] = { _mm256_mul_pd(_mm256_sub_pd(x, lx), _mm256_set1_pd(g->inv_h.x)), _mm256_mul_pd(_mm256_sub_pd(y, ly), _mm256_set1_pd(g->inv_h.y)),
+                           _mm256_mul_pd(_mm256_sub_pd(z, lz), _mm256_set1_pd(g->inv_h.z)) };
+    for (int d = 0; d < 3; ++d) {
+        const __m128i m = _mm_min_epi32(_mm256_cvttpd_epi32(_mm256_max_pd(r[d], zero)), _mm_set1_epi32((int32_t)g->res[d] - 1));
+        _mm_storeu_si128((__m128i*)ijk[d], m);
+    }
+    /* cell_local per lane: xi = c0 p - c1 with the cell's coefficients */
+    const double* tx = g->axis_coef;
+    const double* ty = tx + 2 * (size_t)g->res[0];
+    const double* tz = ty + 2 * (size_t)g->res[1];
+    const __m256d c0x = _mm256_setr_pd(tx[2 * ijk[0][0]], tx[2 * ijk[0][1]], tx[2 * ijk[0][2]], tx[2 * ijk[0][3]]);
+    const __m256d c1x = _mm256_setr_pd(tx[2 * ijk[0][0] + 1], tx[2 * ijk[0][1] + 1], tx[2 * ijk[0][2] + 1], tx[2 * ijk[0][3] + 1]);
+    const __m256d c0y = _mm256_setr_pd(ty[2 * ijk[1][0]], ty[2 * ijk[1][1]], ty[2 * ijk[1][2]], ty[2 * ijk[1][3]]);
+    const __m256d c1y = _mm256_setr_pd(ty[2 * ijk[1][0] + 1], ty[2 * ijk[1][1] + 1], ty[2 * ijk[1][2] + 1], ty[2 * ijk[1][3] + 1]);
+    const __m256d c0z = _mm256_setr_pd(tz[2 * ijk[2][0]], tz[2 * ijk[2][1]], tz[2 * ijk[2][2]], tz[2 * ijk[2][3]]);
+    const __m256d c1z = _mm256_setr_pd(tz[2 * ijk[2][0] + 1], tz[2 * ijk[2][1] + 1], tz[2 * ijk[2][2] + 1], tz[2 * ijk[2][3] + 1]);
+    _mm256_storeu_pd(q->xi[0], _mm256_sub_pd(_mm256_mul_pd(c0x, x), c1x));
+    _mm256_storeu_pd(q->xi[1], _mm256_sub_pd(_mm256_mul_pd(c0y, y), c1y));
+    _mm256_storeu_pd(q->xi[2], _mm256_sub_pd(_mm256_mul_pd(c0z, z), c1z));
+    _mm256_storeu_pd(q->c0[0], c0x);
+    _mm256_storeu_pd(q->c0[1], c0y);
+    _mm256_storeu_pd(q->c0[2], c0z);
+    const uint64_t sy = (uint64_t)g->res[0] + 1, sz = ((uint64_t)g->res[1] + 1) * sy;
+    for (int k = 0; k < 4; ++k) {
+        const uint64_t i = (uint32_t)ijk[0][k], j = (uint32_t)ijk[1][k], kk = (uint32_t)ijk[2][k];
+        const double* b0 = g->blocks + 7 * (i + sy * j + sz * kk);
+        q->idx[k] = i0 + (size_t)k;
+        q->b0[k] = b0;
+        const uint64_t l = i + (uint64_t)g->res[0] * (j + (uint64_t)g->res[1] * kk);
+        if (l == *last) continue;
+        *last = l;
+        for (int c = 0; c < 8; c += 2) { __builtin_prefetch(b0 + off[c]); __builtin_prefetch(b0 + off[c] + 7); __builtin_prefetch(b0 + off[c] + 13); }
+    }
+    q->count = 4;
+    return 1;
+}
+
 /* scc_cell_eval4 on a filled quad; writes the values (and gradients) of its points. */
 __attribute__((target("avx"))) static void quad_eval(const grid_quad* q, const ptrdiff_t off[8], double* out_v, scc_vec3* out_g)
 {
     const double *const b0 = q->b0[0], *const b1 = q->b0[1], *const b2 = q->b0[2], *const b3 = q->b0[3];
 #define LANES(c, o) ((scc_d4){ b0[off[c] + o], b1[off[c] + o], b2[off[c] + o], b3[off[c] + o] })
-    const scc_d4 c[8] = { LANES(0, 0), LANES(1, 0), LANES(2, 0), LANES(3, 0), LANES(4, 0), LANES(5, 0), LANES(6, 0), LANES(7, 0) };
-    /* the edge pairs of scc_cell_eval_at: x from blocks 0 4 2 6 (+1), y from 0 1 4 5 (+3), z from 0 2 1 3 (+5) */
-    const scc_d4 ex[4][2] = { { LANES(0, 1), LANES(0, 2) }, { LANES(4, 1), LANES(4, 2) }, { LANES(2, 1), LANES(2, 2) }, { LANES(6, 1), LANES(6, 2) } };
-    const scc_d4 ey[4][2] = { { LANES(0, 3), LANES(0, 4) }, { LANES(1, 3), LANES(1, 4) }, { LANES(4, 3), LANES(4, 4) }, { LANES(5, 3), LANES(5, 4) } };
-    const scc_d4 ez[4][2] = { { LANES(0, 5), LANES(0, 6) }, { LANES(2, 5), LANES(2, 6) }, { LANES(1, 5), LANES(1, 6) }, { LANES(3, 5), LANES(3, 6) } };
-#undef LANES
-    scc_d4 xi[3], c0[3];
+    scc_d4 xi[3], c0[3], L[3][2], v, gr[3];
     memcpy(xi, q->xi, sizeof xi);
     memcpy(c0, q->c0, sizeof c0);
-    scc_d4 v, gr[3];
-    scc_cell_eval4(c, ex, ey, ez, xi, &v, gr);
+    {
+        const scc_d4 c[8] = { LANES(0, 0), LANES(1, 0), LANES(2, 0), LANES(3, 0), LANES(4, 0), LANES(5, 0), LANES(6, 0), LANES(7, 0) };
+        scc_cell_corners4(c, xi, L, &v, gr);
+    }
+    /* each edge family's pairs, loaded just before it: x from blocks 0 4 2 6 (+1), y from 0 1 4 5
+     * (+3), z from 0 2 1 3 (+5), as in scc_cell_eval_at */
+    {
+        const scc_d4 e[4][2] = { { LANES(0, 1), LANES(0, 2) }, { LANES(4, 1), LANES(4, 2) }, { LANES(2, 1), LANES(2, 2) }, { LANES(6, 1), LANES(6, 2) } };
+        scc_cell_edge_family4(e, xi[0], L[1], L[2], &v, gr, 0, 1, 2);
+    }
+    {
+        const scc_d4 e[4][2] = { { LANES(0, 3), LANES(0, 4) }, { LANES(1, 3), LANES(1, 4) }, { LANES(4, 3), LANES(4, 4) }, { LANES(5, 3), LANES(5, 4) } };
+        scc_cell_edge_family4(e, xi[1], L[2], L[0], &v, gr, 1, 2, 0);
+    }
+    {
+        const scc_d4 e[4][2] = { { LANES(0, 5), LANES(0, 6) }, { LANES(2, 5), LANES(2, 6) }, { LANES(1, 5), LANES(1, 6) }, { LANES(3, 5), LANES(3, 6) } };
+        scc_cell_edge_family4(e, xi[2], L[0], L[1], &v, gr, 2, 0, 1);
+    }
+#undef LANES
     double vv[4], gg[3][4];
     memcpy(vv, &v, sizeof vv);
     for (int d = 0; d < 3; ++d) {
@@ -418,7 +492,7 @@ __attribute__((target("avx"))) static void quad_eval(const grid_quad* q, const p
 }
 
 /* The direct grid's batch in quads: the next quad's blocks are requested while this one is
- * computed. The numbers are eval_direct's (scc_cell_eval4). */
+ * computed. The numbers are eval_direct's (scc_cell_corners4, scc_cell_edge_family4). */
 __attribute__((target("avx"))) static void eval_batch_avx(const scc_grid* g, const scc_vec3* p, size_t n, double* out_v, scc_vec3* out_g)
 {
     const ptrdiff_t sy = (ptrdiff_t)g->res[0] + 1, sz = sy * ((ptrdiff_t)g->res[1] + 1);

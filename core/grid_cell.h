@@ -128,7 +128,9 @@ SCC_CELL_INLINE void scc_cell_eval_at(const double* const c[8], const double* co
 /* Four points at once, one per lane (scc_d4: the AVX evaluation, grid.c). Every lane does the
  * scalar formula's operations in its order (the plain C build of scc_cell_eval_at, whose two-lane
  * pairs are the t = 0, 1 lanes below), so each point gets the bits scc_cell_eval_at gives it.
- * c[q]: corner q's values; ex/ey/ez[2 dp + dr][t]: the edge pairs as in scc_cell_eval_at. */
+ * c[q]: corner q's values; e[2 dp + dr][t]: a family's edge pairs as in scc_cell_eval_at. The
+ * caller loads each family's values just before its call (32 vectors at once would not fit in
+ * the registers). */
 typedef double scc_d4 __attribute__((vector_size(32)));
 
 SCC_CELL_INLINE void scc_cell_edge_family4(const scc_d4 e[4][2], scc_d4 xd, const scc_d4 Lp[2], const scc_d4 Lr[2], scc_d4* phi, scc_d4* g,
@@ -150,11 +152,10 @@ SCC_CELL_INLINE void scc_cell_edge_family4(const scc_d4 e[4][2], scc_d4 xd, cons
     g[r] += (9.0 / 64.0) * w * (m0 * Br0 + m1 * Br1);
 }
 
-/* Value and xi-derivatives of four cells' interpolants, each at its own xi. */
-SCC_CELL_INLINE void scc_cell_eval4(const scc_d4 c[8], const scc_d4 ex[4][2], const scc_d4 ey[4][2], const scc_d4 ez[4][2], const scc_d4 xi[3],
-                                  scc_d4* out_value, scc_d4 g[3])
+/* The corner part of four cells' interpolants (scc_cell_eval_at's, before the edge families):
+ * value *phi and xi-derivatives g, and the linear factors L the edge families take. */
+SCC_CELL_INLINE void scc_cell_corners4(const scc_d4 c[8], const scc_d4 xi[3], scc_d4 L[3][2], scc_d4* phi, scc_d4 g[3])
 {
-    scc_d4 L[3][2];
     for (int d = 0; d < 3; ++d) { L[d][0] = 1.0 - xi[d]; L[d][1] = 1.0 + xi[d]; }
     const scc_d4 a00 = c[0] * L[0][0] + c[1] * L[0][1], a10 = c[2] * L[0][0] + c[3] * L[0][1];
     const scc_d4 a01 = c[4] * L[0][0] + c[5] * L[0][1], a11 = c[6] * L[0][0] + c[7] * L[0][1];
@@ -164,15 +165,13 @@ SCC_CELL_INLINE void scc_cell_eval4(const scc_d4 c[8], const scc_d4 ex[4][2], co
     const scc_d4 Sy = (a10 - a00) * L[2][0] + (a11 - a01) * L[2][1];
     const scc_d4 Sz = (a01 - a00) * L[1][0] + (a11 - a10) * L[1][1];
     const scc_d4 q = 9.0 * (xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]) - 19.0;
-    scc_d4 phi = (1.0 / 64.0) * q * S;
+    *phi = (1.0 / 64.0) * q * S;
     g[0] = (1.0 / 64.0) * (q * Sx + 18.0 * xi[0] * S);
     g[1] = (1.0 / 64.0) * (q * Sy + 18.0 * xi[1] * S);
     g[2] = (1.0 / 64.0) * (q * Sz + 18.0 * xi[2] * S);
-    scc_cell_edge_family4(ex, xi[0], L[1], L[2], &phi, g, 0, 1, 2);
-    scc_cell_edge_family4(ey, xi[1], L[2], L[0], &phi, g, 1, 2, 0);
-    scc_cell_edge_family4(ez, xi[2], L[0], L[1], &phi, g, 2, 0, 1);
-    *out_value = phi;
 }
+/* Then the edge families in scc_cell_eval_at's order: x (ex, xi[0], L[1], L[2], 0, 1, 2),
+ * y (ey, xi[1], L[2], L[0], 1, 2, 0), z (ez, xi[2], L[0], L[1], 2, 0, 1). */
 #endif
 
 /* The same for the 32 values in slot order. */
