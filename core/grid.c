@@ -283,7 +283,7 @@ SCC_CELL_INLINE double eval_direct(const scc_grid* g, uint64_t l, const uint32_t
 #if defined(__GNUC__) || defined(__clang__)
     /* every line of the 8 blocks requested up front: the kernel's last loads would otherwise
      * wait for its first ones to retire (a cell at random is 8-12 cache misses) */
-    for (int q = 0; q < 8; ++q) { __builtin_prefetch(b[q]); __builtin_prefetch(b[q] + 6); }
+    for (int q = 0; q < 8; q += 2) { __builtin_prefetch(b[q]); __builtin_prefetch(b[q] + 7); __builtin_prefetch(b[q] + 13); }
 #endif
     const double* const ex[4] = { b[0] + 1, b[4] + 1, b[2] + 1, b[6] + 1 };
     const double* const ey[4] = { b[0] + 3, b[1] + 3, b[4] + 3, b[5] + 3 };
