@@ -491,18 +491,20 @@ __attribute__((target("avx"))) static void quad_eval(const grid_quad* q, const p
     }
 }
 
-/* The direct grid's batch in quads: the next quad's blocks are requested while this one is
- * computed. The numbers are eval_direct's (scc_cell_corners4, scc_cell_edge_family4). */
+/* The direct grid's batch in quads: the blocks of the next two quads are requested while this
+ * one is computed (a cold cell's 12 lines take longer than one quad's arithmetic). The numbers
+ * are eval_direct's (scc_cell_corners4, scc_cell_edge_family4). */
 __attribute__((target("avx"))) static void eval_batch_avx(const scc_grid* g, const scc_vec3* p, size_t n, double* out_v, scc_vec3* out_g)
 {
     const ptrdiff_t sy = (ptrdiff_t)g->res[0] + 1, sz = sy * ((ptrdiff_t)g->res[1] + 1);
     const ptrdiff_t off[8] = { 0, 7, 7 * sy, 7 * (sy + 1), 7 * sz, 7 * (sz + 1), 7 * (sz + sy), 7 * (sz + sy + 1) }; /* cell_blocks_of's */
-    grid_quad q[2];
+    grid_quad q[3];
     size_t next = 0;
     uint64_t last = UINT64_MAX;
     quad_fill(g, p, n, &next, &q[0], off, &last, out_v, out_g);
-    for (int k = 0; q[k].count > 0; k ^= 1) {
-        quad_fill(g, p, n, &next, &q[k ^ 1], off, &last, out_v, out_g);
+    quad_fill(g, p, n, &next, &q[1], off, &last, out_v, out_g);
+    for (int k = 0; q[k].count > 0; k = k == 2 ? 0 : k + 1) {
+        quad_fill(g, p, n, &next, &q[k == 0 ? 2 : k - 1], off, &last, out_v, out_g);
         quad_eval(&q[k], off, out_v, out_g);
     }
 }
