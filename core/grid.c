@@ -618,10 +618,9 @@ double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
 double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
 {
     const scc_grid* g = (const scc_grid*)self;
-    const double global = fmax(g->lipschitz_max, g->hole_source ? 1.0 : 0.0);
-    const double outside_global = scc_hypot2(1.0, global);
+#define GLOBAL_BOUND fmax(g->lipschitz_max, g->hole_source ? 1.0 : 0.0) /* computed only where taken */
     if (!box || !scc_vfinite(box->lo) || !scc_vfinite(box->hi) || box->lo.x > box->hi.x || box->lo.y > box->hi.y || box->lo.z > box->hi.z)
-        return outside_global;
+        return scc_hypot2(1.0, GLOBAL_BOUND);
     const int leaves = box->lo.x < g->lo.x || box->lo.y < g->lo.y || box->lo.z < g->lo.z ||
                        box->hi.x > g->hi.x || box->hi.y > g->hi.y || box->hi.z > g->hi.z;
     const scc_aabb dom = { g->lo, g->hi };
@@ -639,18 +638,30 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
      * (+0.2% evaluations on the data set). */
     const uint64_t blocks = (uint64_t)(b[0] / 4 - a[0] / 4 + 1) * (b[1] / 4 - a[1] / 4 + 1) * (b[2] / 4 - a[2] / 4 + 1);
     double L = 0.0;
-    if (count > 64 && g->block_lipschitz && blocks > 512) L = global;
+    if (count > 64 && g->block_lipschitz && blocks > 512) L = GLOBAL_BOUND;
     else if (count > 64 && g->block_lipschitz) {
         /* large boxes: the per-block maxima of the blocks the box touches */
-        const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4;
+        const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4, w = b[0] / 4 - a[0] / 4 + 1;
+        float m = 0.0f; /* the max as floats, then widened: the same number */
         for (uint32_t k = a[2] / 4; k <= b[2] / 4; ++k)
-            for (uint32_t j = a[1] / 4; j <= b[1] / 4; ++j)
-                for (uint32_t i = a[0] / 4; i <= b[0] / 4; ++i) {
-                    const double bl = g->block_lipschitz[i + (uint64_t)nbx * (j + (uint64_t)nby * k)];
-                    if (bl > L) L = bl;
-                }
-    } else if (count > 32768) L = global;
-    else {
+            for (uint32_t j = a[1] / 4; j <= b[1] / 4; ++j) {
+                const float* row = g->block_lipschitz + a[0] / 4 + (uint64_t)nbx * (j + (uint64_t)nby * k);
+                for (uint32_t i = 0; i < w; ++i) m = row[i] > m ? row[i] : m;
+            }
+        L = (double)m;
+    } else if (count > 32768) L = GLOBAL_BOUND;
+    else if (g->direct) {
+        /* every cell valued, the map the identity: each row of the box is a run of cell bounds
+         * (their max as floats, then widened: the same number) */
+        float m = 0.0f;
+        const uint32_t w = b[0] - a[0] + 1;
+        for (uint32_t k = a[2]; k <= b[2]; ++k)
+            for (uint32_t j = a[1]; j <= b[1]; ++j) {
+                const float* row = g->cell_lipschitz + a[0] + (uint64_t)g->res[0] * (j + (uint64_t)g->res[1] * k);
+                for (uint32_t i = 0; i < w; ++i) m = row[i] > m ? row[i] : m;
+            }
+        L = (double)m;
+    } else {
         const scc_grid_field* fd = &g->fields[0];
         for (uint32_t k = a[2]; k <= b[2]; ++k)
             for (uint32_t j = a[1]; j <= b[1]; ++j)
@@ -661,6 +672,7 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
                     if (cl > L) L = cl;
                 }
     }
+#undef GLOBAL_BOUND
     return leaves ? sqrt(1.0 + L * L) : L;
 }
 
