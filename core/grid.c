@@ -468,15 +468,15 @@ __attribute__((target("avx"))) static void quad_eval(const grid_quad* q, const p
      * (+3), z from 0 2 1 3 (+5), as in scc_cell_eval_at */
     {
         const scc_d4 e[4][2] = { { LANES(0, 1), LANES(0, 2) }, { LANES(4, 1), LANES(4, 2) }, { LANES(2, 1), LANES(2, 2) }, { LANES(6, 1), LANES(6, 2) } };
-        scc_cell_edge_family4(e, xi[0], L[1], L[2], &v, gr, 0, 1, 2);
+        scc_cell_edge_family4(e, &xi[0], L[1], L[2], &v, gr, 0, 1, 2);
     }
     {
         const scc_d4 e[4][2] = { { LANES(0, 3), LANES(0, 4) }, { LANES(1, 3), LANES(1, 4) }, { LANES(4, 3), LANES(4, 4) }, { LANES(5, 3), LANES(5, 4) } };
-        scc_cell_edge_family4(e, xi[1], L[2], L[0], &v, gr, 1, 2, 0);
+        scc_cell_edge_family4(e, &xi[1], L[2], L[0], &v, gr, 1, 2, 0);
     }
     {
         const scc_d4 e[4][2] = { { LANES(0, 5), LANES(0, 6) }, { LANES(2, 5), LANES(2, 6) }, { LANES(1, 5), LANES(1, 6) }, { LANES(3, 5), LANES(3, 6) } };
-        scc_cell_edge_family4(e, xi[2], L[0], L[1], &v, gr, 2, 0, 1);
+        scc_cell_edge_family4(e, &xi[2], L[0], L[1], &v, gr, 2, 0, 1);
     }
 #undef LANES
     double vv[4], gg[3][4];

@@ -133,9 +133,10 @@ SCC_CELL_INLINE void scc_cell_eval_at(const double* const c[8], const double* co
  * the registers). */
 typedef double scc_d4 __attribute__((vector_size(32)));
 
-SCC_CELL_INLINE void scc_cell_edge_family4(const scc_d4 e[4][2], scc_d4 xd, const scc_d4 Lp[2], const scc_d4 Lr[2], scc_d4* phi, scc_d4* g,
+SCC_CELL_INLINE void scc_cell_edge_family4(const scc_d4 e[4][2], const scc_d4* xdp, const scc_d4 Lp[2], const scc_d4 Lr[2], scc_d4* phi, scc_d4* g,
                                          int d, int p, int r)
 {
+    const scc_d4 xd = *xdp; /* by address: a 32-byte vector passed by value needs AVX in every caller (Clang) */
     const scc_d4 w = 1.0 - xd * xd;
     const scc_d4 m0 = 1.0 - 3.0 * xd, m1 = 1.0 + 3.0 * xd;
     const scc_d4 l00 = Lp[0] * Lr[0], l01 = Lp[0] * Lr[1], l10 = Lp[1] * Lr[0], l11 = Lp[1] * Lr[1];
@@ -170,8 +171,8 @@ SCC_CELL_INLINE void scc_cell_corners4(const scc_d4 c[8], const scc_d4 xi[3], sc
     g[1] = (1.0 / 64.0) * (q * Sy + 18.0 * xi[1] * S);
     g[2] = (1.0 / 64.0) * (q * Sz + 18.0 * xi[2] * S);
 }
-/* Then the edge families in scc_cell_eval_at's order: x (ex, xi[0], L[1], L[2], 0, 1, 2),
- * y (ey, xi[1], L[2], L[0], 1, 2, 0), z (ez, xi[2], L[0], L[1], 2, 0, 1). */
+/* Then the edge families in scc_cell_eval_at's order: x (ex, &xi[0], L[1], L[2], 0, 1, 2),
+ * y (ey, &xi[1], L[2], L[0], 1, 2, 0), z (ez, &xi[2], L[0], L[1], 2, 0, 1). */
 #endif
 
 /* The same for the 32 values in slot order. */
