@@ -348,7 +348,7 @@ SCC_CELL_INLINE void eval_batch_direct(const scc_grid* g, const scc_vec3* p, siz
 /* The direct grid's evaluation compiled for AVX: three-operand instructions spare the register
  * copies of the two-operand SSE2 code (about a quarter of the kernel's instructions). No FMA (it
  * is not in the "avx" target): the same operations in the same order, so the same bits. */
-/* Four points of a batch inside the domain, one per lane of scc_cell_eval4: their indices, the
+/* Four points of a batch inside the domain, one per lane of the four-lane kernel (scc_cell_corners4, scc_cell_edge_family4): their indices, the
  * first of their cell's 8 vertex blocks (the others lie at the grid's fixed offsets), local
  * coordinates and gradient scales. */
 typedef struct grid_quad {
@@ -452,7 +452,7 @@ __attribute__((target("avx"))) static int quad_fill4(const scc_grid* g, const sc
     return 1;
 }
 
-/* scc_cell_eval4 on a filled quad; writes the values (and gradients) of its points. */
+/* The four-lane kernel on a filled quad; writes the values (and gradients) of its points. */
 __attribute__((target("avx"))) static void quad_eval(const grid_quad* q, const ptrdiff_t off[8], double* out_v, scc_vec3* out_g)
 {
     const double *const b0 = q->b0[0], *const b1 = q->b0[1], *const b2 = q->b0[2], *const b3 = q->b0[3];
