@@ -348,9 +348,9 @@ SCC_CELL_INLINE void eval_batch_direct(const scc_grid* g, const scc_vec3* p, siz
 /* The direct grid's evaluation compiled for AVX: three-operand instructions spare the register
  * copies of the two-operand SSE2 code (about a quarter of the kernel's instructions). No FMA (it
  * is not in the "avx" target): the same operations in the same order, so the same bits. */
-/* Four points of a batch inside the domain, one per lane of the four-lane kernel (scc_cell_corners4, scc_cell_edge_family4): their indices, the
- * first of their cell's 8 vertex blocks (the others lie at the grid's fixed offsets), local
- * coordinates and gradient scales. */
+/* Four points of a batch inside the domain, one per lane of the four-lane kernel
+ * (scc_cell_corners4, scc_cell_edge_family4): their indices, the first of their cell's 8 vertex
+ * blocks (the others lie at the grid's fixed offsets), local coordinates and gradient scales. */
 typedef struct grid_quad {
     size_t idx[4];
     const double* b0[4];
