@@ -12,6 +12,9 @@
 
 #include <float.h>
 #include <string.h>
+#if SCC_GRID_AVX
+#include <immintrin.h>
+#endif
 
 /* ------------------------------------------------------------------------------------------
  * Grid data
@@ -280,7 +283,7 @@ SCC_CELL_INLINE double eval_direct(const scc_grid* g, uint64_t l, const uint32_t
 #if defined(__GNUC__) || defined(__clang__)
     /* every line of the 8 blocks requested up front: the kernel's last loads would otherwise
      * wait for its first ones to retire (a cell at random is 8-12 cache misses) */
-    for (int q = 0; q < 8; ++q) { __builtin_prefetch(b[q]); __builtin_prefetch(b[q] + 6); }
+    for (int q = 0; q < 8; q += 2) { __builtin_prefetch(b[q]); __builtin_prefetch(b[q] + 7); __builtin_prefetch(b[q] + 13); }
 #endif
     const double* const ex[4] = { b[0] + 1, b[4] + 1, b[2] + 1, b[6] + 1 };
     const double* const ey[4] = { b[0] + 3, b[1] + 3, b[4] + 3, b[5] + 3 };
@@ -345,9 +348,165 @@ SCC_CELL_INLINE void eval_batch_direct(const scc_grid* g, const scc_vec3* p, siz
 /* The direct grid's evaluation compiled for AVX: three-operand instructions spare the register
  * copies of the two-operand SSE2 code (about a quarter of the kernel's instructions). No FMA (it
  * is not in the "avx" target): the same operations in the same order, so the same bits. */
+/* Four points of a batch inside the domain, one per lane of the four-lane kernel
+ * (scc_cell_corners4, scc_cell_edge_family4): their indices, the first of their cell's 8 vertex
+ * blocks (the others lie at the grid's fixed offsets), local coordinates and gradient scales. */
+typedef struct grid_quad {
+    size_t idx[4];
+    const double* b0[4];
+    double xi[3][4], c0[3][4];
+    int count;
+} grid_quad;
+
+/* Fills q with the next (up to) four points from *next that lie inside the domain, evaluating
+ * the others on the way (scc_grid_eval), and requests their blocks (a cell requested just before
+ * is not requested again); unused lanes repeat lane 0. off: the 8 blocks' offsets from the first. */
+__attribute__((target("avx"))) static int quad_fill4(const scc_grid* g, const scc_vec3* p, size_t i0, grid_quad* q, const ptrdiff_t off[8], uint64_t* last);
+
+__attribute__((target("avx"))) static void quad_fill(const scc_grid* g, const scc_vec3* p, size_t n, size_t* next, grid_quad* q, const ptrdiff_t off[8],
+                                                      uint64_t* last, double* out_v, scc_vec3* out_g)
+{
+    q->count = 0;
+    if (*next + 4 <= n && quad_fill4(g, p, *next, q, off, last)) {
+        *next += 4;
+        return;
+    }
+    while (q->count < 4 && *next < n) {
+        const size_t i = (*next)++;
+        if (!inside_domain(g, p[i])) {
+            out_v[i] = scc_grid_eval(&g->base, p[i], out_g ? &out_g[i] : NULL);
+            continue;
+        }
+        const int k = q->count++;
+        uint32_t ijk[3];
+        const uint64_t l = locate(g, p[i], ijk);
+        double c0[3];
+        const scc_vec3 xi = cell_local(g, ijk, p[i], c0);
+        q->idx[k] = i;
+        q->xi[0][k] = xi.x; q->xi[1][k] = xi.y; q->xi[2][k] = xi.z;
+        q->c0[0][k] = c0[0]; q->c0[1][k] = c0[1]; q->c0[2][k] = c0[2];
+        const double* b0 = g->blocks + 7 * (ijk[0] + ((uint64_t)g->res[0] + 1) * (ijk[1] + ((uint64_t)g->res[1] + 1) * ijk[2]));
+        q->b0[k] = b0;
+        if (l == *last) continue;
+        *last = l;
+        /* blocks 2c and 2c + 1 are neighbours: 14 values, at most 3 lines */
+        for (int c = 0; c < 8; c += 2) { __builtin_prefetch(b0 + off[c]); __builtin_prefetch(b0 + off[c] + 7); __builtin_prefetch(b0 + off[c] + 13); }
+    }
+    for (int k = q->count; k < 4 && q->count > 0; ++k) {
+        q->b0[k] = q->b0[0];
+        for (int d = 0; d < 3; ++d) { q->xi[d][k] = q->xi[d][0]; q->c0[d][k] = q->c0[d][0]; }
+    }
+}
+
+/* quad_fill's common case: the four points from i0 all inside the domain (else returns 0 and
+ * changes nothing), located and their local coordinates computed four at a time: the same
+ * operations as locate and cell_local per lane, so the same cells and bits. */
+__attribute__((target("avx"))) static int quad_fill4(const scc_grid* g, const scc_vec3* p, size_t i0, grid_quad* q, const ptrdiff_t off[8], uint64_t* last)
+{
+    const scc_vec3* a = p + i0;
+    const __m256d x = _mm256_setr_pd(a[0].x, a[1].x, a[2].x, a[3].x);
+    const __m256d y = _mm256_setr_pd(a[0].y, a[1].y, a[2].y, a[3].y);
+    const __m256d z = _mm256_setr_pd(a[0].z, a[1].z, a[2].z, a[3].z);
+    const __m256d lx = _mm256_set1_pd(g->lo.x), ly = _mm256_set1_pd(g->lo.y), lz = _mm256_set1_pd(g->lo.z);
+    __m256d in = _mm256_and_pd(_mm256_cmp_pd(x, lx, _CMP_GE_OQ), _mm256_cmp_pd(x, _mm256_set1_pd(g->hi.x), _CMP_LE_OQ));
+    in = _mm256_and_pd(in, _mm256_and_pd(_mm256_cmp_pd(y, ly, _CMP_GE_OQ), _mm256_cmp_pd(y, _mm256_set1_pd(g->hi.y), _CMP_LE_OQ)));
+    in = _mm256_and_pd(in, _mm256_and_pd(_mm256_cmp_pd(z, lz, _CMP_GE_OQ), _mm256_cmp_pd(z, _mm256_set1_pd(g->hi.z), _CMP_LE_OQ)));
+    if (_mm256_movemask_pd(in) != 15) return 0;
+    /* locate: r = (p - lo) / h clamped to [0, res - 1] and truncated (r >= 0 inside the domain) */
+    const __m256d zero = _mm256_setzero_pd();
+    int32_t ijk[3][4];
+    const __m256d r[3] = { _mm256_mul_pd(_mm256_sub_pd(x, lx), _mm256_set1_pd(g->inv_h.x)), _mm256_mul_pd(_mm256_sub_pd(y, ly), _mm256_set1_pd(g->inv_h.y)),
+                           _mm256_mul_pd(_mm256_sub_pd(z, lz), _mm256_set1_pd(g->inv_h.z)) };
+    for (int d = 0; d < 3; ++d) {
+        const __m128i m = _mm_min_epi32(_mm256_cvttpd_epi32(_mm256_max_pd(r[d], zero)), _mm_set1_epi32((int32_t)g->res[d] - 1));
+        _mm_storeu_si128((__m128i*)ijk[d], m);
+    }
+    /* cell_local per lane: xi = c0 p - c1 with the cell's coefficients */
+    const double* tx = g->axis_coef;
+    const double* ty = tx + 2 * (size_t)g->res[0];
+    const double* tz = ty + 2 * (size_t)g->res[1];
+    const __m256d c0x = _mm256_setr_pd(tx[2 * ijk[0][0]], tx[2 * ijk[0][1]], tx[2 * ijk[0][2]], tx[2 * ijk[0][3]]);
+    const __m256d c1x = _mm256_setr_pd(tx[2 * ijk[0][0] + 1], tx[2 * ijk[0][1] + 1], tx[2 * ijk[0][2] + 1], tx[2 * ijk[0][3] + 1]);
+    const __m256d c0y = _mm256_setr_pd(ty[2 * ijk[1][0]], ty[2 * ijk[1][1]], ty[2 * ijk[1][2]], ty[2 * ijk[1][3]]);
+    const __m256d c1y = _mm256_setr_pd(ty[2 * ijk[1][0] + 1], ty[2 * ijk[1][1] + 1], ty[2 * ijk[1][2] + 1], ty[2 * ijk[1][3] + 1]);
+    const __m256d c0z = _mm256_setr_pd(tz[2 * ijk[2][0]], tz[2 * ijk[2][1]], tz[2 * ijk[2][2]], tz[2 * ijk[2][3]]);
+    const __m256d c1z = _mm256_setr_pd(tz[2 * ijk[2][0] + 1], tz[2 * ijk[2][1] + 1], tz[2 * ijk[2][2] + 1], tz[2 * ijk[2][3] + 1]);
+    _mm256_storeu_pd(q->xi[0], _mm256_sub_pd(_mm256_mul_pd(c0x, x), c1x));
+    _mm256_storeu_pd(q->xi[1], _mm256_sub_pd(_mm256_mul_pd(c0y, y), c1y));
+    _mm256_storeu_pd(q->xi[2], _mm256_sub_pd(_mm256_mul_pd(c0z, z), c1z));
+    _mm256_storeu_pd(q->c0[0], c0x);
+    _mm256_storeu_pd(q->c0[1], c0y);
+    _mm256_storeu_pd(q->c0[2], c0z);
+    const uint64_t sy = (uint64_t)g->res[0] + 1, sz = ((uint64_t)g->res[1] + 1) * sy;
+    for (int k = 0; k < 4; ++k) {
+        const uint64_t i = (uint32_t)ijk[0][k], j = (uint32_t)ijk[1][k], kk = (uint32_t)ijk[2][k];
+        const double* b0 = g->blocks + 7 * (i + sy * j + sz * kk);
+        q->idx[k] = i0 + (size_t)k;
+        q->b0[k] = b0;
+        const uint64_t l = i + (uint64_t)g->res[0] * (j + (uint64_t)g->res[1] * kk);
+        if (l == *last) continue;
+        *last = l;
+        for (int c = 0; c < 8; c += 2) { __builtin_prefetch(b0 + off[c]); __builtin_prefetch(b0 + off[c] + 7); __builtin_prefetch(b0 + off[c] + 13); }
+    }
+    q->count = 4;
+    return 1;
+}
+
+/* The four-lane kernel on a filled quad; writes the values (and gradients) of its points. */
+__attribute__((target("avx"))) static void quad_eval(const grid_quad* q, const ptrdiff_t off[8], double* out_v, scc_vec3* out_g)
+{
+    const double *const b0 = q->b0[0], *const b1 = q->b0[1], *const b2 = q->b0[2], *const b3 = q->b0[3];
+#define LANES(c, o) ((scc_d4){ b0[off[c] + o], b1[off[c] + o], b2[off[c] + o], b3[off[c] + o] })
+    scc_d4 xi[3], c0[3], L[3][2], v, gr[3];
+    memcpy(xi, q->xi, sizeof xi);
+    memcpy(c0, q->c0, sizeof c0);
+    {
+        const scc_d4 c[8] = { LANES(0, 0), LANES(1, 0), LANES(2, 0), LANES(3, 0), LANES(4, 0), LANES(5, 0), LANES(6, 0), LANES(7, 0) };
+        scc_cell_corners4(c, xi, L, &v, gr);
+    }
+    /* each edge family's pairs, loaded just before it: x from blocks 0 4 2 6 (+1), y from 0 1 4 5
+     * (+3), z from 0 2 1 3 (+5), as in scc_cell_eval_at */
+    {
+        const scc_d4 e[4][2] = { { LANES(0, 1), LANES(0, 2) }, { LANES(4, 1), LANES(4, 2) }, { LANES(2, 1), LANES(2, 2) }, { LANES(6, 1), LANES(6, 2) } };
+        scc_cell_edge_family4(e, &xi[0], L[1], L[2], &v, gr, 0, 1, 2);
+    }
+    {
+        const scc_d4 e[4][2] = { { LANES(0, 3), LANES(0, 4) }, { LANES(1, 3), LANES(1, 4) }, { LANES(4, 3), LANES(4, 4) }, { LANES(5, 3), LANES(5, 4) } };
+        scc_cell_edge_family4(e, &xi[1], L[2], L[0], &v, gr, 1, 2, 0);
+    }
+    {
+        const scc_d4 e[4][2] = { { LANES(0, 5), LANES(0, 6) }, { LANES(2, 5), LANES(2, 6) }, { LANES(1, 5), LANES(1, 6) }, { LANES(3, 5), LANES(3, 6) } };
+        scc_cell_edge_family4(e, &xi[2], L[0], L[1], &v, gr, 2, 0, 1);
+    }
+#undef LANES
+    double vv[4], gg[3][4];
+    memcpy(vv, &v, sizeof vv);
+    for (int d = 0; d < 3; ++d) {
+        const scc_d4 s = gr[d] * c0[d];
+        memcpy(gg[d], &s, sizeof gg[d]);
+    }
+    for (int k = 0; k < q->count; ++k) {
+        out_v[q->idx[k]] = vv[k];
+        if (out_g) out_g[q->idx[k]] = scc_v3(gg[0][k], gg[1][k], gg[2][k]);
+    }
+}
+
+/* The direct grid's batch in quads: the blocks of the next two quads are requested while this
+ * one is computed (a cold cell's 12 lines take longer than one quad's arithmetic). The numbers
+ * are eval_direct's (scc_cell_corners4, scc_cell_edge_family4). */
 __attribute__((target("avx"))) static void eval_batch_avx(const scc_grid* g, const scc_vec3* p, size_t n, double* out_v, scc_vec3* out_g)
 {
-    eval_batch_direct(g, p, n, out_v, out_g);
+    const ptrdiff_t sy = (ptrdiff_t)g->res[0] + 1, sz = sy * ((ptrdiff_t)g->res[1] + 1);
+    const ptrdiff_t off[8] = { 0, 7, 7 * sy, 7 * (sy + 1), 7 * sz, 7 * (sz + 1), 7 * (sz + sy), 7 * (sz + sy + 1) }; /* cell_blocks_of's */
+    grid_quad q[3];
+    size_t next = 0;
+    uint64_t last = UINT64_MAX;
+    quad_fill(g, p, n, &next, &q[0], off, &last, out_v, out_g);
+    quad_fill(g, p, n, &next, &q[1], off, &last, out_v, out_g);
+    for (int k = 0; q[k].count > 0; k = k == 2 ? 0 : k + 1) {
+        quad_fill(g, p, n, &next, &q[k == 0 ? 2 : k - 1], off, &last, out_v, out_g);
+        quad_eval(&q[k], off, out_v, out_g);
+    }
 }
 
 __attribute__((target("avx"))) double scc_grid_eval_avx(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
@@ -459,10 +618,9 @@ double scc_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* out_grad)
 double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
 {
     const scc_grid* g = (const scc_grid*)self;
-    const double global = fmax(g->lipschitz_max, g->hole_source ? 1.0 : 0.0);
-    const double outside_global = scc_hypot2(1.0, global);
+#define GLOBAL_BOUND fmax(g->lipschitz_max, g->hole_source ? 1.0 : 0.0) /* computed only where taken */
     if (!box || !scc_vfinite(box->lo) || !scc_vfinite(box->hi) || box->lo.x > box->hi.x || box->lo.y > box->hi.y || box->lo.z > box->hi.z)
-        return outside_global;
+        return scc_hypot2(1.0, GLOBAL_BOUND);
     const int leaves = box->lo.x < g->lo.x || box->lo.y < g->lo.y || box->lo.z < g->lo.z ||
                        box->hi.x > g->hi.x || box->hi.y > g->hi.y || box->hi.z > g->hi.z;
     const scc_aabb dom = { g->lo, g->hi };
@@ -480,18 +638,30 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
      * (+0.2% evaluations on the data set). */
     const uint64_t blocks = (uint64_t)(b[0] / 4 - a[0] / 4 + 1) * (b[1] / 4 - a[1] / 4 + 1) * (b[2] / 4 - a[2] / 4 + 1);
     double L = 0.0;
-    if (count > 64 && g->block_lipschitz && blocks > 512) L = global;
+    if (count > 64 && g->block_lipschitz && blocks > 512) L = GLOBAL_BOUND;
     else if (count > 64 && g->block_lipschitz) {
         /* large boxes: the per-block maxima of the blocks the box touches */
-        const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4;
+        const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4, w = b[0] / 4 - a[0] / 4 + 1;
+        float m = 0.0f; /* the max as floats, then widened: the same number */
         for (uint32_t k = a[2] / 4; k <= b[2] / 4; ++k)
-            for (uint32_t j = a[1] / 4; j <= b[1] / 4; ++j)
-                for (uint32_t i = a[0] / 4; i <= b[0] / 4; ++i) {
-                    const double bl = g->block_lipschitz[i + (uint64_t)nbx * (j + (uint64_t)nby * k)];
-                    if (bl > L) L = bl;
-                }
-    } else if (count > 32768) L = global;
-    else {
+            for (uint32_t j = a[1] / 4; j <= b[1] / 4; ++j) {
+                const float* row = g->block_lipschitz + a[0] / 4 + (uint64_t)nbx * (j + (uint64_t)nby * k);
+                for (uint32_t i = 0; i < w; ++i) m = row[i] > m ? row[i] : m;
+            }
+        L = (double)m;
+    } else if (count > 32768) L = GLOBAL_BOUND;
+    else if (g->direct) {
+        /* every cell valued, the map the identity: each row of the box is a run of cell bounds
+         * (their max as floats, then widened: the same number) */
+        float m = 0.0f;
+        const uint32_t w = b[0] - a[0] + 1;
+        for (uint32_t k = a[2]; k <= b[2]; ++k)
+            for (uint32_t j = a[1]; j <= b[1]; ++j) {
+                const float* row = g->cell_lipschitz + a[0] + (uint64_t)g->res[0] * (j + (uint64_t)g->res[1] * k);
+                for (uint32_t i = 0; i < w; ++i) m = row[i] > m ? row[i] : m;
+            }
+        L = (double)m;
+    } else {
         const scc_grid_field* fd = &g->fields[0];
         for (uint32_t k = a[2]; k <= b[2]; ++k)
             for (uint32_t j = a[1]; j <= b[1]; ++j)
@@ -502,6 +672,7 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
                     if (cl > L) L = cl;
                 }
     }
+#undef GLOBAL_BOUND
     return leaves ? sqrt(1.0 + L * L) : L;
 }
 

@@ -126,6 +126,57 @@ SCC_CELL_INLINE void scc_cell_eval_at(const double* const c[8], const double* co
     if (out_grad) { out_grad[0] = g[0]; out_grad[1] = g[1]; out_grad[2] = g[2]; }
 }
 
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(SCC_CELL_PLAIN_C)
+/* Four points at once, one per lane (scc_d4: the AVX evaluation, grid.c). Every lane does the
+ * scalar formula's operations in its order (the plain C build of scc_cell_eval_at, whose two-lane
+ * pairs are the t = 0, 1 lanes below), so each point gets the bits scc_cell_eval_at gives it.
+ * c[q]: corner q's values; e[2 dp + dr][t]: a family's edge pairs as in scc_cell_eval_at. The
+ * caller loads each family's values just before its call (32 vectors at once would not fit in
+ * the registers). */
+typedef double scc_d4 __attribute__((vector_size(32)));
+
+SCC_CELL_INLINE void scc_cell_edge_family4(const scc_d4 e[4][2], const scc_d4* xdp, const scc_d4 Lp[2], const scc_d4 Lr[2], scc_d4* phi, scc_d4* g,
+                                         int d, int p, int r)
+{
+    const scc_d4 xd = *xdp; /* by address: a 32-byte vector passed by value needs AVX in every caller (Clang) */
+    const scc_d4 w = 1.0 - xd * xd;
+    const scc_d4 m0 = 1.0 - 3.0 * xd, m1 = 1.0 + 3.0 * xd;
+    const scc_d4 l00 = Lp[0] * Lr[0], l01 = Lp[0] * Lr[1], l10 = Lp[1] * Lr[0], l11 = Lp[1] * Lr[1];
+    const scc_d4 B0 = e[0][0] * l00 + e[1][0] * l01 + e[2][0] * l10 + e[3][0] * l11;
+    const scc_d4 B1 = e[0][1] * l00 + e[1][1] * l01 + e[2][1] * l10 + e[3][1] * l11;
+    const scc_d4 m = m0 * B0 + m1 * B1;
+    *phi += (9.0 / 64.0) * w * m;
+    const scc_d4 Bp0 = (e[2][0] - e[0][0]) * Lr[0] + (e[3][0] - e[1][0]) * Lr[1];
+    const scc_d4 Bp1 = (e[2][1] - e[0][1]) * Lr[0] + (e[3][1] - e[1][1]) * Lr[1];
+    const scc_d4 Br0 = (e[1][0] - e[0][0]) * Lp[0] + (e[3][0] - e[2][0]) * Lp[1];
+    const scc_d4 Br1 = (e[1][1] - e[0][1]) * Lp[0] + (e[3][1] - e[2][1]) * Lp[1];
+    g[d] += (9.0 / 64.0) * (-2.0 * xd * m + w * 3.0 * (B1 - B0));
+    g[p] += (9.0 / 64.0) * w * (m0 * Bp0 + m1 * Bp1);
+    g[r] += (9.0 / 64.0) * w * (m0 * Br0 + m1 * Br1);
+}
+
+/* The corner part of four cells' interpolants (scc_cell_eval_at's, before the edge families):
+ * value *phi and xi-derivatives g, and the linear factors L the edge families take. */
+SCC_CELL_INLINE void scc_cell_corners4(const scc_d4 c[8], const scc_d4 xi[3], scc_d4 L[3][2], scc_d4* phi, scc_d4 g[3])
+{
+    for (int d = 0; d < 3; ++d) { L[d][0] = 1.0 - xi[d]; L[d][1] = 1.0 + xi[d]; }
+    const scc_d4 a00 = c[0] * L[0][0] + c[1] * L[0][1], a10 = c[2] * L[0][0] + c[3] * L[0][1];
+    const scc_d4 a01 = c[4] * L[0][0] + c[5] * L[0][1], a11 = c[6] * L[0][0] + c[7] * L[0][1];
+    const scc_d4 y00 = L[1][0] * L[2][0], y10 = L[1][1] * L[2][0], y01 = L[1][0] * L[2][1], y11 = L[1][1] * L[2][1];
+    const scc_d4 S = a00 * y00 + a10 * y10 + a01 * y01 + a11 * y11;
+    const scc_d4 Sx = (c[1] - c[0]) * y00 + (c[3] - c[2]) * y10 + (c[5] - c[4]) * y01 + (c[7] - c[6]) * y11;
+    const scc_d4 Sy = (a10 - a00) * L[2][0] + (a11 - a01) * L[2][1];
+    const scc_d4 Sz = (a01 - a00) * L[1][0] + (a11 - a10) * L[1][1];
+    const scc_d4 q = 9.0 * (xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]) - 19.0;
+    *phi = (1.0 / 64.0) * q * S;
+    g[0] = (1.0 / 64.0) * (q * Sx + 18.0 * xi[0] * S);
+    g[1] = (1.0 / 64.0) * (q * Sy + 18.0 * xi[1] * S);
+    g[2] = (1.0 / 64.0) * (q * Sz + 18.0 * xi[2] * S);
+}
+/* Then the edge families in scc_cell_eval_at's order: x (ex, &xi[0], L[1], L[2], 0, 1, 2),
+ * y (ey, &xi[1], L[2], L[0], 1, 2, 0), z (ez, &xi[2], L[0], L[1], 2, 0, 1). */
+#endif
+
 /* The same for the 32 values in slot order. */
 static inline void scc_cell_eval_inline(const double v[32], scc_vec3 xi, double* out_value, double out_grad[3])
 {
