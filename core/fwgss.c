@@ -174,13 +174,13 @@ static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 
      * query (test_sweep, golden section / this / this at the full tolerance: mean |dTOI| 3.08e-8 /
      * 3.04e-8 / 3.09e-8 s, mean distance from the certified bracket 2.53e-9 / 2.17e-9 / 2.65e-9 s). */
     if (p->fwgss_deriv_spatial && !s->kinked && coarse <= fine &&
-        scc_deriv_minimize(f0, scc_dot(gn, scc_sub(end, xn)), 0.05 * tol, p->max_ls_iter, phi_slope_on_segment, &k, &sp, &f1)) {
+        scc_deriv_run(f0, scc_dot(gn, scc_sub(end, xn)), 0.05 * tol, p->max_ls_iter, phi_slope_on_segment, &k, &sp, &f1)) {
         /* done */
     } else if (p->fwgss_brent_spatial) {
         /* Brent's parabolic steps (ours) converge superlinearly where phi is smooth along the segment */
         sp = scc_brent_minimize(0.0, 1.0, tol, p->max_ls_iter, phi_on_segment, &k);
     } else {
-        sp = scc_gss_minimize_from(0.0, 1.0, f0, f1, tol, 0.0, p->max_ls_iter, phi_on_segment, &k); /* Algorithm 1 */
+        sp = scc_gss_run(0.0, 1.0, f0, f1, tol, 0.0, p->max_ls_iter, phi_on_segment, &k); /* Algorithm 1 */
     }
     for (int j = 0; j < 3; ++j) s->b[j] = scc_fmax((1.0 - sp.l) * s->b[j] + sp.l * bb[j], 0.0);
     return sp.l * len;
@@ -251,9 +251,9 @@ static int descend(scc_fw_state* s, double t, int64_t* io_iterations)
             ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, unsigned_phi_at_time, s);
             if (ls.f > s->dist_tol) ls = crossing_by_bisection(s, s->ts, scc_fmin(t, s->te), p);
         } else if (scc_dot(g, v) > 0.0) { /* d = -1: moving away, look back in time (phi at t is known) */
-            ls = scc_gss_minimize_from(s->ts, t, NAN, phi - p->margin, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
+            ls = scc_gss_run(s->ts, t, NAN, phi - p->margin, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         } else {
-            ls = scc_gss_minimize_from(t, s->te, phi - p->margin, NAN, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
+            ls = scc_gss_run(t, s->te, phi - p->margin, NAN, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         }
         double tn = scc_fmin(ls.l, s->te);
 
