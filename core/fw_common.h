@@ -50,16 +50,14 @@ void scc_fw_prepare_motion(scc_fw_state* s);
  * below 2e-18 for |d| <= 1.6), by Horner's rule. Both run as the two lanes of one vector where the
  * compiler has vector extensions, with the same operations per lane as the scalar loops (the sine
  * lane starts one step early from 0: 0 * d2 + ks[0] is ks[0] exactly), so the same bits. */
-static const double scc_series_ks[11] = { 1.0 / 51090942171709440000.0, -1.0 / 121645100408832000.0, 1.0 / 355687428096000.0,
-                                          -1.0 / 1307674368000.0, 1.0 / 6227020800.0, -1.0 / 39916800.0, 1.0 / 362880.0,
-                                          -1.0 / 5040.0, 1.0 / 120.0, -1.0 / 6.0, 1.0 };
-static const double scc_series_kc[12] = { -1.0 / 1124000727777607680000.0, 1.0 / 2432902008176640000.0, -1.0 / 6402373705728000.0,
-                                          1.0 / 20922789888000.0, -1.0 / 87178291200.0, 1.0 / 479001600.0, -1.0 / 3628800.0,
-                                          1.0 / 40320.0, -1.0 / 720.0, 1.0 / 24.0, -0.5, 1.0 };
 static inline void scc_sincos_series(double d2, double* out_sd, double* out_cd)
 {
-    const double* ks = scc_series_ks;
-    const double* kc = scc_series_kc;
+    static const double ks[11] = { 1.0 / 51090942171709440000.0, -1.0 / 121645100408832000.0, 1.0 / 355687428096000.0,
+                                   -1.0 / 1307674368000.0, 1.0 / 6227020800.0, -1.0 / 39916800.0, 1.0 / 362880.0,
+                                   -1.0 / 5040.0, 1.0 / 120.0, -1.0 / 6.0, 1.0 };
+    static const double kc[12] = { -1.0 / 1124000727777607680000.0, 1.0 / 2432902008176640000.0, -1.0 / 6402373705728000.0,
+                                   1.0 / 20922789888000.0, -1.0 / 87178291200.0, 1.0 / 479001600.0, -1.0 / 3628800.0,
+                                   1.0 / 40320.0, -1.0 / 720.0, 1.0 / 24.0, -0.5, 1.0 };
 #if (defined(__GNUC__) || defined(__clang__)) && !defined(SCC_SERIES_PLAIN_C)
     typedef double v2d __attribute__((vector_size(16)));
     v2d acc = { 0.0, kc[0] };
@@ -145,44 +143,6 @@ static inline scc_vec3 scc_fw_point_pure(const scc_fw_state* s, scc_vec3 r, scc_
         rr = scc_fw_rodrigues(s, c, sn, r, kr, kd);
     }
     return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
-}
-
-/* scc_fw_point_pure at three times at once (the vertex traces' lanes, fwgss.c): the three sine
- * and cosine series side by side, six independent chains, instead of one after the other; the
- * same operations per point (the plain loops of scc_sincos_series), so the same bits. */
-static inline void scc_fw_points3(const scc_fw_state* s, const double t[3], const scc_vec3 r[3], const scc_vec3 kr[3], const double kd[3],
-                                  scc_vec3 x[3])
-{
-    if (s->wlen == 0.0) {
-        for (int i = 0; i < 3; ++i) x[i] = scc_add(scc_madd(s->g0, s->v, t[i] - s->t0), r[i]);
-        return;
-    }
-    double d[3], d2[3], sd[3], cd[3];
-    for (int i = 0; i < 3; ++i) {
-        d[i] = s->wlen * (t[i] - s->base_t);
-        d2[i] = d[i] * d[i];
-        sd[i] = scc_series_ks[0];
-        cd[i] = scc_series_kc[0];
-    }
-    for (int k = 1; k < 11; ++k)
-        for (int i = 0; i < 3; ++i) {
-            sd[i] = sd[i] * d2[i] + scc_series_ks[k];
-            cd[i] = cd[i] * d2[i] + scc_series_kc[k];
-        }
-    for (int i = 0; i < 3; ++i) {
-        cd[i] = cd[i] * d2[i] + scc_series_kc[11];
-        double c, sn;
-        if (fabs(d[i]) <= 1.6) {
-            const double sdd = sd[i] * d[i];
-            c = s->base_c * cd[i] - s->base_s * sdd;
-            sn = s->base_s * cd[i] + s->base_c * sdd;
-        } else {
-            const double a = s->wlen * (t[i] - s->t0);
-            c = cos(a);
-            sn = sin(a);
-        }
-        x[i] = scc_add(scc_madd(s->g0, s->v, t[i] - s->t0), scc_fw_rodrigues(s, c, sn, r[i], kr[i], kd[i]));
-    }
 }
 
 /* Point with weights b at time t (SDF frame) and its velocity when vel is not NULL. */

@@ -356,9 +356,7 @@ static void trace_ahead(scc_fw_state* s, int cap, trace_lane lanes[3])
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) b[i][j] = i == j;
         lanes[i].n = 0;
-        lanes[i].t[0] = s->ts;
         active[i] = 0;
-        if (s->fast) scc_fw_offset(s, b[i], &r[i], &kr[i], &kd[i]);
         /* the start of trace_vertex: the record's speed, witness and clear stretch */
         scc_vertex_trace* rec = s->m->trace[i];
         double t = s->ts;
@@ -376,41 +374,34 @@ static void trace_ahead(scc_fw_state* s, int cap, trace_lane lanes[3])
         if (!(speed[i] > 0.0)) continue;
         lanes[i].t[0] = t;
         active[i] = 1;
+        if (s->fast) scc_fw_offset(s, b[i], &r[i], &kr[i], &kd[i]);
     }
     const int steps = cap < TRACE_LANE_STEPS ? cap : TRACE_LANE_STEPS;
     for (int k = 0; k < steps; ++k) {
-        /* a lane stops at te or at an earlier lane's contact (found by the last round: a sample
-         * more than needed at most, which trace_vertex does not use) */
-        double t[3], limit = s->te;
         int any = 0;
+        double limit = s->te;
         for (int i = 0; i < 3; ++i) {
-            t[i] = lanes[i].t[active[i] ? k : 0];
-            if (active[i] && !(t[i] < limit)) active[i] = 0;
-            any |= active[i];
-            limit = scc_fmin(limit, witness[i]);
+            if (active[i]) {
+                const double t = lanes[i].t[k];
+                if (!(t < limit)) {
+                    active[i] = 0;
+                } else {
+                    const scc_vec3 x = s->fast ? scc_fw_point_pure(s, r[i], kr[i], kd[i], t) : scc_tri_point_at(s->m, b[i], t, NULL);
+                    const double phi = scc_sdf_eval_builtin(s->sdf, x, NULL);
+                    lanes[i].phi[k] = phi;
+                    lanes[i].n = k + 1;
+                    if (phi <= margin) {
+                        witness[i] = t;
+                        active[i] = 0;
+                    } else {
+                        lanes[i].t[k + 1] = trace_next(s, t, x, phi, speed[i]);
+                        any = 1;
+                    }
+                }
+            }
+            limit = scc_fmin(limit, witness[i]); /* a later vertex's trace ends at this one's contact */
         }
         if (!any) break;
-        scc_vec3 x[3];
-        if (s->fast) {
-            scc_fw_points3(s, t, r, kr, kd, x);
-        } else {
-            for (int i = 0; i < 3; ++i)
-                if (active[i]) x[i] = scc_tri_point_at(s->m, b[i], t[i], NULL);
-        }
-        double phi[3];
-        for (int i = 0; i < 3; ++i)
-            if (active[i]) phi[i] = scc_sdf_eval_builtin(s->sdf, x[i], NULL);
-        for (int i = 0; i < 3; ++i) {
-            if (!active[i]) continue;
-            lanes[i].phi[k] = phi[i];
-            lanes[i].n = k + 1;
-            if (phi[i] <= margin) {
-                witness[i] = t[i];
-                active[i] = 0;
-            } else {
-                lanes[i].t[k + 1] = trace_next(s, t[i], x[i], phi[i], speed[i]);
-            }
-        }
     }
 }
 
