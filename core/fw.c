@@ -26,8 +26,6 @@ void scc_fw_prepare_motion(scc_fw_state* s)
     const scc_tri_motion* m = s->m;
     s->fast = m->kind == SCC_TRI_RIGID && m->sdf == NULL;
     s->cache_t = NAN;
-    s->prep_t[0] = s->prep_t[1] = NAN;
-    s->prep_k = 0;
     s->pt_valid = 0;
     s->wlen = 0.0;
     if (!s->fast) return;

@@ -30,8 +30,6 @@ typedef struct scc_fw_state {
     double t0, wlen;
     double cache_t, cache_c, cache_s;
     double base_t, base_c, base_s; /* rotation angle's sine and cosine at base_t (mid-interval) */
-    double prep_t[2], prep_c[2], prep_s[2]; /* cosine and sine computed ahead for two times (fwgss.c) */
-    int prep_k;
     /* The offset r of the last weights evaluated (pt_b, compared bit for bit) with axis x r and
      * axis . r: a temporal search or a vertex trace evaluates one point at many times. */
     scc_vec3 kr0[3];     /* axis x r0[i] */
@@ -111,13 +109,7 @@ static inline scc_vec3 scc_fw_rotate_pre(scc_fw_state* s, double t, scc_vec3 r, 
 {
     if (s->wlen == 0.0) return r;
     if (t != s->cache_t) {
-        const int k = t == s->prep_t[1];
-        if (t == s->prep_t[k]) {
-            s->cache_c = s->prep_c[k];
-            s->cache_s = s->prep_s[k];
-        } else {
-            scc_fw_cos_sin(s, t, &s->cache_c, &s->cache_s);
-        }
+        scc_fw_cos_sin(s, t, &s->cache_c, &s->cache_s);
         s->cache_t = t;
     }
     return scc_fw_rodrigues(s, s->cache_c, s->cache_s, r, kr, kd);

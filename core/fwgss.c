@@ -18,19 +18,6 @@ static double phi_at_time(double t, void* c)
     return phi - s->p->margin;
 }
 
-/* A temporal search's next sample is at one of two times (scc_gss_run's prep): the rotation's
- * cosine and sine there are computed ahead into the motion's two slots (fw_common.h). */
-static double prepare_time(double t, void* c)
-{
-    scc_fw_state* s = c;
-    if (s->fast && s->wlen != 0.0) {
-        const int k = s->prep_k ^= 1;
-        s->prep_t[k] = t;
-        scc_fw_cos_sin(s, t, &s->prep_c[k], &s->prep_s[k]);
-    }
-    return 0.0;
-}
-
 static double unsigned_phi_at_time(double t, void* c) { return fabs(phi_at_time(t, c)); }
 
 /* Algorithm 2 line 13 minimises |phi| over [ts, t_i] to find where the current point enters the
@@ -193,7 +180,7 @@ static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 
         /* Brent's parabolic steps (ours) converge superlinearly where phi is smooth along the segment */
         sp = scc_brent_minimize(0.0, 1.0, tol, p->max_ls_iter, phi_on_segment, &k);
     } else {
-        sp = scc_gss_run(0.0, 1.0, f0, f1, tol, 0.0, p->max_ls_iter, phi_on_segment, NULL, &k); /* Algorithm 1 */
+        sp = scc_gss_run(0.0, 1.0, f0, f1, tol, 0.0, p->max_ls_iter, phi_on_segment, &k); /* Algorithm 1 */
     }
     for (int j = 0; j < 3; ++j) s->b[j] = scc_fmax((1.0 - sp.l) * s->b[j] + sp.l * bb[j], 0.0);
     return sp.l * len;
@@ -264,9 +251,9 @@ static int descend(scc_fw_state* s, double t, int64_t* io_iterations)
             ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, unsigned_phi_at_time, s);
             if (ls.f > s->dist_tol) ls = crossing_by_bisection(s, s->ts, scc_fmin(t, s->te), p);
         } else if (scc_dot(g, v) > 0.0) { /* d = -1: moving away, look back in time (phi at t is known) */
-            ls = scc_gss_run(s->ts, t, NAN, phi - p->margin, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, prepare_time, s);
+            ls = scc_gss_run(s->ts, t, NAN, phi - p->margin, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         } else {
-            ls = scc_gss_run(t, s->te, phi - p->margin, NAN, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, prepare_time, s);
+            ls = scc_gss_run(t, s->te, phi - p->margin, NAN, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         }
         double tn = scc_fmin(ls.l, s->te);
 

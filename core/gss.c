@@ -21,7 +21,7 @@ scc_gss_result scc_gss_minimize_gap(double a, double b, double tol, double slope
 
 scc_gss_result scc_gss_minimize_from(double a, double b, double fa, double fb, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx)
 {
-    return scc_gss_run(a, b, fa, fb, tol, slope, max_iter, f, NULL, ctx);
+    return scc_gss_run(a, b, fa, fb, tol, slope, max_iter, f, ctx);
 }
 
 /* Brent's minimiser (golden-section steps safeguarding parabolic interpolation through the three

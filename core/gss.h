@@ -48,18 +48,14 @@ typedef double scc_gss_dfn(double l, double* df, void* ctx);
 int scc_deriv_minimize(double f0, double d0, double tol, int max_iter, scc_gss_dfn* f, void* ctx, scc_gss_result* out, double* f1);
 
 /* The bodies of scc_gss_minimize_from and scc_deriv_minimize, inline: a solver that calls them with
- * its own static f gets f inlined too (no call per sample). scc_gss_run's `prep` (NULL: none) is
- * told the two places the next sample can be, before the last sample's value decides which (ours):
- * f can then find its set-up for the place done (e.g. a rotation's sine and cosine), off the
- * chain of dependent operations from one sample to the next. */
+ * its own static f gets f inlined too (no call per sample). */
 #if defined(__GNUC__) || defined(__clang__)
 #define SCC_GSS_INLINE static inline __attribute__((always_inline))
 #else
 #define SCC_GSS_INLINE static inline
 #endif
 
-SCC_GSS_INLINE scc_gss_result scc_gss_run(double a, double b, double fa, double fb, double tol, double slope, int max_iter, scc_gss_fn* f,
-                                          scc_gss_fn* prep, void* ctx)
+SCC_GSS_INLINE scc_gss_result scc_gss_run(double a, double b, double fa, double fb, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx)
 {
     const double r = 0.61803398874989484820; /* 1/phi */
     const double rc = 1.0 - r;
@@ -90,12 +86,6 @@ SCC_GSS_INLINE scc_gss_result scc_gss_run(double a, double b, double fa, double 
             if (m > 0.0 && fabs(l3 - l0) * slope <= m) { flat = 1; break; }
         }
         ++it;
-        if (prep) {
-            /* the next sample is one of these two (the same expressions as below); f's value of the
-             * last sample picks it, but the set-up of both need not wait for it */
-            prep(a + (b - a) * (r * a1 + rc * a0), ctx);
-            prep(a + (b - a) * (r * a2 + rc * a3), ctx);
-        }
         if (scc_fmin(f0, f1) < scc_fmin(f2, f3)) {
             a3 = a2; l3 = l2; f3 = f2;
             a2 = a1; l2 = l1; f2 = f1;
