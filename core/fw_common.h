@@ -75,66 +75,32 @@ static inline void scc_sincos_series(double d2, double* out_sd, double* out_cd)
 #endif
 }
 
-/* The rotation angle's cosine and sine at time t (s->wlen > 0), a pure function of t: the angle is
- * base + d with d the rotation since base_t (mid-interval, |d| <= pi/2 in a segment of at most half
- * a turn): sin d and cos d by their Taylor series, whose first omitted terms are below 2e-18 for
- * |d| <= 1.6, then the angle-sum formulas; cheaper than a libm sincos per time evaluated. Larger
- * |d|: libm. */
-static inline void scc_fw_cos_sin(const scc_fw_state* s, double t, double* out_c, double* out_s)
-{
-    double d = s->wlen * (t - s->base_t);
-    if (fabs(d) <= 1.6) {
-        double d2 = d * d, sd, cd;
-        scc_sincos_series(d2, &sd, &cd);
-        sd *= d;
-        *out_c = s->base_c * cd - s->base_s * sd;
-        *out_s = s->base_s * cd + s->base_c * sd;
-    } else {
-        double a = s->wlen * (t - s->t0);
-        *out_c = cos(a);
-        *out_s = sin(a);
-    }
-}
-
-/* R(w tau) r by Rodrigues' formula from the angle's cosine c and sine sn, with kr = axis x r and
- * kd = axis . r. */
-static inline scc_vec3 scc_fw_rodrigues(const scc_fw_state* s, double c, double sn, scc_vec3 r, scc_vec3 kr, double kd)
-{
-    return scc_add(scc_add(scc_scale(r, c), scc_scale(kr, sn)), scc_scale(s->axis, kd * (1.0 - c)));
-}
-
-/* Offset R(w tau) r at time t, with kr = axis x r and kd = axis . r given (constant for one
- * point); the rotation's sine and cosine are cached for the last time. */
+/* Offset R(w tau) r at time t by Rodrigues' formula, with kr = axis x r and kd = axis . r given
+ * (constant for one point); the rotation's sine and cosine are cached for the last time. */
 static inline scc_vec3 scc_fw_rotate_pre(scc_fw_state* s, double t, scc_vec3 r, scc_vec3 kr, double kd)
 {
     if (s->wlen == 0.0) return r;
     if (t != s->cache_t) {
-        scc_fw_cos_sin(s, t, &s->cache_c, &s->cache_s);
+        /* The angle is base + d with d the rotation since base_t (mid-interval, |d| <= pi/2 in a
+         * segment of at most half a turn): sin d and cos d by their Taylor series, whose first
+         * omitted terms are below 2e-18 for |d| <= 1.6, then the angle-sum formulas; cheaper
+         * than a libm sincos per time evaluated. Larger |d|: libm. */
+        double d = s->wlen * (t - s->base_t);
+        if (fabs(d) <= 1.6) {
+            double d2 = d * d, sd, cd;
+            scc_sincos_series(d2, &sd, &cd);
+            sd *= d;
+            s->cache_c = s->base_c * cd - s->base_s * sd;
+            s->cache_s = s->base_s * cd + s->base_c * sd;
+        } else {
+            double a = s->wlen * (t - s->t0);
+            s->cache_c = cos(a);
+            s->cache_s = sin(a);
+        }
         s->cache_t = t;
     }
-    return scc_fw_rodrigues(s, s->cache_c, s->cache_s, r, kr, kd);
-}
-
-/* The offset from the centre of the point with weights b (closed-form motion), with axis x r and
- * axis . r: constant for one point. */
-static inline void scc_fw_offset(const scc_fw_state* s, const double b[3], scc_vec3* r, scc_vec3* kr, double* kd)
-{
-    *r = scc_add(scc_add(scc_scale(s->r0[0], b[0]), scc_scale(s->r0[1], b[1])), scc_scale(s->r0[2], b[2]));
-    *kr = scc_cross(s->axis, *r);
-    *kd = scc_dot(s->axis, *r);
-}
-
-/* The point of offset r (scc_fw_offset) at time t, without the caches: a pure function of t, the
- * same numbers as scc_fw_point. */
-static inline scc_vec3 scc_fw_point_pure(const scc_fw_state* s, scc_vec3 r, scc_vec3 kr, double kd, double t)
-{
-    scc_vec3 rr = r;
-    if (s->wlen != 0.0) {
-        double c, sn;
-        scc_fw_cos_sin(s, t, &c, &sn);
-        rr = scc_fw_rodrigues(s, c, sn, r, kr, kd);
-    }
-    return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
+    double c = s->cache_c, sn = s->cache_s;
+    return scc_add(scc_add(scc_scale(r, c), scc_scale(kr, sn)), scc_scale(s->axis, kd * (1.0 - c)));
 }
 
 /* Point with weights b at time t (SDF frame) and its velocity when vel is not NULL. */
@@ -143,7 +109,9 @@ static inline scc_vec3 scc_fw_point(scc_fw_state* s, const double b[3], double t
     if (!s->fast) return scc_tri_point_at(s->m, b, t, vel);
     if (!s->pt_valid || memcmp(b, s->pt_b, sizeof s->pt_b) != 0) {
         memcpy(s->pt_b, b, sizeof s->pt_b);
-        scc_fw_offset(s, b, &s->pt_r, &s->pt_kr, &s->pt_kd);
+        s->pt_r = scc_add(scc_add(scc_scale(s->r0[0], b[0]), scc_scale(s->r0[1], b[1])), scc_scale(s->r0[2], b[2]));
+        s->pt_kr = scc_cross(s->axis, s->pt_r);
+        s->pt_kd = scc_dot(s->axis, s->pt_r);
         s->pt_valid = 1;
     }
     scc_vec3 rr = scc_fw_rotate_pre(s, t, s->pt_r, s->pt_kr, s->pt_kd);

@@ -301,104 +301,13 @@ static void refine_entry(scc_fw_state* s, const double b[3], double lo, double f
     }
 }
 
-/* The time after a trace sample at t (point x, phi there): phi cannot reach the margin sooner
- * than (phi - margin) / (L S). Near the surface the steps shrink geometrically; a step of the time
- * tolerance can then pass a crossing by at most that tolerance. */
-static inline double trace_next(const scc_fw_state* s, double t, scc_vec3 x, double phi, double speed)
-{
-    const double step = (phi - s->p->margin) / (step_lipschitz(s, x, phi) * speed);
-    return t + scc_fmax(step, s->p->time_tol);
-}
-
-/* The vertex traces' first samples, computed ahead for the three vertices together (ours): each
- * trace is a chain (the next time needs phi at this one), so one trace after the other waits on
- * every sample's latency, while the three chains side by side overlap. trace_vertex then takes
- * the samples from here, in its own order and with its own stopping rules, so the evaluations
- * counted, the witnesses and the records are the ones of the traces run one after the other. A
- * lane stops at its first sample in contact, at te, or at the first contact of an earlier vertex
- * (its trace ends there, which shrinks te). */
-#define TRACE_LANE_STEPS 64
-typedef struct trace_lane {
-    int n;                             /* samples computed */
-    double t[TRACE_LANE_STEPS + 1];    /* t[k]: time of sample k; t[n]: the next time */
-    double phi[TRACE_LANE_STEPS];
-} trace_lane;
-
-/* Whether evaluating the field has no effect but its result: no user callback inside. The lanes
- * may evaluate samples a trace never uses, which a user's function would see. */
-static int field_is_builtin(const scc_sdf* f)
-{
-    if (f->kind == SCC_SDF_CALLBACK) return 0;
-    if (f->kind == SCC_SDF_CSG) return field_is_builtin(((const scc_sdf_csg*)f)->a) && field_is_builtin(((const scc_sdf_csg*)f)->b);
-    if (f->kind == SCC_SDF_TRANSFORM) return field_is_builtin(((const scc_sdf_transform*)f)->child);
-    return 1;
-}
-
-static void trace_ahead(scc_fw_state* s, int cap, trace_lane lanes[3])
-{
-    const double margin = s->p->margin;
-    scc_vec3 r[3], kr[3];
-    double kd[3], speed[3], b[3][3], witness[3] = { INFINITY, INFINITY, INFINITY };
-    int active[3];
-    for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) b[i][j] = i == j;
-        lanes[i].n = 0;
-        active[i] = 0;
-        /* the start of trace_vertex: the record's speed, witness and clear stretch */
-        scc_vertex_trace* rec = s->m->trace[i];
-        double t = s->ts;
-        if (rec) {
-            if (rec->speed < 0.0) rec->speed = scc_vertex_speed_bound(s->m, i);
-            speed[i] = rec->speed;
-            if (rec->hit_t >= s->ts && rec->hit_t <= s->te) {
-                witness[i] = rec->hit_t;
-                continue;
-            }
-            if (rec->from <= t && t < rec->to) t = rec->to;
-        } else {
-            speed[i] = scc_vertex_speed_bound(s->m, i);
-        }
-        if (!(speed[i] > 0.0)) continue;
-        lanes[i].t[0] = t;
-        active[i] = 1;
-        if (s->fast) scc_fw_offset(s, b[i], &r[i], &kr[i], &kd[i]);
-    }
-    const int steps = cap < TRACE_LANE_STEPS ? cap : TRACE_LANE_STEPS;
-    for (int k = 0; k < steps; ++k) {
-        int any = 0;
-        double limit = s->te;
-        for (int i = 0; i < 3; ++i) {
-            if (active[i]) {
-                const double t = lanes[i].t[k];
-                if (!(t < limit)) {
-                    active[i] = 0;
-                } else {
-                    const scc_vec3 x = s->fast ? scc_fw_point_pure(s, r[i], kr[i], kd[i], t) : scc_tri_point_at(s->m, b[i], t, NULL);
-                    const double phi = scc_sdf_eval_builtin(s->sdf, x, NULL);
-                    lanes[i].phi[k] = phi;
-                    lanes[i].n = k + 1;
-                    if (phi <= margin) {
-                        witness[i] = t;
-                        active[i] = 0;
-                    } else {
-                        lanes[i].t[k + 1] = trace_next(s, t, x, phi, speed[i]);
-                        any = 1;
-                    }
-                }
-            }
-            limit = scc_fmin(limit, witness[i]); /* a later vertex's trace ends at this one's contact */
-        }
-        if (!any) break;
-    }
-}
-
 /* Conservative advancement of one vertex path (ours): with |grad phi| <= L and the vertex's speed
  * <= S, phi cannot reach the margin sooner than (phi - margin) / (L S), so stepping by that never
  * skips a crossing (steps are at least the time tolerance). Stops at the first witness (which
  * shrinks te), at te, or after `cap` steps. With a shared record (a mesh query's vertex, motion.h)
  * the part of the path traced for an earlier triangle is not traced again: its witness is reused,
  * a clear stretch is skipped, and the new steps extend the record. */
-static void trace_vertex(scc_fw_state* s, int i, int cap, const trace_lane* lane)
+static void trace_vertex(scc_fw_state* s, int i, int cap)
 {
     const double b[3] = { i == 0, i == 1, i == 2 };
     scc_vertex_trace* r = s->m->trace[i];
@@ -419,10 +328,8 @@ static void trace_vertex(scc_fw_state* s, int i, int cap, const trace_lane* lane
     const double start = t;
     double t_prev = t, f_prev = INFINITY, clear_to = t;
     for (int k = 0; k < cap && t < s->te && s->evals < s->p->max_evals; ++k) {
-        /* a sample the lanes computed ahead (the same time, so the same numbers) is not computed again */
-        const int ahead = lane && k < lane->n && lane->t[k] == t;
-        scc_vec3 x = ahead ? scc_v3(0, 0, 0) : scc_fw_point(s, b, t, NULL);
-        double phi = ahead ? lane->phi[k] : scc_sdf_eval_builtin(s->sdf, x, NULL);
+        scc_vec3 x = scc_fw_point(s, b, t, NULL);
+        double phi = scc_sdf_eval_builtin(s->sdf, x, NULL);
         s->evals++;
         if (phi <= s->p->margin) {
             if (k > 0) refine_entry(s, b, t_prev, f_prev, &t, &phi);
@@ -433,7 +340,10 @@ static void trace_vertex(scc_fw_state* s, int i, int cap, const trace_lane* lane
         }
         t_prev = t;
         f_prev = phi - s->p->margin;
-        t = ahead ? lane->t[k + 1] : trace_next(s, t, x, phi, speed);
+        double step = (phi - s->p->margin) / (step_lipschitz(s, x, phi) * speed);
+        /* Near the surface the steps shrink geometrically; a step of the time tolerance can then
+         * pass a crossing by at most that tolerance. */
+        t += scc_fmax(step, s->p->time_tol);
         clear_to = t;
     }
     if (!r || !(clear_to > start)) return;
@@ -644,12 +554,8 @@ void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb
     s.time_slope = p->fwgss_gap_tol > 0.0 ? scc_fmax(sdf->lipschitz, 1.0) * speed / p->fwgss_gap_tol : 0.0;
     /* The vertex paths first: in a mesh query their traces are shared with the neighbouring
      * triangles, and a contact found there rules the proof below out. */
-    if (p->fwgss_vertex_trace > 0) {
-        trace_lane lanes[3];
-        const int ahead = field_is_builtin(sdf);
-        if (ahead) trace_ahead(&s, p->fwgss_vertex_trace, lanes);
-        for (int i = 0; i < 3; ++i) trace_vertex(&s, i, p->fwgss_vertex_trace, ahead ? &lanes[i] : NULL);
-    }
+    if (p->fwgss_vertex_trace > 0)
+        for (int i = 0; i < 3; ++i) trace_vertex(&s, i, p->fwgss_vertex_trace);
     /* Most triangles the broad phase hands over pass close to the field without touching it; a
      * short proof of that skips the descents. */
     if (!s.hit && p->fwgss_clear_budget > 0 && speed > 0.0 && prove_clear(&s, s.ts, s.te, speed, p->fwgss_clear_budget)) {
