@@ -197,11 +197,11 @@ static double spatial_step(scc_fw_state* s, double tn, double* out_gap)
      * in-plane steepest descent up to the boundary: vertex-to-vertex directions zig-zag
      * towards an interior optimum (a spike apex under a face took more than 32 iterations and
      * stopped 62 us late), while the projected gradient points at it. */
-    scc_vec3 xn, gn, v;
-    double gap = scc_fw_eval(s, s->b, tn, &xn, &gn, &v) - s->p->margin;
+    scc_vec3 xn, gn;
+    double gap = scc_fw_eval(s, s->b, tn, &xn, &gn, NULL) - s->p->margin; /* no velocity needed here */
     if (out_gap) *out_gap = gap;
     scc_tri_state st;
-    scc_fw_tri_state(s, tn, &st);
+    scc_fw_tri_points(s, tn, &st);
     double bb[3];
     int have_dir = 0, interior = 0;
     if (s->b[0] > 0.0 && s->b[1] > 0.0 && s->b[2] > 0.0) interior = have_dir = interior_direction(&st, gn, s->b, bb);
@@ -412,7 +412,7 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
                 c = scc_fw_point(s, bc, r.t, NULL);
             } else {
                 scc_tri_state st;
-                scc_fw_tri_state(s, r.t, &st);
+                scc_fw_tri_points(s, r.t, &st);
                 c = scc_add(scc_add(scc_scale(st.x[0], bc[0]), scc_scale(st.x[1], bc[1])), scc_scale(st.x[2], bc[2]));
                 rad = region_radius(st.x, r.u, r.v, c);
             }
@@ -511,7 +511,7 @@ static int sharp_at_witness(scc_fw_state* s)
     scc_sdf_eval_builtin(s->sdf, x, &g0);
     s->evals++;
     scc_tri_state st;
-    scc_fw_tri_state(s, s->hit_t, &st);
+    scc_fw_tri_points(s, s->hit_t, &st);
     const scc_vec3 e1 = scc_sub(st.x[1], st.x[0]), e2 = scc_sub(st.x[2], st.x[0]);
     const scc_vec3 dirs[3] = { e1, e2, scc_cross(e1, e2) };
     const double l0 = scc_len(g0);
