@@ -90,20 +90,21 @@ void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double ou
     scc_cell_eval_inline(v, xi, out_value, out_grad);
 }
 
+/* Values at the 4 points above -> cubic Bernstein coefficients on [-1,1] (the inverse of the
+ * Bernstein basis sampled at those points). */
+const double scc_cell_to_bernstein[4][4] = {
+    { 1.0, 0.0, 0.0, 0.0 },
+    { -5.0 / 6.0, 3.0, -1.5, 1.0 / 3.0 },
+    { 1.0 / 3.0, -1.5, 3.0, -5.0 / 6.0 },
+    { 0.0, 0.0, 0.0, 1.0 },
+};
+
 /* out[s][a]: the Bernstein coefficient s = i + 4j + 16k (degree 3 per axis on [-1,1]^3) of
  * shape function a. Built by sampling at the tensor points {-1,-1/3,1/3,1}^3 and converting the
  * samples per axis. */
 void scc_cell_bernstein(double out[64][32])
 {
     static const double pts[4] = { -1.0, -1.0 / 3.0, 1.0 / 3.0, 1.0 };
-    /* Values at the 4 points above -> cubic Bernstein coefficients on [-1,1] (the inverse of
-     * the Bernstein basis sampled at those points). */
-    static const double conv[4][4] = {
-        { 1.0, 0.0, 0.0, 0.0 },
-        { -5.0 / 6.0, 3.0, -1.5, 1.0 / 3.0 },
-        { 1.0 / 3.0, -1.5, 3.0, -5.0 / 6.0 },
-        { 0.0, 0.0, 0.0, 1.0 },
-    };
     double N[32];
     for (int k = 0; k < 4; ++k)
         for (int j = 0; j < 4; ++j)
@@ -120,7 +121,7 @@ void scc_cell_bernstein(double out[64][32])
                 const int idx = (s / stride) % 4;
                 const int base = s - idx * stride;
                 double acc = 0.0;
-                for (int m = 0; m < 4; ++m) acc += conv[idx][m] * f[base + m * stride];
+                for (int m = 0; m < 4; ++m) acc += scc_cell_to_bernstein[idx][m] * f[base + m * stride];
                 g[s] = acc;
             }
             memcpy(f, g, sizeof f);

@@ -20,6 +20,8 @@ void scc_cell_eval(const double v[32], scc_vec3 xi, double* out_value, double ou
  * s = i + 4j + 16k (i, j, k in 0..3 along x, y, z) of shape function a, so the interpolant of node
  * values v has the Bernstein coefficients b[s] = sum_a out[s][a] v[a]. */
 void scc_cell_bernstein(double out[64][32]);
+/* Values of a cubic at {-1,-1/3,1/3,1} -> its Bernstein coefficients on [-1,1] (row = coefficient). */
+extern const double scc_cell_to_bernstein[4][4];
 
 /* ---- the factored kernel, inline for the grid's evaluation (scc_cell_eval calls it) ----
  * The two nodes of a cell edge are a pair (t = 0, 1: at -1/3 and +1/3 along it) that every

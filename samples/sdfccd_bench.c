@@ -360,9 +360,13 @@ static void exp_scaling(const options* o)
         /* SDFCCD_BENCH_SCALING_LEVEL=0|1|2: that mesh size alone (1K, 10K, 100K; a short run for profiling) */
         if (getenv("SDFCCD_BENCH_SCALING_LEVEL") && L != atoi(getenv("SDFCCD_BENCH_SCALING_LEVEL"))) continue;
         /* the certified bracket of the scene, once */
-        sdfccd_QueryParams pc = certified_params();
-        fall_result c = fall(spikes, mesh, lo, hi, &pc, ws);
-        printf("%u,Certified,1,0,%.4f,%d,%.12g,%.12g,%lld,%lld\n", info.triangle_count, c.total_ms, c.steps, c.toi, c.toi_lower, c.tested, c.evals);
+        /* SDFCCD_BENCH_SCALING_METHOD=NAME: that configuration alone (e.g. for callgrind's instruction counts) */
+        const char* only = getenv("SDFCCD_BENCH_SCALING_METHOD");
+        if (!only || !strcmp(only, "Certified")) {
+            sdfccd_QueryParams pc = certified_params();
+            fall_result c = fall(spikes, mesh, lo, hi, &pc, ws);
+            printf("%u,Certified,1,0,%.4f,%d,%.12g,%.12g,%lld,%lld\n", info.triangle_count, c.total_ms, c.steps, c.toi, c.toi_lower, c.tested, c.evals);
+        }
         struct { const char* name; sdfccd_QueryParams p; } m[5] = {
             { "DCD", method_params(SDFCCD_METHOD_DCD, 1) },
             { "FWGSS", config_params(CFG_NEW, 1) },
@@ -377,6 +381,7 @@ static void exp_scaling(const options* o)
             int reps = bp ? R : (R > 3 ? 3 : R);
             for (int r = 0; r < reps; ++r)
                 for (int k = 0; k < nm; ++k) { /* interleaved: the configurations see the same load */
+                    if (only && strcmp(only, m[k].name)) continue;
                     sdfccd_QueryParams p = m[k].p;
                     p.broad_phase = bp;
                     p.max_sdf_evaluations = INT64_MAX; /* the brute-force rows (17M evaluations at 100K) are measured whole */

@@ -232,7 +232,9 @@ static void section_kinds(FILE* md, const char* dir, const table* t, const table
                 "`sdfccd_query_mesh` without subdivision. FWGSS: the defaults (`fwgss_kink_guard` 1: on analytic fields with kinks and on "
                 "grids the answer checked by the certified search seeded with FWGSS's witness, at most 10^6 evaluations, on grids with "
                 "per-cell first-order Taylor bounds instead of the cells' Lipschitz bounds, where the cells along the path bound "
-                "|∇φ| above 2.25 (a crease); on convex fields without the guard's searches; "
+                "|∇φ| above 2.25 (a crease); on analytic fields the check's first-order bound less a bending term (0 where phi is convex; "
+                "a CSG max bends as its active operand, the negated distance of a convex shape by 1/distance), its regions bounded only "
+                "up to 3e-8 s before FWGSS's witness (it proves no earlier contact beyond that), witnesses sampled in every 4th generation of regions; on convex fields without the guard's searches; "
                 "on grids the guard's extra searches only when phi bends sharply at the earliest contact); FWGSS-before: the defaults of the commit in "
                 "`kinds_machine.txt` (when present: main before the check); FWGSS-guard-off: FWGSS before issue 20 (`fwgss_kink_guard` "
                 "0: no guard, no check); FWGSS-guard-2: the guard on every grid query too; FWGSS-baseline and "
@@ -390,12 +392,11 @@ static void section_scaling(FILE* md, const char* dir, const table* t)
                 "triangle, so some 90,000 narrow-phase tests). Here the hierarchy is tight (one triangle per leaf, padded only by the "
                 "motion's curvature), so only the few triangles that really reach a spike are tested, and those are the hard ones; "
                 "DCD pays a Frank-Wolfe descent per touching triangle at the end pose only, FWGSS a search over the whole step. "
-                "FWGSS's TOI is its earliest witness; the check proves no contact more than max(time tolerance, 1e-7 s) before it, "
-                "and the certified bracket can be narrower than that. At 100K the contact is a spike's tip under the armadillo: "
+                "FWGSS's TOI is its earliest witness; the check proves no contact more than max(0.3 x time tolerance, 1e-8 s) (3e-8 s) "
+                "before it, and replaces it by an earlier contact it finds. At 100K the contact is a spike's tip under the armadillo: "
                 "phi then changes linearly with the contact point's sideways error (the spatial tolerance, speed × time "
-                "tolerance), so a witness a few 1e-8 s after the certified one is within FWGSS's tolerance; refining the witness's "
-                "own entry time to 1e-9 s leaves it 6.6e-9 s after the bracket (measured with the guard's searches), so the lateness is in which point of "
-                "the triangle, not in the search along its path. CSV: `scaling.csv` (every repeat).\n\n");
+                "tolerance), so FWGSS's own witness was 1.5e-8 s after the certified bracket; with the check to 1e-7 s it stayed there, "
+                "to 3e-8 s the check finds an earlier contact inside the bracket. CSV: `scaling.csv` (every repeat).\n\n");
 }
 
 static void section_cost(FILE* md, const char* dir, const table* t)

@@ -144,7 +144,7 @@ typedef struct sdfccd_QueryParams {
                                         method's search over [t0, TOI] (no hit: the whole interval) seeded with its
                                         witness (on grids bounding phi per cell by a first-order Taylor form, and
                                         only where the cells along the path bound |grad phi| above 2.25): it
-                                        stops once no contact is proven more than max(time_tolerance, 1e-7 s) before
+                                        stops once no contact is proven more than max(0.3 x time_tolerance, 1e-8 s) before
                                         the witness, or after 128 x FWGSS's evaluations + 16384 (grids: + 65536; at
                                         most 10^6), and an earlier contact it finds replaces the answer; on the convex ones (box,
                                         cylinder) the golden-section searches and the 1 us check are left to it. Per-kind
