@@ -125,7 +125,7 @@ void scc_fw(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, c
         double phi = scc_fw_eval(&s, s.b, t, &x, &g, &v);
         double d = phi <= p->margin ? -1.0 : (scc_dot(g, v) > 0.0 ? -1.0 : 1.0); /* Eq. 17 */
         scc_tri_state st;
-        scc_fw_tri_state(&s, t, &st);
+        scc_fw_tri_points(&s, t, &st);
         int sv = scc_fw_support(&st, g);
         double tn = scc_clamp(t + alpha * (s.te - s.ts) * d, s.ts, s.te); /* Eq. 18-19 */
         double bn[3];

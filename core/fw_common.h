@@ -119,8 +119,9 @@ static inline scc_vec3 scc_fw_point(scc_fw_state* s, const double b[3], double t
     return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
 }
 
-/* The three vertices and their velocities at time t. */
-static inline void scc_fw_tri_state(scc_fw_state* s, double t, scc_tri_state* st)
+/* The three vertices at time t and, when with_velocity, their velocities (else st->v is left
+ * unset on the closed-form path: the spatial steps need only the positions). */
+static inline void scc_fw_tri_state_ex(scc_fw_state* s, double t, scc_tri_state* st, int with_velocity)
 {
     if (!s->fast) {
         scc_tri_state_at(s->m, t, st);
@@ -131,9 +132,15 @@ static inline void scc_fw_tri_state(scc_fw_state* s, double t, scc_tri_state* st
     for (int i = 0; i < 3; ++i) {
         scc_vec3 rr = scc_fw_rotate_pre(s, t, s->r0[i], s->kr0[i], s->kd0[i]);
         st->x[i] = scc_add(g, rr);
-        st->v[i] = scc_add(s->v, scc_cross(s->w, rr));
+        if (with_velocity) st->v[i] = scc_add(s->v, scc_cross(s->w, rr));
     }
 }
+
+/* The three vertices and their velocities at time t. */
+static inline void scc_fw_tri_state(scc_fw_state* s, double t, scc_tri_state* st) { scc_fw_tri_state_ex(s, t, st, 1); }
+
+/* The three vertices at time t (st->v unset on the closed-form path). */
+static inline void scc_fw_tri_points(scc_fw_state* s, double t, scc_tri_state* st) { scc_fw_tri_state_ex(s, t, st, 0); }
 
 /* Records a contact witness (phi <= margin) at time t with weights b: shrinks te. */
 static inline void scc_fw_witness(scc_fw_state* s, double t, const double b[3], double phi)

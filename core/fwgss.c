@@ -174,13 +174,13 @@ static double spatial_search(scc_fw_state* s, const scc_tri_state* st, scc_vec3 
      * query (test_sweep, golden section / this / this at the full tolerance: mean |dTOI| 3.08e-8 /
      * 3.04e-8 / 3.09e-8 s, mean distance from the certified bracket 2.53e-9 / 2.17e-9 / 2.65e-9 s). */
     if (p->fwgss_deriv_spatial && !s->kinked && coarse <= fine &&
-        scc_deriv_minimize(f0, scc_dot(gn, scc_sub(end, xn)), 0.05 * tol, p->max_ls_iter, phi_slope_on_segment, &k, &sp, &f1)) {
+        scc_deriv_run(f0, scc_dot(gn, scc_sub(end, xn)), 0.05 * tol, p->max_ls_iter, phi_slope_on_segment, &k, &sp, &f1)) {
         /* done */
     } else if (p->fwgss_brent_spatial) {
         /* Brent's parabolic steps (ours) converge superlinearly where phi is smooth along the segment */
         sp = scc_brent_minimize(0.0, 1.0, tol, p->max_ls_iter, phi_on_segment, &k);
     } else {
-        sp = scc_gss_minimize_from(0.0, 1.0, f0, f1, tol, 0.0, p->max_ls_iter, phi_on_segment, &k); /* Algorithm 1 */
+        sp = scc_gss_run(0.0, 1.0, f0, f1, tol, 0.0, p->max_ls_iter, phi_on_segment, &k); /* Algorithm 1 */
     }
     for (int j = 0; j < 3; ++j) s->b[j] = scc_fmax((1.0 - sp.l) * s->b[j] + sp.l * bb[j], 0.0);
     return sp.l * len;
@@ -197,11 +197,11 @@ static double spatial_step(scc_fw_state* s, double tn, double* out_gap)
      * in-plane steepest descent up to the boundary: vertex-to-vertex directions zig-zag
      * towards an interior optimum (a spike apex under a face took more than 32 iterations and
      * stopped 62 us late), while the projected gradient points at it. */
-    scc_vec3 xn, gn, v;
-    double gap = scc_fw_eval(s, s->b, tn, &xn, &gn, &v) - s->p->margin;
+    scc_vec3 xn, gn;
+    double gap = scc_fw_eval(s, s->b, tn, &xn, &gn, NULL) - s->p->margin; /* no velocity needed here */
     if (out_gap) *out_gap = gap;
     scc_tri_state st;
-    scc_fw_tri_state(s, tn, &st);
+    scc_fw_tri_points(s, tn, &st);
     double bb[3];
     int have_dir = 0, interior = 0;
     if (s->b[0] > 0.0 && s->b[1] > 0.0 && s->b[2] > 0.0) interior = have_dir = interior_direction(&st, gn, s->b, bb);
@@ -251,9 +251,9 @@ static int descend(scc_fw_state* s, double t, int64_t* io_iterations)
             ls = scc_gss_minimize(s->ts, t, p->time_tol, p->max_ls_iter, unsigned_phi_at_time, s);
             if (ls.f > s->dist_tol) ls = crossing_by_bisection(s, s->ts, scc_fmin(t, s->te), p);
         } else if (scc_dot(g, v) > 0.0) { /* d = -1: moving away, look back in time (phi at t is known) */
-            ls = scc_gss_minimize_from(s->ts, t, NAN, phi - p->margin, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
+            ls = scc_gss_run(s->ts, t, NAN, phi - p->margin, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         } else {
-            ls = scc_gss_minimize_from(t, s->te, phi - p->margin, NAN, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
+            ls = scc_gss_run(t, s->te, phi - p->margin, NAN, p->time_tol, s->time_slope, p->max_ls_iter, phi_at_time, s);
         }
         double tn = scc_fmin(ls.l, s->te);
 
@@ -412,7 +412,7 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
                 c = scc_fw_point(s, bc, r.t, NULL);
             } else {
                 scc_tri_state st;
-                scc_fw_tri_state(s, r.t, &st);
+                scc_fw_tri_points(s, r.t, &st);
                 c = scc_add(scc_add(scc_scale(st.x[0], bc[0]), scc_scale(st.x[1], bc[1])), scc_scale(st.x[2], bc[2]));
                 rad = region_radius(st.x, r.u, r.v, c);
             }
@@ -511,7 +511,7 @@ static int sharp_at_witness(scc_fw_state* s)
     scc_sdf_eval_builtin(s->sdf, x, &g0);
     s->evals++;
     scc_tri_state st;
-    scc_fw_tri_state(s, s->hit_t, &st);
+    scc_fw_tri_points(s, s->hit_t, &st);
     const scc_vec3 e1 = scc_sub(st.x[1], st.x[0]), e2 = scc_sub(st.x[2], st.x[0]);
     const scc_vec3 dirs[3] = { e1, e2, scc_cross(e1, e2) };
     const double l0 = scc_len(g0);

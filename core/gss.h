@@ -3,6 +3,8 @@
 #ifndef SCC_GSS_H
 #define SCC_GSS_H
 
+#include "scc_math.h"
+
 typedef double scc_gss_fn(double l, void* ctx);
 
 typedef struct scc_gss_result {
@@ -44,5 +46,127 @@ typedef double scc_gss_dfn(double l, double* df, void* ctx);
  * sign more than once: the caller then searches without derivatives, with f(1) in *f1. d0 >= 0
  * gives l = 0 without an evaluation. */
 int scc_deriv_minimize(double f0, double d0, double tol, int max_iter, scc_gss_dfn* f, void* ctx, scc_gss_result* out, double* f1);
+
+/* The bodies of scc_gss_minimize_from and scc_deriv_minimize, inline: a solver that calls them with
+ * its own static f gets f inlined too (no call per sample). */
+#if defined(__GNUC__) || defined(__clang__)
+#define SCC_GSS_INLINE static inline __attribute__((always_inline))
+#else
+#define SCC_GSS_INLINE static inline
+#endif
+
+SCC_GSS_INLINE scc_gss_result scc_gss_run(double a, double b, double fa, double fb, double tol, double slope, int max_iter, scc_gss_fn* f, void* ctx)
+{
+    const double r = 0.61803398874989484820; /* 1/phi */
+    const double rc = 1.0 - r;
+    scc_gss_result res;
+    double a0 = 0.0, a1 = rc, a2 = r, a3 = 1.0;
+    double l0 = a, l3 = b;
+    double f0 = fa, f3 = fb;
+    res.evals = 0;
+    if (isnan(f0)) {
+        f0 = f(l0, ctx);
+        res.evals++;
+    }
+    if (a == b) {
+        res.l = a; res.f = f0; res.converged = 1;
+        return res;
+    }
+    if (isnan(f3)) {
+        f3 = f(l3, ctx);
+        res.evals++;
+    }
+    double l1 = a + (b - a) * a1, l2 = a + (b - a) * a2;
+    double f1 = f(l1, ctx), f2 = f(l2, ctx);
+    res.evals += 2;
+    int it = 0, flat = 0;
+    while (fabs(l3 - l0) > tol && it < max_iter) {
+        if (slope > 0.0) {
+            double m = scc_fmin(scc_fmin(f0, f1), scc_fmin(f2, f3));
+            if (m > 0.0 && fabs(l3 - l0) * slope <= m) { flat = 1; break; }
+        }
+        ++it;
+        if (scc_fmin(f0, f1) < scc_fmin(f2, f3)) {
+            a3 = a2; l3 = l2; f3 = f2;
+            a2 = a1; l2 = l1; f2 = f1;
+            a1 = r * a2 + rc * a0;
+            l1 = a + (b - a) * a1;
+            f1 = f(l1, ctx);
+        } else {
+            a0 = a1; l0 = l1; f0 = f1;
+            a1 = a2; l1 = l2; f1 = f2;
+            a2 = r * a1 + rc * a3;
+            l2 = a + (b - a) * a2;
+            f2 = f(l2, ctx);
+        }
+        res.evals++;
+    }
+    res.converged = flat || fabs(l3 - l0) <= tol;
+    double lmid = a + (b - a) * 0.5 * (a0 + a3);
+    double fmid = f(lmid, ctx);
+    res.evals++;
+    if (f0 < fmid && f0 < f3) { res.l = l0; res.f = f0; }
+    else if (fmid < f3) { res.l = lmid; res.f = fmid; }
+    else { res.l = l3; res.f = f3; }
+    return res;
+}
+
+SCC_GSS_INLINE int scc_deriv_run(double f0, double d0, double tol, int max_iter, scc_gss_dfn* f, void* ctx, scc_gss_result* out, double* f1)
+{
+    scc_gss_result res = { 0.0, f0, 0, 1 };
+    if (!(d0 < 0.0)) {
+        *out = res;
+        return 1;
+    }
+    double dhi;
+    const double fhi = f(1.0, &dhi, ctx);
+    *f1 = fhi;
+    res.evals = 1;
+    if (!(dhi > 0.0)) {
+        if (!(fhi < f0)) return 0; /* f fell, rose and fell again: more than one sign change of f' */
+        res.l = 1.0;
+        res.f = fhi;
+        *out = res;
+        return 1;
+    }
+    if (fhi < res.f) { res.l = 1.0; res.f = fhi; }
+    double lo = 0.0, hi = 1.0, dlo = d0;
+    int it = 0, side = 0, slow = 0;
+    while (hi - lo > tol && it < max_iter) {
+        ++it;
+        const double width = hi - lo;
+        double l;
+        if (slow >= 2) {
+            l = 0.5 * (lo + hi);
+            slow = 0;
+        } else {
+            l = lo - dlo * (hi - lo) / (dhi - dlo);
+            const double m = 0.25 * tol; /* strictly inside, as the entry search keeps its samples */
+            if (!(l > lo + m)) l = lo + m;
+            if (!(l < hi - m)) l = hi - m;
+        }
+        double dl;
+        const double fl = f(l, &dl, ctx);
+        res.evals++;
+        if (fl < res.f) { res.l = l; res.f = fl; }
+        if (dl < 0.0) {
+            lo = l;
+            dlo = dl;
+            if (side == -1) dhi *= 0.5;
+            side = -1;
+        } else if (dl > 0.0) {
+            hi = l;
+            dhi = dl;
+            if (side == 1) dlo *= 0.5;
+            side = 1;
+        } else {
+            break; /* a stationary point (or a NaN slope): nothing better to bracket */
+        }
+        slow = hi - lo > 0.5 * width ? slow + 1 : 0;
+    }
+    res.converged = hi - lo <= tol || it < max_iter;
+    *out = res;
+    return 1;
+}
 
 #endif

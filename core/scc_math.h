@@ -31,6 +31,11 @@ static inline double scc_dist(scc_vec3 a, scc_vec3 b) { return scc_len(scc_sub(a
  * when every coordinate is in [1e-150, 1e150] or zero, else the coordinates scaled by the largest. */
 static inline double scc_hypot3(double x, double y, double z)
 {
+    /* The common case first: 4e-300 <= s <= 1e299 implies every coordinate < 1e150, the largest
+     * >= 1e-150 and s >= 1e-300, the plain formula's conditions below; so the same result, with
+     * two comparisons instead of the coordinates' magnitudes. */
+    const double s0 = x * x + y * y + z * z;
+    if (s0 >= 4e-300 && s0 <= 1e299) return sqrt(s0);
     /* a NaN coordinate gives NaN either way below: plain comparisons (no libm call) suffice */
     double ax = fabs(x), ay = fabs(y), az = fabs(z);
     double m = ax > ay ? ax : ay;
@@ -46,6 +51,8 @@ static inline double scc_hypot3(double x, double y, double z)
 /* scc_hypot3(x, y, 0) bit for bit, without the third coordinate's work on the common path. */
 static inline double scc_hypot2(double x, double y)
 {
+    const double s0 = x * x + y * y; /* the common case first, as in scc_hypot3 */
+    if (s0 >= 4e-300 && s0 <= 1e299) return sqrt(s0);
     double ax = fabs(x), ay = fabs(y);
     double m = ax > ay ? ax : ay;
     if (m <= 1e150 && m >= 1e-150) {

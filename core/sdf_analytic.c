@@ -167,17 +167,24 @@ static double cone_distance2(double rho, double z, double R, double H, double* g
     return inside ? -d : d;
 }
 
+/* The cone cell nearest p in x and y, clamped to the grid (clamped before rounding too: a far
+ * point's index must not overflow an int). */
+static void spike_cell(const scc_sdf_spike_grid* s, scc_vec3 p, int* ci, int* cj)
+{
+    const int i = (int)lround(scc_clamp((p.x - s->x0) / s->spacing, -1.0, (double)s->count_x));
+    const int j = (int)lround(scc_clamp((p.y - s->y0) / s->spacing, -1.0, (double)s->count_y));
+    *ci = i < 0 ? 0 : (i >= s->count_x ? s->count_x - 1 : i);
+    *cj = j < 0 ? 0 : (j >= s->count_y ? s->count_y - 1 : j);
+}
+
 static double spike_grid_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
     const scc_sdf_spike_grid* s = (const scc_sdf_spike_grid*)self;
     double best = p.z; /* ground slab z <= 0 */
     scc_vec3 bg = k_up;
     {
-        /* Clamped before rounding: a far point's cell index must not overflow an int. */
-        int ci = (int)lround(scc_clamp((p.x - s->x0) / s->spacing, -1.0, (double)s->count_x));
-        int cj = (int)lround(scc_clamp((p.y - s->y0) / s->spacing, -1.0, (double)s->count_y));
-        ci = ci < 0 ? 0 : (ci >= s->count_x ? s->count_x - 1 : ci);
-        cj = cj < 0 ? 0 : (cj >= s->count_y ? s->count_y - 1 : cj);
+        int ci, cj;
+        spike_cell(s, p, &ci, &cj);
         for (int j = cj - 1; j <= cj + 1; ++j) {
             if (j < 0 || j >= s->count_y) continue;
             for (int i = ci - 1; i <= ci + 1; ++i) {
@@ -211,10 +218,8 @@ static int spike_grid_convex_in(const scc_sdf* self, const scc_aabb* box)
     const double h = 0.5 * scc_dist(box->lo, box->hi);
     if (!(h < 0.25 * s->spacing) || !scc_vfinite(c)) return 0;
     double best = c.z, second = 1.5 * s->spacing - s->base_radius; /* the ground; the far cones' bound */
-    int ci = (int)lround(scc_clamp((c.x - s->x0) / s->spacing, -1.0, (double)s->count_x));
-    int cj = (int)lround(scc_clamp((c.y - s->y0) / s->spacing, -1.0, (double)s->count_y));
-    ci = ci < 0 ? 0 : (ci >= s->count_x ? s->count_x - 1 : ci);
-    cj = cj < 0 ? 0 : (cj >= s->count_y ? s->count_y - 1 : cj);
+    int ci, cj;
+    spike_cell(s, c, &ci, &cj);
     for (int j = cj - 1; j <= cj + 1; ++j) {
         if (j < 0 || j >= s->count_y) continue;
         for (int i = ci - 1; i <= ci + 1; ++i) {

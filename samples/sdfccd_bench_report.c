@@ -406,13 +406,16 @@ static void section_cost(FILE* md, const char* dir, const table* t)
     fprintf(md, "Measured differentially through the public ABI: the torus as a user SDF that evaluates the field once or five times "
                 "per call; the extra time per extra evaluation is the field's cost, the rest is the motion (closed-form rigid motion, "
                 "cached sine and cosine), the solver and the dispatch. The last column uses the built-in torus. The three take turns; each "
-                "runs a mesh's 1024 queries 15 times and the fastest pass counts. The user SDF is declared "
+                "runs a mesh's 1024 queries 15 times and the fastest pass counts, timed by the thread's CPU time (on a shared machine "
+                "the wall clock also counts the time other processes hold the CPU). The user SDF is declared "
                 "smooth (`sdfccd_CallbackSdfDef::smooth`), as the built-in torus is: same answers and evaluation counts (without it "
                 "FWGSS runs its kink guard and certified check on a user field, about 570 evaluations per triangle query). The "
                 "differential column is the field's throughput: the five evaluations of one call do not depend on each other, so "
                 "the processor overlaps them, whereas in the solver each evaluation waits for the one before (the next sample "
                 "depends on it); the field's latency (two dependent square roots for the torus) therefore counts in the "
-                "motion + solver + dispatch column.\n\n");
+                "motion + solver + dispatch column. Yet the solver is bound by the instructions it executes more than by its "
+                "chains (callgrind's count per evaluation against this time at the machine's 2.1 GHz: over 3 instructions per cycle); "
+                "running the three vertex traces' chains side by side, or a search's next sine and cosine ahead, did not pay.\n\n");
     fprintf(md, "| mesh | SDF evals/query | ns per evaluation | field (ns) | motion + solver + dispatch (ns) | built-in torus (ns per evaluation) |\n|---|---|---|---|---|---|\n");
     for (int r = 0; r < t->rows; ++r)
         fprintf(md, "| %s | %.0f | %.1f | %.1f | %.1f | %.1f |\n", S(t, r, "mesh"), D(t, r, "evals_per_query"), D(t, r, "ns_per_evaluation"),

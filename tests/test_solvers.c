@@ -2,6 +2,8 @@
  * Golden-section search (Algorithm 1) on functions with known minima, and DCD (Section 3.2)
  * against known deepest points. Uses the core's internal headers. */
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 #include "test_util.h"
 #include "ccd.h"
 #include "gss.h"
@@ -287,6 +289,55 @@ START_TEST(test_spike_grid_convex_in)
 }
 END_TEST
 
+/* The range-checked length as it was before its common-case test on the sum of squares (scc_math.h):
+ * the reference the fast path must match bit for bit. */
+static double hypot3_reference(double x, double y, double z)
+{
+    double ax = fabs(x), ay = fabs(y), az = fabs(z);
+    double m = ax > ay ? ax : ay;
+    m = m > az ? m : az;
+    if (m <= 1e150 && m >= 1e-150) {
+        double s = x * x + y * y + z * z;
+        if (s >= 1e-300) return sqrt(s);
+    }
+    if (!(m > 0.0) || isinf(m)) return m;
+    x /= m; y /= m; z /= m;
+    return m * sqrt(x * x + y * y + z * z);
+}
+
+static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0 || (isnan(a) && isnan(b)); }
+
+/* scc_hypot3 and scc_hypot2 equal the reference bit for bit, most of all next to the range limits
+ * (largest coordinate near 1e-150 and 1e150, sums of squares near 1e-300), where a fast path with
+ * looser bounds would take sqrt of the sum where the reference scales. */
+START_TEST(test_hypot_fast_path_identical)
+{
+    uint64_t state = 12345;
+    const double bands[6] = { 1e-150, 7.1e-151, 2e-150, 3.2e149, 1e150, 1.0 };
+    int checked = 0;
+    for (int i = 0; i < 200000; ++i) {
+        double c[3];
+        for (int k = 0; k < 3; ++k) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            const double u = (double)(state >> 11) * 0x1.0p-53; /* [0, 1) */
+            const double band = bands[(state >> 7) % 6];
+            c[k] = (k == 2 && (i & 1) ? 0.0 : band * (0.5 + 1.5 * u)) * ((state >> 3) & 1 ? -1.0 : 1.0);
+        }
+        const double ref = hypot3_reference(c[0], c[1], c[2]);
+        ck_assert_msg(same_bits(scc_hypot3(c[0], c[1], c[2]), ref), "hypot3(%a, %a, %a)", c[0], c[1], c[2]);
+        if (c[2] == 0.0) ck_assert_msg(same_bits(scc_hypot2(c[0], c[1]), ref), "hypot2(%a, %a)", c[0], c[1]);
+        ++checked;
+    }
+    const double odd[6] = { 0.0, -0.0, INFINITY, -INFINITY, NAN, 0x1p-1070 };
+    for (int a = 0; a < 6; ++a)
+        for (int b = 0; b < 6; ++b) {
+            ck_assert(same_bits(scc_hypot3(odd[a], odd[b], 1e-160), hypot3_reference(odd[a], odd[b], 1e-160)));
+            ck_assert(same_bits(scc_hypot2(odd[a], odd[b]), hypot3_reference(odd[a], odd[b], 0.0)));
+        }
+    ck_assert_int_eq(checked, 200000);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("solvers");
@@ -303,6 +354,7 @@ int main(void)
     tcase_add_test(d, test_dcd_edge_interior);
     tcase_add_test(d, test_dcd_box_separated);
     tcase_add_test(d, test_spike_grid_convex_in);
+    tcase_add_test(d, test_hypot_fast_path_identical);
     suite_add_tcase(s, d);
     return test_run_suite(s);
 }
