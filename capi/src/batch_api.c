@@ -1,23 +1,14 @@
 /* SPDX-License-Identifier: MIT
  * sdfccd C ABI: sdfccd_query_batch, many independent triangle or mesh queries on a caller-chosen
- * number of threads (issue 9). The calling thread and threads - 1 POSIX threads take the next
- * query from a shared atomic counter until none is left and then exit (no thread waits on
- * another except the final join, nothing spins). Mesh queries go through one workspace per
- * thread, so a batch allocates only per thread, not per query. Every query is computed exactly
- * as by itself (the solvers are deterministic and the workspace does not change results), so the
- * results do not depend on the thread count or on the order in which threads take queries. */
+ * number of threads (issue 9), through the thread loop in threads.c. Mesh queries go through one
+ * workspace per thread, so a batch allocates only per thread, not per query. Every query is computed
+ * exactly as by itself (the solvers are deterministic and the workspace does not change results), so
+ * the results do not depend on the thread count or on the order in which threads take queries. */
 #include "capi_internal.h"
-
-#include <pthread.h>
-#include <stdatomic.h>
-#include <stdio.h>
-
-#define MAX_BATCH_THREADS 256
 
 typedef struct batch {
     sdfccd_BatchQuery* q;
-    int32_t count;
-    atomic_int next;
+    sdfccd_Workspace* ws[SDFCCD__MAX_THREADS]; /* one per thread slot; NULL: each mesh query allocates its own */
 } batch;
 
 static sdfccd_Status run_one(sdfccd_BatchQuery* b, sdfccd_Workspace* ws)
@@ -44,18 +35,10 @@ static sdfccd_Status run_one(sdfccd_BatchQuery* b, sdfccd_Workspace* ws)
     }
 }
 
-static void* worker(void* arg)
+static sdfccd_Status run_item(void* ctx, int32_t i, int32_t slot)
 {
-    batch* bt = arg;
-    sdfccd_Workspace* ws = NULL;
-    if (sdfccd_create_workspace(&ws) != SDFCCD_OK) ws = NULL; /* then each mesh query allocates its own */
-    for (;;) {
-        int i = atomic_fetch_add(&bt->next, 1);
-        if (i >= bt->count) break;
-        bt->q[i].status = run_one(&bt->q[i], ws);
-    }
-    sdfccd_destroy_workspace(ws);
-    return NULL;
+    batch* bt = ctx;
+    return bt->q[i].status = run_one(&bt->q[i], bt->ws[slot]);
 }
 
 sdfccd_Status sdfccd_query_batch(sdfccd_BatchQuery* queries, int32_t count, int32_t threads)
@@ -63,30 +46,15 @@ sdfccd_Status sdfccd_query_batch(sdfccd_BatchQuery* queries, int32_t count, int3
     static const char fn[] = "sdfccd_query_batch";
     if (count < 0 || (count > 0 && !queries))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: queries is NULL or count (%d) < 0", fn, (int)count);
-    if (threads < 1 || threads > MAX_BATCH_THREADS)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: threads must be in [1, %d] (got %d)", fn, MAX_BATCH_THREADS, (int)threads);
+    if (threads < 1 || threads > SDFCCD__MAX_THREADS)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: threads must be in [1, %d] (got %d)", fn, SDFCCD__MAX_THREADS, (int)threads);
     if (count == 0) return SDFCCD_OK;
     if (threads > count) threads = count;
     batch bt;
     bt.q = queries;
-    bt.count = count;
-    atomic_init(&bt.next, 0);
-    pthread_t tid[MAX_BATCH_THREADS];
-    int started = 0;
-    for (int k = 1; k < threads; ++k) {
-        if (pthread_create(&tid[started], NULL, worker, &bt) != 0) break; /* fewer threads: still correct */
-        ++started;
-    }
-    worker(&bt);
-    for (int k = 0; k < started; ++k) pthread_join(tid[k], NULL);
-    /* The first failure, re-run on this thread so that its message is this thread's last error
-     * (queries are deterministic, so the re-run fails the same way). */
-    for (int32_t i = 0; i < count; ++i)
-        if (queries[i].status != SDFCCD_OK) {
-            sdfccd_Status st = run_one(&queries[i], NULL);
-            char msg[512];
-            snprintf(msg, sizeof msg, "%s", sdfccd_last_error());
-            return sdfccd__error(st, "%s: query %d: %s", fn, (int)i, msg);
-        }
-    return SDFCCD_OK;
+    for (int k = 0; k < threads; ++k)
+        if (sdfccd_create_workspace(&bt.ws[k]) != SDFCCD_OK) bt.ws[k] = NULL;
+    sdfccd_Status st = sdfccd__run_threads(fn, "query", run_item, &bt, count, threads);
+    for (int k = 0; k < threads; ++k) sdfccd_destroy_workspace(bt.ws[k]);
+    return st;
 }

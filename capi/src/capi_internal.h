@@ -36,6 +36,14 @@ sdfccd_Status sdfccd__check_finite(double v, const char* what);
 sdfccd_Status sdfccd__check_vec(sdfccd_Vec3 v, const char* what);
 sdfccd_Status sdfccd__check_pose(sdfccd_Pose pose, const char* what, scc_xform* out); /* validated, normalised */
 
+/* ---- batches on threads (threads.c) ---- */
+#define SDFCCD__MAX_THREADS 256
+/* One item of a batch; `slot` in [0, threads) is the running thread's own (for its workspace). */
+typedef sdfccd_Status (*sdfccd__RunItem)(void* ctx, int32_t item, int32_t slot);
+/* Runs every item in [0, count) on up to `threads` threads. If any failed, the first one is run
+ * again on this thread in slot 0 and its status returned with the message "fn: noun i: ...". */
+sdfccd_Status sdfccd__run_threads(const char* fn, const char* noun, sdfccd__RunItem run, void* ctx, int32_t count, int32_t threads);
+
 static inline scc_vec3 sdfccd__v(sdfccd_Vec3 v) { scc_vec3 r = { v.x, v.y, v.z }; return r; }
 static inline sdfccd_Vec3 sdfccd__pv(scc_vec3 v) { sdfccd_Vec3 r = { v.x, v.y, v.z }; return r; }
 static inline scc_aabb sdfccd__box(sdfccd_Aabb b) { scc_aabb r = { sdfccd__v(b.lo), sdfccd__v(b.hi) }; return r; }

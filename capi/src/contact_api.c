@@ -8,8 +8,6 @@
 #include "../../core/contacts.h"
 #include "../../core/faces.h"
 
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 
 /* Finite pose with a unit orientation (within 1e-4, then normalised) and a bounded position. */
@@ -350,61 +348,30 @@ sdfccd_Status sdfccd_generate_contacts_linear(sdfccd_Workspace* ws, sdfccd_SdfId
 
 typedef struct contact_batch {
     sdfccd_ContactPair* pairs;
-    int32_t count;
-    sdfccd_Workspace* const* ws;
-    atomic_int next, worker;
+    sdfccd_Workspace* const* ws; /* one per thread slot */
 } contact_batch;
 
-static sdfccd_Status run_pair(sdfccd_ContactPair* q, sdfccd_Workspace* ws)
+static sdfccd_Status run_pair(void* ctx, int32_t i, int32_t slot)
 {
-    return sdfccd_generate_contacts(ws, q->sdf, q->sdf_motion, q->mesh, q->motion, q->t0, q->t1, q->params, q->out_points, q->capacity,
-                                    q->out_set);
-}
-
-/* Takes the next pair until none is left (each thread its own workspace). */
-static void* contact_worker(void* arg)
-{
-    contact_batch* b = arg;
-    sdfccd_Workspace* ws = b->ws[atomic_fetch_add(&b->worker, 1)];
-    for (int i; (i = atomic_fetch_add(&b->next, 1)) < b->count;) b->pairs[i].status = run_pair(&b->pairs[i], ws);
-    return NULL;
+    contact_batch* b = ctx;
+    sdfccd_ContactPair* q = &b->pairs[i];
+    return q->status = sdfccd_generate_contacts(b->ws[slot], q->sdf, q->sdf_motion, q->mesh, q->motion, q->t0, q->t1, q->params,
+                                                q->out_points, q->capacity, q->out_set);
 }
 
 sdfccd_Status sdfccd_generate_contacts_batch(sdfccd_Workspace* const* workspaces, int32_t thread_count, sdfccd_ContactPair* pairs,
                                              int32_t count)
 {
     static const char fn[] = "sdfccd_generate_contacts_batch";
-    enum { MAX_THREADS = 256 };
     if (count < 0 || (count > 0 && !pairs) || !workspaces)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: pairs or workspaces is NULL or count (%d) < 0", fn, (int)count);
-    if (thread_count < 1 || thread_count > MAX_THREADS)
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: thread_count must be in [1, %d] (got %d)", fn, MAX_THREADS, (int)thread_count);
+    if (thread_count < 1 || thread_count > SDFCCD__MAX_THREADS)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: thread_count must be in [1, %d] (got %d)", fn, SDFCCD__MAX_THREADS,
+                             (int)thread_count);
     for (int32_t k = 0; k < thread_count; ++k)
         if (!workspaces[k]) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: workspaces[%d] is NULL", fn, (int)k);
-    if (count == 0) return SDFCCD_OK;
-    contact_batch b;
-    b.pairs = pairs;
-    b.count = count;
-    b.ws = workspaces;
-    atomic_init(&b.next, 0);
-    atomic_init(&b.worker, 0);
-    pthread_t tid[MAX_THREADS];
-    int started = 0;
-    for (int k = 1; k < thread_count && k < count; ++k) {
-        if (pthread_create(&tid[started], NULL, contact_worker, &b) != 0) break; /* fewer threads: still correct */
-        ++started;
-    }
-    contact_worker(&b);
-    for (int k = 0; k < started; ++k) pthread_join(tid[k], NULL);
-    /* The first failure again on this thread, so that its message is this thread's last error. */
-    for (int32_t i = 0; i < count; ++i)
-        if (pairs[i].status != SDFCCD_OK) {
-            sdfccd_Status st = run_pair(&pairs[i], workspaces[0]);
-            char msg[512];
-            snprintf(msg, sizeof msg, "%s", sdfccd_last_error());
-            return sdfccd__error(st, "%s: pair %d: %s", fn, (int)i, msg);
-        }
-    return SDFCCD_OK;
+    contact_batch b = { pairs, workspaces };
+    return sdfccd__run_threads(fn, "pair", run_pair, &b, count, thread_count);
 }
 
 /* ---- the face search ---- */
