@@ -3,6 +3,7 @@
 #include "bullet_scene.h"
 
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -256,6 +257,34 @@ void BulletScene::step(int i, double dt)
     beforeStep(i);
     m_world->stepSimulation((btScalar)dt, 1, (btScalar)dt);
     syncBodies();
+    // SDFCCD_SCENES_TRACE=FILE: every dynamic body's centre, velocity and spin, and every manifold point
+    // (triangle, lifetime, point on the mesh, normal, gap, normal and friction impulses, the solver's
+    // friction direction) after each step, for diagnosing contacts that do not come to rest.
+    static std::FILE* trace = std::getenv("SDFCCD_SCENES_TRACE") ? std::fopen(std::getenv("SDFCCD_SCENES_TRACE"), "w") : nullptr;
+    if (trace) traceStep(trace, i);
+}
+
+void BulletScene::traceStep(std::FILE* f, int i) const
+{
+    for (size_t k = 0; k < m_rigid.size(); ++k) {
+        const btRigidBody* r = m_rigid[k].get();
+        if (r->getInvMass() == 0) continue;
+        const btVector3 p = r->getCenterOfMassPosition(), v = r->getLinearVelocity(), w = r->getAngularVelocity();
+        std::fprintf(f, "B %d %zu p %.7f %.7f %.7f v %.3e %.3e %.3e w %.3e %.3e %.3e\n", i, k, (double)p[0], (double)p[1], (double)p[2],
+                     (double)v[0], (double)v[1], (double)v[2], (double)w[0], (double)w[1], (double)w[2]);
+    }
+    for (int m = 0; m < m_dispatcher->getNumManifolds(); ++m) {
+        btPersistentManifold* mf = m_dispatcher->getManifoldByIndexInternal(m);
+        for (int j = 0; j < mf->getNumContacts(); ++j) {
+            const btManifoldPoint& c = mf->getContactPoint(j);
+            const btVector3 &a = c.m_positionWorldOnA, &n = c.m_normalWorldOnB, &d = c.m_lateralFrictionDir1;
+            std::fprintf(f, "C %d m%d j%d tri %d life %d pA %.5f %.5f %.5f n %.4f %.4f %.4f d %.3e imp %.4e lat1 %.4e lat2 %.4e dir1 %.3f %.3f %.3f\n",
+                         i, m, j, c.m_index0, c.m_lifeTime, (double)a[0], (double)a[1], (double)a[2], (double)n[0], (double)n[1], (double)n[2],
+                         (double)c.m_distance1, (double)c.m_appliedImpulse, (double)c.m_appliedImpulseLateral1, (double)c.m_appliedImpulseLateral2,
+                         (double)d[0], (double)d[1], (double)d[2]);
+        }
+    }
+    std::fflush(f);
 }
 
 StepCost BulletScene::cost() const

@@ -8,6 +8,7 @@
 #ifndef SDFCCD_SCENES_BULLET_SCENE_H
 #define SDFCCD_SCENES_BULLET_SCENE_H
 
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -44,6 +45,8 @@ public:
 
     void step(int i, double dt) override;
     StepCost cost() const override;
+    /** Writes step i's bodies and manifold points to f (SDFCCD_SCENES_TRACE; samples/scenes/README.md). */
+    void traceStep(std::FILE* f, int i) const;
     double energy() const override;
     const char* precision() const override { return SDFCCD_BULLET_PRECISION_NAME; }
     std::string describe() const override;
