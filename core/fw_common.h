@@ -119,6 +119,32 @@ static inline scc_vec3 scc_fw_point(scc_fw_state* s, const double b[3], double t
     return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
 }
 
+/* One point of the triangle (fixed weights) followed over time: a temporal search or a vertex trace
+ * evaluates it at many times. Its offset terms are those scc_fw_point computes (the same bits),
+ * set once, so a sample skips scc_fw_point's cache check. */
+typedef struct scc_fw_path {
+    double b[3];
+    scc_vec3 r, kr; /* offset r from the centre at t0 and axis x r (closed-form motion) */
+    double kd;      /* axis . r */
+} scc_fw_path;
+
+static inline void scc_fw_path_init(const scc_fw_state* s, const double b[3], scc_fw_path* out)
+{
+    out->b[0] = b[0]; out->b[1] = b[1]; out->b[2] = b[2];
+    if (!s->fast) return;
+    out->r = scc_add(scc_add(scc_scale(s->r0[0], b[0]), scc_scale(s->r0[1], b[1])), scc_scale(s->r0[2], b[2]));
+    out->kr = scc_cross(s->axis, out->r);
+    out->kd = scc_dot(s->axis, out->r);
+}
+
+/* scc_fw_point(s, path->b, t, NULL), the same bits. */
+static inline scc_vec3 scc_fw_path_point(scc_fw_state* s, const scc_fw_path* path, double t)
+{
+    if (!s->fast) return scc_tri_point_at(s->m, path->b, t, NULL);
+    scc_vec3 rr = scc_fw_rotate_pre(s, t, path->r, path->kr, path->kd);
+    return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
+}
+
 /* The three vertices at time t and, when with_velocity, their velocities (else st->v is left
  * unset on the closed-form path: the spatial steps need only the positions). */
 static inline void scc_fw_tri_state_ex(scc_fw_state* s, double t, scc_tri_state* st, int with_velocity)
