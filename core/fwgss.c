@@ -129,10 +129,10 @@ SCC_HOT_INLINE double eval_on_segment(space_ctx* k, double l, double* df)
     return phi;
 }
 
-static double phi_on_segment(double l, void* c) { return eval_on_segment(c, l, NULL); }
+SCC_HOT_INLINE double phi_on_segment(double l, void* c) { return eval_on_segment(c, l, NULL); }
 
 /* phi on the segment and its slope, for the search with derivatives. */
-static double phi_slope_on_segment(double l, double* df, void* c) { return eval_on_segment(c, l, df); }
+SCC_HOT_INLINE double phi_slope_on_segment(double l, double* df, void* c) { return eval_on_segment(c, l, df); }
 
 /* Inside the triangle: the end point (weights `bb`) where the in-plane steepest descent
  * direction -grad leaves the triangle. Returns 0 when there is no such direction. */
