@@ -280,8 +280,11 @@ static int descend(scc_fw_state* s, double t, int64_t* io_iterations)
  * box about the ball of radius phi (at least 1e-12). */
 static double step_lipschitz(const scc_fw_state* s, scc_vec3 x, double phi)
 {
-    scc_aabb box = { scc_sub(x, scc_v3(phi, phi, phi)), scc_add(x, scc_v3(phi, phi, phi)) };
-    double L = scc_sdf_lipschitz(s->sdf, &box);
+    double L = s->sdf->lipschitz; /* scc_sdf_lipschitz without the box when the field has no local bound */
+    if (s->sdf->lipschitz_in) {
+        scc_aabb box = { scc_sub(x, scc_v3(phi, phi, phi)), scc_add(x, scc_v3(phi, phi, phi)) };
+        L = s->sdf->lipschitz_in(s->sdf, &box);
+    }
     return L > 1e-12 ? L : 1e-12;
 }
 
