@@ -133,6 +133,7 @@ static inline scc_vec3 scc_fw_point(scc_fw_state* s, const double b[3], double t
  * set once, so a sample skips scc_fw_point's cache check. */
 typedef struct scc_fw_path {
     double b[3];
+    int motion;     /* 0: scc_tri_point_at; 1: closed form, no spin; 2: closed form with spin */
     scc_vec3 r, kr; /* offset r from the centre at t0 and axis x r (closed-form motion) */
     double kd;      /* axis . r */
 } scc_fw_path;
@@ -140,6 +141,7 @@ typedef struct scc_fw_path {
 static inline void scc_fw_path_init(const scc_fw_state* s, const double b[3], scc_fw_path* out)
 {
     out->b[0] = b[0]; out->b[1] = b[1]; out->b[2] = b[2];
+    out->motion = !s->fast ? 0 : (s->wlen != 0.0 ? 2 : 1);
     if (!s->fast) return;
     out->r = scc_add(scc_add(scc_scale(s->r0[0], b[0]), scc_scale(s->r0[1], b[1])), scc_scale(s->r0[2], b[2]));
     out->kr = scc_cross(s->axis, out->r);
@@ -150,9 +152,9 @@ static inline void scc_fw_path_init(const scc_fw_state* s, const double b[3], sc
  * in the data set's vertex traces), so the angle is computed without looking at the cache first. */
 static inline scc_vec3 scc_fw_path_point(scc_fw_state* s, const scc_fw_path* path, double t)
 {
-    if (!s->fast) return scc_tri_point_at(s->m, path->b, t, NULL);
+    if (path->motion == 0) return scc_tri_point_at(s->m, path->b, t, NULL);
     scc_vec3 rr = path->r;
-    if (s->wlen != 0.0) {
+    if (path->motion == 2) {
         scc_fw_angle_at(s, t);
         rr = scc_fw_rodrigues(s, path->r, path->kr, path->kd);
     }
