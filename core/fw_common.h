@@ -75,32 +75,41 @@ static inline void scc_sincos_series(double d2, double* out_sd, double* out_cd)
 #endif
 }
 
+/* The rotation's cosine and sine at time t into the cache (s->wlen > 0). The angle is base + d with
+ * d the rotation since base_t (mid-interval, |d| <= pi/2 in a segment of at most half a turn): sin d
+ * and cos d by their Taylor series, whose first omitted terms are below 2e-18 for |d| <= 1.6, then
+ * the angle-sum formulas; cheaper than a libm sincos per time evaluated. Larger |d|: libm. */
+static inline void scc_fw_angle_at(scc_fw_state* s, double t)
+{
+    double d = s->wlen * (t - s->base_t);
+    if (fabs(d) <= 1.6) {
+        double d2 = d * d, sd, cd;
+        scc_sincos_series(d2, &sd, &cd);
+        sd *= d;
+        s->cache_c = s->base_c * cd - s->base_s * sd;
+        s->cache_s = s->base_s * cd + s->base_c * sd;
+    } else {
+        double a = s->wlen * (t - s->t0);
+        s->cache_c = cos(a);
+        s->cache_s = sin(a);
+    }
+    s->cache_t = t;
+}
+
+/* Rodrigues' formula with the cached cosine and sine. */
+static inline scc_vec3 scc_fw_rodrigues(const scc_fw_state* s, scc_vec3 r, scc_vec3 kr, double kd)
+{
+    double c = s->cache_c, sn = s->cache_s;
+    return scc_add(scc_add(scc_scale(r, c), scc_scale(kr, sn)), scc_scale(s->axis, kd * (1.0 - c)));
+}
+
 /* Offset R(w tau) r at time t by Rodrigues' formula, with kr = axis x r and kd = axis . r given
  * (constant for one point); the rotation's sine and cosine are cached for the last time. */
 static inline scc_vec3 scc_fw_rotate_pre(scc_fw_state* s, double t, scc_vec3 r, scc_vec3 kr, double kd)
 {
     if (s->wlen == 0.0) return r;
-    if (t != s->cache_t) {
-        /* The angle is base + d with d the rotation since base_t (mid-interval, |d| <= pi/2 in a
-         * segment of at most half a turn): sin d and cos d by their Taylor series, whose first
-         * omitted terms are below 2e-18 for |d| <= 1.6, then the angle-sum formulas; cheaper
-         * than a libm sincos per time evaluated. Larger |d|: libm. */
-        double d = s->wlen * (t - s->base_t);
-        if (fabs(d) <= 1.6) {
-            double d2 = d * d, sd, cd;
-            scc_sincos_series(d2, &sd, &cd);
-            sd *= d;
-            s->cache_c = s->base_c * cd - s->base_s * sd;
-            s->cache_s = s->base_s * cd + s->base_c * sd;
-        } else {
-            double a = s->wlen * (t - s->t0);
-            s->cache_c = cos(a);
-            s->cache_s = sin(a);
-        }
-        s->cache_t = t;
-    }
-    double c = s->cache_c, sn = s->cache_s;
-    return scc_add(scc_add(scc_scale(r, c), scc_scale(kr, sn)), scc_scale(s->axis, kd * (1.0 - c)));
+    if (t != s->cache_t) scc_fw_angle_at(s, t);
+    return scc_fw_rodrigues(s, r, kr, kd);
 }
 
 /* Point with weights b at time t (SDF frame) and its velocity when vel is not NULL. */
@@ -116,6 +125,39 @@ static inline scc_vec3 scc_fw_point(scc_fw_state* s, const double b[3], double t
     }
     scc_vec3 rr = scc_fw_rotate_pre(s, t, s->pt_r, s->pt_kr, s->pt_kd);
     if (vel) *vel = scc_add(s->v, scc_cross(s->w, rr));
+    return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
+}
+
+/* One point of the triangle (fixed weights) followed over time: a temporal search or a vertex trace
+ * evaluates it at many times. Its offset terms are those scc_fw_point computes (the same bits),
+ * set once, so a sample skips scc_fw_point's cache check. */
+typedef struct scc_fw_path {
+    double b[3];
+    int motion;     /* 0: scc_tri_point_at; 1: closed form, no spin; 2: closed form with spin */
+    scc_vec3 r, kr; /* offset r from the centre at t0 and axis x r (closed-form motion) */
+    double kd;      /* axis . r */
+} scc_fw_path;
+
+static inline void scc_fw_path_init(const scc_fw_state* s, const double b[3], scc_fw_path* out)
+{
+    out->b[0] = b[0]; out->b[1] = b[1]; out->b[2] = b[2];
+    out->motion = !s->fast ? 0 : (s->wlen != 0.0 ? 2 : 1);
+    if (!s->fast) return;
+    out->r = scc_add(scc_add(scc_scale(s->r0[0], b[0]), scc_scale(s->r0[1], b[1])), scc_scale(s->r0[2], b[2]));
+    out->kr = scc_cross(s->axis, out->r);
+    out->kd = scc_dot(s->axis, out->r);
+}
+
+/* scc_fw_point(s, path->b, t, NULL), the same bits. A path is sampled at a new time nearly always (99 %
+ * in the data set's vertex traces), so the angle is computed without looking at the cache first. */
+static inline scc_vec3 scc_fw_path_point(scc_fw_state* s, const scc_fw_path* path, double t)
+{
+    if (path->motion == 0) return scc_tri_point_at(s->m, path->b, t, NULL);
+    scc_vec3 rr = path->r;
+    if (path->motion == 2) {
+        scc_fw_angle_at(s, t);
+        rr = scc_fw_rodrigues(s, path->r, path->kr, path->kd);
+    }
     return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
 }
 

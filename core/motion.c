@@ -115,8 +115,8 @@ scc_vec3 scc_tri_point_at(const scc_tri_motion* m, const double b[3], double t, 
     return x;
 }
 
-/* scc_tri_speed_bound of the triangle with vertices idx[0..2] of m (a vertex alone: i, i, i). */
-static double speed_bound_of(const scc_tri_motion* m, const int idx[3])
+/* scc_tri_speed_bound of the n vertices idx[0..n-1] of m (the triangle: 0, 1, 2; a vertex alone: i). */
+static double speed_bound_of(const scc_tri_motion* m, const int* idx, int n)
 {
     double T = m->t1 - m->t0;
     double speed = 0.0, reach = 0.0; /* reach: bound on |x_world(t) - g_sdf(t)| */
@@ -124,14 +124,14 @@ static double speed_bound_of(const scc_tri_motion* m, const int idx[3])
     if (m->kind == SCC_TRI_RIGID) {
         scc_vec3 c = m->body->c_local;
         double r = 0.0;
-        for (int i = 0; i < 3; ++i) r = scc_fmax(r, scc_dist(m->local[idx[i]], c));
+        for (int i = 0; i < n; ++i) r = scc_fmax(r, scc_dist(m->local[idx[i]], c));
         speed = scc_len(m->body->v) + scc_len(m->body->w) * r;
         if (m->sdf) {
             scc_vec3 g0 = scc_rigid_center_at(m->body, m->t0);
             reach = scc_dist(g0, gs0) + r + (scc_len(m->body->v) + scc_len(m->sdf->v)) * fabs(T);
         }
     } else {
-        for (int i = 0; i < 3; ++i) {
+        for (int i = 0; i < n; ++i) {
             double d = scc_dist(m->end[idx[i]], m->start[idx[i]]);
             speed = scc_fmax(speed, T > 0.0 ? d / T : 0.0);
             if (m->sdf) reach = scc_fmax(reach, scc_dist(m->start[idx[i]], gs0) + d + scc_len(m->sdf->v) * fabs(T));
@@ -144,13 +144,12 @@ static double speed_bound_of(const scc_tri_motion* m, const int idx[3])
 double scc_tri_speed_bound(const scc_tri_motion* m)
 {
     static const int all[3] = { 0, 1, 2 };
-    return speed_bound_of(m, all);
+    return speed_bound_of(m, all, 3);
 }
 
 double scc_vertex_speed_bound(const scc_tri_motion* m, int i)
 {
-    const int one[3] = { i, i, i };
-    return speed_bound_of(m, one);
+    return speed_bound_of(m, &i, 1); /* the vertex once (its bound repeated three times is the same max) */
 }
 
 double scc_tri_accel_bound(const scc_tri_motion* m)

@@ -48,7 +48,11 @@ static inline double scc_hypot3(double x, double y, double z)
     x /= m; y /= m; z /= m;
     return m * sqrt(x * x + y * y + z * z);
 }
-/* scc_hypot3(x, y, 0) bit for bit, without the third coordinate's work on the common path. */
+/* scc_hypot3(x, y, 0) bit for bit, without the third coordinate's work on the common path; always
+ * inlined (the torus evaluates it twice per sample in the solvers' hot loops). */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
 static inline double scc_hypot2(double x, double y)
 {
     const double s0 = x * x + y * y; /* the common case first, as in scc_hypot3 */

@@ -34,6 +34,14 @@ void scc_sdf_spike_grid_init(scc_sdf_spike_grid* s, double spacing, double base_
 void scc_sdf_csg_init(scc_sdf_csg* s, scc_csg_op op, const scc_sdf* a, const scc_sdf* b);
 void scc_sdf_transform_init(scc_sdf_transform* s, const scc_sdf* child, scc_xform xf, double scale);
 
+/* Inlined even where the compiler would call it (their bodies look large): the solvers' hot
+ * loops evaluate through them. */
+#if defined(__GNUC__) || defined(__clang__)
+#define SCC_HOT_INLINE static inline __attribute__((always_inline))
+#else
+#define SCC_HOT_INLINE static inline
+#endif
+
 /* The evaluators of the simple analytic fields, inline: a solver's hot loop calls them directly
  * (scc_sdf_eval_builtin) instead of through the eval pointer, the same arithmetic. */
 static inline double scc_sign_of(double x) { return x < 0.0 ? -1.0 : 1.0; }
@@ -65,7 +73,7 @@ static inline double scc_sdf_box_value(const scc_sdf_box* s, scc_vec3 p, scc_vec
     return outside + inside - s->radius;
 }
 
-static inline double scc_sdf_torus_value(const scc_sdf_torus* s, scc_vec3 p, scc_vec3* g)
+SCC_HOT_INLINE double scc_sdf_torus_value(const scc_sdf_torus* s, scc_vec3 p, scc_vec3* g)
 {
     double rho = scc_hypot2(p.x, p.y);
     double qx = rho - s->major, qz = p.z;
@@ -116,14 +124,6 @@ double scc_sdf_torus_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g);
 double scc_sdf_capsule_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g);
 double scc_sdf_cylinder_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g);
 double scc_sdf_half_space_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g);
-
-/* Inlined even where the compiler would call it (its four bodies look large): the solvers' hot
- * loops evaluate through it. */
-#if defined(__GNUC__) || defined(__clang__)
-#define SCC_HOT_INLINE static inline __attribute__((always_inline))
-#else
-#define SCC_HOT_INLINE static inline
-#endif
 
 /* scc_sdf_eval with the simple analytic fields evaluated inline (identified by their eval pointer,
  * so a struct of another kind with the same tag is never misread). */

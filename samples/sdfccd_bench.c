@@ -449,7 +449,8 @@ static void exp_batch(const options* o)
  * ABI: the torus as a user (callback) SDF that evaluates the field `repeat` times per call. The
  * query time grows by (repeat - 1) x evaluations x field cost, which gives the field's cost; the
  * rest of the time per evaluation is the motion, the solver and the dispatch.
- * SDFCCD_BENCH_MESH=triangle|shuriken runs one mesh only. */
+ * SDFCCD_BENCH_MESH=triangle|shuriken runs one mesh only; SDFCCD_BENCH_COST_ONLY=0|1|2 runs one
+ * pass of one variant only (the callback x1, x5, the built-in torus: for callgrind). */
 typedef struct torus_cb { int repeat; } torus_cb;
 
 static double torus_eval(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
@@ -497,7 +498,8 @@ static void exp_cost(const options* o)
         d.smooth = 1; /* as the built-in torus: no kink guard, no certified check */
         CHECK(sdfccd_create_callback_sdf(&d, &sdf[k]));
     }
-    int R = o->quick >= 2 ? 1 : (o->quick ? 5 : 15); /* the fastest of the repeats: more of them find a quieter moment on a shared machine */
+    const int only_k = getenv("SDFCCD_BENCH_COST_ONLY") ? atoi(getenv("SDFCCD_BENCH_COST_ONLY")) : -1;
+    int R = o->quick >= 2 || only_k >= 0 ? 1 : (o->quick ? 5 : 15); /* the fastest of the repeats: more of them find a quieter moment on a shared machine */
     printf("mesh,queries,evals_per_query,ns_per_evaluation,ns_field,ns_motion_solver_dispatch,ns_per_evaluation_builtin_torus\n");
     const char* only = getenv("SDFCCD_BENCH_MESH"); /* one mesh only (a shorter run) */
     for (int mesh = 0; mesh < 2; ++mesh) {
@@ -507,6 +509,7 @@ static void exp_cost(const options* o)
         long long evals = 0;
         for (int rep = 0; rep < R; ++rep)
             for (int k = 0; k < 3; ++k) { /* interleaved: callback x1, callback x5, the built-in torus */
+                if (only_k >= 0 && k != only_k) continue;
                 sdfccd_SdfId f = k < 2 ? sdf[k] : ds.torus;
                 long long e = 0;
                 double t0 = clock_us();

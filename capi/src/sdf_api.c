@@ -210,12 +210,11 @@ typedef struct callback_sdf {
 static double callback_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
 {
     const callback_sdf* c = (const callback_sdf*)self;
+    if (!g) return c->fn(sdfccd__pv(p), NULL, c->user); /* most samples: no gradient, nothing to check */
     sdfccd_Vec3 gp = { 0.0, 0.0, 1.0 };
-    double v = c->fn(sdfccd__pv(p), g ? &gp : NULL, c->user);
-    if (g) {
-        *g = sdfccd__v(gp);
-        if (!scc_vfinite(*g)) *g = scc_v3(0.0, 0.0, 1.0); /* never hand NaN to a solver */
-    }
+    double v = c->fn(sdfccd__pv(p), &gp, c->user);
+    *g = sdfccd__v(gp);
+    if (!scc_vfinite(*g)) *g = scc_v3(0.0, 0.0, 1.0); /* never hand NaN to a solver */
     return v;
 }
 
