@@ -163,7 +163,7 @@ START_TEST(test_sampled_sdf_closed_form)
     ck_assert_double_near(n.z, -1.0, 1e-15);
     sdfccd_SdfInfo info;
     ck_assert_int_eq(sdfccd_sdf_get_info(s, &info), SDFCCD_OK);
-    ck_assert(info.bounds.lo.x == -2 && info.bounds.hi.z == 2 && info.lipschitz == 1);
+    ck_assert(info.bounds.lo.x == -2 && info.bounds.hi.z == 2 && info.lipschitz == 1 && info.kind == SDFCCD_SDF_CALLBACK);
     sdfccd_destroy_sdf(s);
 }
 END_TEST

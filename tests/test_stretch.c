@@ -45,6 +45,7 @@ START_TEST(test_sphere_closed_form)
     ck_assert_double_near(info.bounds.hi.y, 2.0, 0);
     ck_assert_double_near(info.bounds.hi.z, 3.0, 0);
     ck_assert_double_near(info.lipschitz, 1.0, 0);
+    ck_assert_int_eq(info.kind, SDFCCD_SDF_TRANSFORM);
     ck_assert_int_eq(sdfccd_destroy_sdf(e), SDFCCD_OK);
 }
 END_TEST

@@ -29,7 +29,8 @@ typedef int32_t sdfccd_SampleGradFcn(sdfccd_Vec3 p, double* out_value, sdfccd_Ve
  * asked; phi is the sample plus the distance moved, and outside the box the gradient points away
  * from it. Where `sample` has no value, phi is `hole_value` (finite) plus that distance, the
  * gradient pointing away from the box centre. Its Lipschitz bound is taken as 1 and its bounds are
- * `box`. `sample` must be pure and thread-safe and `user` must outlive the SDF. */
+ * `box`; its kind is ::SDFCCD_SDF_CALLBACK. `sample` must be pure and thread-safe and `user` must
+ * outlive the SDF. */
 SDFCCD_API sdfccd_Status sdfccd_create_sampled_sdf(sdfccd_SampleGradFcn* sample, void* user, sdfccd_Aabb box, double hole_value,
                                                    sdfccd_SdfId* out_sdf);
 
