@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // sdfccd Bullet bridge: the no-tunnelling guarantee (paper, Section 4). After Bullet integrates a
-// step, an action hands each dynamic body's executed motion to sdfccd_guard_step_rigid and puts a
-// body it rolls back at its safe pose, with sdfccd_guard_response's velocity.
+// step, an action hands each dynamic body's executed motion (per part and SDF) to sdfccd_guard_body
+// and puts a body it rolls back at its safe pose, with sdfccd_guard_response's velocity.
 #include "internal.h"
 
 #include <LinearMath/btAabbUtil2.h>
