@@ -49,6 +49,14 @@ int scc_guard(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p
 int scc_guard_step(const scc_sdf* sdf, const scc_mesh_motion* mm, const scc_params* p, double tolerance, scc_workspace* ws,
                    scc_guard_out* out);
 
+/* Whether a check's rollback at `toi` goes back before the body's earliest so far (`best_toi`; the
+ * end of the step at first). A body checked part by part against several SDFs goes back to the
+ * earliest of its rollbacks; of equal times the first one checked is kept. */
+static inline int scc_guard_earlier(int rolled_back, double toi, double best_toi)
+{
+    return rolled_back && toi < best_toi;
+}
+
 /* A rigid body's velocity state for the guard's response (world frame). */
 typedef struct scc_body_state {
     scc_vec3 center;         /* centre of mass */

@@ -946,6 +946,82 @@ START_TEST(test_response)
 }
 END_TEST
 
+/* sdfccd_guard_body on known inputs: a box (bottom at z = 1) falling at 2 m/s for 1 s, checked
+ * against a far sphere, a ground at z = 0 and two grounds at z = 0.4. The earliest rollback is the
+ * first z = 0.4 ground's, where the bottom first reached -TOL/2 (closed form t = 0.300125 s), equal
+ * to that pair's own sdfccd_guard_step_rigid; evaluations and certificates are the pairs' sums. A
+ * pair that fails is skipped and counted; moving up, or no pair, is CLEAR at t1. */
+START_TEST(test_guard_body_earliest)
+{
+    const sdfccd_MeshId box = test_box_mesh(v3(0.1, 0.1, 0.1), 2, 2, 2);
+    sdfccd_SdfId ball, ground, raised, dead;
+    ck_assert_int_eq(sdfccd_create_sphere(0.5, &ball), SDFCCD_OK);
+    sdfccd_Pose far = sdfccd_pose_identity();
+    far.position = v3(10, 0, 0);
+    sdfccd_SdfId far_ball;
+    ck_assert_int_eq(sdfccd_create_transformed(ball, far, 1.0, &far_ball), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_half_space(v3(0, 0, 1), 0.0, &ground), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_half_space(v3(0, 0, 1), 0.4, &raised), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_half_space(v3(0, 0, 1), 0.2, &dead), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(dead), SDFCCD_OK);
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    const sdfccd_GuardParams gp = sdfccd_default_guard_params();
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position = v3(0, 0, 1.1);
+    m.linear_velocity = v3(0, 0, -2);
+    sdfccd_GuardPair pairs[4] = { { far_ball, NULL, box, m }, { ground, NULL, box, m }, { raised, NULL, box, m }, { raised, NULL, box, m } };
+    sdfccd_GuardBodyResult r;
+    ck_assert_int_eq(sdfccd_guard_body(ws, pairs, 4, 0, 1, &gp, &r), SDFCCD_OK);
+    ck_assert_int_eq(r.index, 2);
+    ck_assert_int_eq(r.failed, 0);
+    ck_assert_int_eq(r.error, SDFCCD_OK);
+    ck_assert_int_eq(r.first.state, SDFCCD_GUARD_ROLLED_BACK);
+    ck_assert_msg(r.first.toi <= 0.300125 && r.first.toi > 0.300125 - 1e-6, "toi %.12g", r.first.toi);
+    int64_t evals = 0;
+    int32_t certified = 0;
+    for (int i = 0; i < 4; ++i) {
+        sdfccd_GuardResult g;
+        ck_assert_int_eq(sdfccd_guard_step_rigid(ws, pairs[i].sdf, NULL, box, &m, 0, 1, &gp, &g), SDFCCD_OK);
+        evals += g.sdf_evaluations;
+        certified += g.certified;
+        if (i == 2) {
+            ck_assert(g.toi == r.first.toi && g.triangle == r.first.triangle && g.sdf_evaluations == r.first.sdf_evaluations);
+            ck_assert(memcmp(&g.safe_pose, &r.first.safe_pose, sizeof g.safe_pose) == 0);
+        }
+        if (i == 1) ck_assert(g.state == SDFCCD_GUARD_ROLLED_BACK && g.toi > r.first.toi + 0.19);
+    }
+    ck_assert_int_eq(certified, 1); /* the far ball */
+    ck_assert(r.sdf_evaluations == evals);
+    ck_assert_int_eq(r.certified, certified);
+    /* A dead handle between two checks: skipped and counted; the later ground still decides. */
+    sdfccd_GuardPair with_dead[3] = { { ground, NULL, box, m }, { dead, NULL, box, m }, { raised, NULL, box, m } };
+    ck_assert_int_eq(sdfccd_guard_body(ws, with_dead, 3, 0, 1, &gp, &r), SDFCCD_OK);
+    ck_assert_int_eq(r.index, 2);
+    ck_assert_int_eq(r.failed, 1);
+    ck_assert_int_eq(r.error, SDFCCD_INVALID_HANDLE);
+    /* Moving up, and no pair: CLEAR at t1, no index. */
+    for (int i = 0; i < 4; ++i) pairs[i].executed.linear_velocity = v3(0, 0, 2);
+    ck_assert_int_eq(sdfccd_guard_body(ws, pairs, 4, 0, 1, &gp, &r), SDFCCD_OK);
+    ck_assert(r.index == -1 && r.first.state == SDFCCD_GUARD_CLEAR && r.first.toi == 1.0 && r.failed == 0);
+    ck_assert_int_eq(sdfccd_guard_body(ws, NULL, 0, 0, 1, &gp, &r), SDFCCD_OK);
+    ck_assert(r.index == -1 && r.first.toi == 1.0 && r.sdf_evaluations == 0);
+    /* Bad calls: nothing written. */
+    r.index = 77;
+    ck_assert_int_eq(sdfccd_guard_body(ws, pairs, -1, 0, 1, &gp, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_body(ws, NULL, 2, 0, 1, &gp, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_body(ws, pairs, 4, 0, 1, NULL, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_guard_body(ws, pairs, 4, 0, 1, &gp, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(r.index, 77);
+    sdfccd_destroy_workspace(ws);
+    sdfccd_destroy_sdf(far_ball);
+    sdfccd_destroy_sdf(ball);
+    sdfccd_destroy_sdf(ground);
+    sdfccd_destroy_sdf(raised);
+    sdfccd_destroy_mesh(box);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("guard");
@@ -973,6 +1049,7 @@ int main(void)
     tcase_add_test(tc, test_step_inside_slides_into_wall);
     tcase_add_test(tc, test_step_certificate_brute_force);
     tcase_add_test(tc, test_response);
+    tcase_add_test(tc, test_guard_body_earliest);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

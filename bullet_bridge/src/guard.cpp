@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // sdfccd Bullet bridge: the no-tunnelling guarantee (paper, Section 4). After Bullet integrates a
-// step, an action hands each dynamic body's executed motion to sdfccd_guard_step_rigid and puts a
-// body it rolls back at its safe pose, with sdfccd_guard_response's velocity.
+// step, an action hands each dynamic body's executed motion (per part and SDF) to sdfccd_guard_body
+// and puts a body it rolls back at its safe pose, with sdfccd_guard_response's velocity.
 #include "internal.h"
 
 #include <LinearMath/btAabbUtil2.h>
@@ -160,6 +160,8 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             sdfs.push_back(o);
         }
         std::vector<std::pair<const btCollisionShape*, btTransform>> parts;
+        std::vector<sdfccd_GuardPair> pairs;
+        std::vector<std::pair<const SdfObject*, btTransform>> which; // each pair's SDF and part offset
         btTransform id;
         id.setIdentity();
         for (int i = 0; i < objs.size() && !sdfs.empty(); ++i) {
@@ -174,10 +176,8 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             lo -= pad;
             hi += pad;
             parts.clear();
-            sdfccd_GuardResult best = sdfccd_GuardResult();
-            best.toi = dt;
-            const SdfObject* best_sdf = nullptr;
-            btTransform best_part;
+            pairs.clear();
+            which.clear();
             for (const SdfObject& o : sdfs) {
                 if (o.co == body || !TestAabbAgainstAabb2(lo, hi, o.lo, o.hi)) continue;
                 if (t0 == t1 && o.t0 == o.t1) { // neither moved (a sleeping body): nothing went deeper
@@ -189,24 +189,26 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     if (part.first == o.co->getCollisionShape() || !isMeshLike(part.first)) continue;
                     const MeshEntry* me = shapes.meshFor(part.first);
                     if (!me) continue;
-                    sdfccd_RigidMotion mm;
-                    sdfccd_GuardResult r;
+                    sdfccd_GuardPair pair = { o.sdf, &o.motion, me->id, sdfccd_RigidMotion() };
                     stats.guard_queries++;
-                    if (motionFromPoses(t0 * part.second, t1 * part.second, part.second.inverse().getOrigin(), dt, &mm) != SDFCCD_OK ||
-                        sdfccd_guard_step_rigid(workspace, o.sdf, &o.motion, me->id, &mm, 0, dt, &gp, &r) != SDFCCD_OK) {
+                    if (motionFromPoses(t0 * part.second, t1 * part.second, part.second.inverse().getOrigin(), dt, &pair.executed) != SDFCCD_OK) {
                         stats.query_errors++;
                         continue;
                     }
-                    stats.sdf_evaluations += r.sdf_evaluations;
-                    if (r.certified) stats.guard_skipped++;
-                    if (r.state == SDFCCD_GUARD_ROLLED_BACK && r.toi < best.toi) {
-                        best = r;
-                        best_sdf = &o;
-                        best_part = part.second;
-                    }
+                    pairs.push_back(pair);
+                    which.push_back(std::make_pair(&o, part.second));
                 }
             }
-            if (!best_sdf) continue;
+            // The earliest rollback of the body's checks (sdfccd_guard_body).
+            sdfccd_GuardBodyResult r;
+            if (pairs.empty() || sdfccd_guard_body(workspace, pairs.data(), (int32_t)pairs.size(), 0, dt, &gp, &r) != SDFCCD_OK) continue;
+            stats.query_errors += r.failed;
+            stats.sdf_evaluations += r.sdf_evaluations;
+            stats.guard_skipped += r.certified;
+            if (r.index < 0) continue;
+            const sdfccd_GuardResult& best = r.first;
+            const SdfObject* best_sdf = which[(size_t)r.index].first;
+            const btTransform& best_part = which[(size_t)r.index].second;
             // The safe pose (of the part that hit first: the body's follows), then the velocity
             // (sdfccd_guard_response, always as "repeated": the body loses its velocity into the surface;
             // keeping it for a first rollback raised the body and left the velocity that sank it, and

@@ -59,15 +59,6 @@ struct MeshEntry {
     bool ok = false;
 };
 
-// A btSdfCollisionShape's field: its grid (Bridge::setBtSdfData), else a callback SDF sampling
-// queryPoint in the shape's box (`hole_value` where it has no data).
-struct BtSdfEntry {
-    sdfccd_SdfId id = { 0, 0 };
-    btSdfCollisionShape* shape = nullptr;
-    btVector3 lo, hi;
-    double hole_value = 0;
-};
-
 // Packed meshes and SDF handles per Bullet shape (keyed by address; see Bridge::invalidateShape).
 class ShapeCache
 {
@@ -85,7 +76,8 @@ public:
 private:
     sdfccd_SdfId btSdfFor(const btSdfCollisionShape* shape);
     std::unordered_map<const btCollisionShape*, MeshEntry> m_meshes;
-    std::unordered_map<const btCollisionShape*, BtSdfEntry> m_bt_sdfs;
+    // A btSdfCollisionShape's field: its grid (setBtSdfData), else queryPoint (sdfccd_create_sampled_sdf).
+    std::unordered_map<const btCollisionShape*, sdfccd_SdfId> m_bt_sdfs;
 };
 
 // One contact candidate, in the frames at the START of the step.

@@ -168,34 +168,16 @@ int sourceCount(const btCollisionShape* shape)
     return 0;
 }
 
-double btSdfEval(sdfccd_Vec3 p, sdfccd_Vec3* out_grad, void* user)
+// queryPoint as the sampled field of sdfccd_create_sampled_sdf (its normal normalised).
+int32_t queryPointField(sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad, void* shape)
 {
-    BtSdfEntry* d = static_cast<BtSdfEntry*>(user);
-    btVector3 x = bt(p);
-    btVector3 eps = (d->hi - d->lo) * btScalar(1e-6);
-    btVector3 q = x;
-    q.setMax(d->lo + eps);
-    q.setMin(d->hi - eps);
-    btVector3 out = x - q;
-    double outside = (double)out.length();
-    btScalar dist = 0;
+    btScalar d = 0;
     btVector3 n(0, 0, 0);
-    bool ok = d->shape->queryPoint(q, dist, n);
-    btVector3 g;
-    double phi;
-    if (ok) {
-        phi = (double)dist + outside; // outside the grid: distance to the box plus the boundary value
-        g = outside > 0 ? out / btScalar(outside) : n;
-    } else {
-        // A cell without data (narrow-band grids): far from the surface by construction.
-        phi = d->hole_value + outside;
-        g = x - (d->lo + d->hi) * btScalar(0.5);
-    }
-    if (out_grad) {
-        btScalar l = g.length();
-        *out_grad = v3(l > btScalar(0) ? g / l : btVector3(0, 0, 1));
-    }
-    return phi;
+    if (!static_cast<btSdfCollisionShape*>(shape)->queryPoint(bt(p), d, n)) return 0;
+    *out_value = (double)d;
+    const btScalar l = n.length();
+    *out_grad = v3(l > btScalar(0) ? n / l : btVector3(0, 0, 1));
+    return 1;
 }
 
 // queryPoint as a sample of the field (sdfccd_sdf_compare_samples).
@@ -281,20 +263,18 @@ sdfccd_SdfId ShapeCache::sdfFor(const btCollisionShape* shape, int sdf_shape_typ
 sdfccd_SdfId ShapeCache::btSdfFor(const btSdfCollisionShape* shape)
 {
     auto it = m_bt_sdfs.find(shape);
-    if (it != m_bt_sdfs.end()) return it->second.id;
-    BtSdfEntry& e = m_bt_sdfs[shape]; // (a map node: its address is the callback's, for life)
-    e.shape = const_cast<btSdfCollisionShape*>(shape); // queryPoint is non-const but only reads
+    if (it != m_bt_sdfs.end()) return it->second;
+    // queryPoint in the shape's box (queryPoint is non-const but only reads).
     btTransform id;
     id.setIdentity();
-    shape->getAabb(id, e.lo, e.hi);
-    e.hole_value = 0.05 * (double)(e.hi - e.lo).length();
-    sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
-    def.eval = btSdfEval;
-    def.user = &e;
-    def.bounds.lo = v3(e.lo);
-    def.bounds.hi = v3(e.hi);
-    if (sdfccd_create_callback_sdf(&def, &e.id) != SDFCCD_OK) e.id = kNullSdf;
-    return e.id;
+    btVector3 lo, hi;
+    shape->getAabb(id, lo, hi);
+    const sdfccd_Aabb box = { v3(lo), v3(hi) };
+    sdfccd_SdfId& sdf = m_bt_sdfs[shape];
+    if (sdfccd_create_sampled_sdf(queryPointField, const_cast<btSdfCollisionShape*>(shape), box, 0.05 * (double)(hi - lo).length(), &sdf) !=
+        SDFCCD_OK)
+        sdf = kNullSdf;
+    return sdf;
 }
 
 bool ShapeCache::setBtSdfData(const btSdfCollisionShape* shape, const void* data, size_t size)
@@ -314,7 +294,7 @@ bool ShapeCache::setBtSdfData(const btSdfCollisionShape* shape, const void* data
         return false;
     }
     invalidate(shape);
-    m_bt_sdfs[shape].id = grid; // (no queryPoint data: the grid is the field)
+    m_bt_sdfs[shape] = grid; // (the grid is the field, not queryPoint)
     return true;
 }
 
@@ -327,7 +307,7 @@ void ShapeCache::invalidate(const btCollisionShape* shape)
     }
     auto jt = m_bt_sdfs.find(shape);
     if (jt != m_bt_sdfs.end()) {
-        if (jt->second.id.index1) sdfccd_destroy_sdf(jt->second.id);
+        if (jt->second.index1) sdfccd_destroy_sdf(jt->second);
         m_bt_sdfs.erase(jt);
     }
 }

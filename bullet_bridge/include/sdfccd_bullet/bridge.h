@@ -1,32 +1,15 @@
 // SPDX-License-Identifier: MIT
 /** @file bridge.h  Registers sdfccd's triangle-SDF continuous collision detection in Bullet.
  *
- *  - one collision algorithm, in both body orders and both of Bullet's tables (contactTest too):
- *      btGImpactMeshShape (alone or in a btCompoundShape) vs SdfShape and btSdfCollisionShape;
- *      any convex shape vs SdfShape (Config::convex_shapes),
- *      as triangles: a box's 12, other shapes' btShapeHull hull;
- *      SdfShape vs SdfShape (Config::sdf_pairs): the moving one's isosurface triangulation
- *      against the other's field.
- *  - the contact model, per pair and step: the features within the step's reach at the start
- *    pose, the CCD's contact set at the first time of impact of the predicted motion (start pose
- *    = world transform, end pose = interpolation transform) and the features touching at the end
- *    pose, each written as a point held by its surface point and normal at the start of the step
- *    (a speculative contact with gap d > 0 lets the solver close at most d; restitution 0). The
- *    set is reduced to the manifold's 4 points (deepest, then the largest contact area), and cover
- *    points (sdfccd_cover_contacts) go into up to three more manifolds where the 4 leave the body
- *    free to turn into the surface. Points of the same material point as the last step's keep
- *    their warm-start impulses; Bullet's contact added, processed, started and ended callbacks
- *    fire as for its own manifolds.
- *  - Bridge::check(world) reports misuse (not registered, registered too late, overwritten,
- *    an SdfShape with a dead handle); while a world steps, it goes to setMisuseHandler's handler.
- *  - the guarantee (Config::guard_tolerance): after each step, a body that went into an SDF is put
- *    back at its time of impact.
+ * One collision algorithm handles GImpact meshes (alone or in a btCompoundShape), convex shapes and
+ * other SdfShapes against SdfShape and btSdfCollisionShape, in both of Bullet's tables. Per pair and
+ * step it writes the contact set (the start pose within the step's reach and the CCD's first time of
+ * impact, reduced to the manifold's points) through Bullet's manifolds and callbacks; after each step
+ * the guarantee puts a body that went into an SDF back at its time of impact (README, contact model).
  *
  * Manifold convention: body A = the mesh body, body B = the SDF body; the normal is grad phi (out
- * of the SDF); distance < 0 means penetration; m_index0 = the mesh's triangle.
- *
- * Known limits: restitution at impact speed is lost; GImpact compound shapes
- * (btGImpactCompoundShape) fall back to GImpact's own algorithm (no CCD).
+ * of the SDF); distance < 0 means penetration; m_index0 = the mesh's triangle. Known limits:
+ * restitution at impact speed is lost; btGImpactCompoundShape falls back to GImpact's algorithm.
  */
 #ifndef SDFCCD_BULLET_BRIDGE_H
 #define SDFCCD_BULLET_BRIDGE_H
@@ -97,21 +80,12 @@ struct Config {
      * against the other's field. Off: such pairs have no algorithm and pass through each other
      * (check() cannot see that; keep it on unless no two SDF bodies can meet). Default on. */
     bool sdf_pairs = true;
-    /** Threads for the queries of a step (1..256; default 1: every query runs in the narrow phase,
-     * pair by pair, on Bullet's thread). With more, the first pair of each step that the bridge
-     * processes runs the queries of EVERY pair the world's broad phase holds for it (the start-pose
-     * query, then the CCD queries, then the end-pose queries, each stage as one sdfccd_query_batch
-     * on this many threads), and each pair then takes its results from there. The results are
-     * bitwise those the pair would have computed itself, so the simulation is the same whatever the
-     * count. Needs registerWith(btCollisionWorld*) (the pair cache is the world's). Not batched,
-     * and queried in the narrow phase as before: compound children, pairs with the face search, a
-     * btSdfCollisionShape, the DCD baseline (query.method DCD), closest-point queries. An SdfShape
-     * made from a callback SDF is then evaluated from several threads at once: its callback must be
-     * thread-safe (the library's built-in SDFs are). Stats::batched_queries counts the queries used
-     * from a batch. */
+    /** Threads for the queries of a step (1..256; default 1). With more, the first pair of a step runs
+     * the queries of every pair in the world's pair cache as batches (needs registerWith(world); a
+     * callback SDF must then be thread-safe); the results are bitwise the same as with 1. */
     int batch_threads = 1;
-    /** Query parameters (margin replaced by contact_margin): the library's defaults without
-     * FWGSS restarts and the certified check, whose misses the discrete queries and the guarantee catch. */
+    /** Query parameters (margin replaced by contact_margin): the library's defaults without FWGSS
+     * restarts and the certified check (the discrete queries and the guarantee catch their misses). */
     sdfccd_QueryParams query;
     /** The defaults stated above. */
     Config() : query(sdfccd_default_query_params()) { query.fwgss_restarts = 0; query.fwgss_verify = 0; }
@@ -121,9 +95,8 @@ struct Config {
 struct Stats {
     int64_t queries = 0;               /**< CCD queries (sdfccd_query_mesh over the step) made by the algorithm. */
     int64_t end_pose_queries = 0;      /**< Discrete queries (at the start pose over the step's reach, at the predicted end pose). */
-    int64_t queries_skipped = 0;       /**< CCD queries not run because the start-pose query settled them: nothing
-                                            within reach (its broad phase proves no contact), or the step starts in
-                                            contact (the CCD would report penetration at the start with the same features). */
+    int64_t queries_skipped = 0;       /**< CCD queries the start-pose query made unnecessary (nothing within reach,
+                                            or already in contact). */
     int64_t requeries = 0;             /**< Queries repeated because the contact buffer was too small. */
     int64_t sdf_evaluations = 0;       /**< SDF evaluations of all those queries (the library's count). */
     int64_t own_evaluations = 0;       /**< The bridge's own SDF evaluations (closest points at the start of the step). */
@@ -136,11 +109,9 @@ struct Stats {
     int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
     int64_t guard_queries = 0;         /**< Executed motions checked by the guarantee (one per body part and SDF). */
     int64_t rollbacks = 0;             /**< Bodies the guarantee put back at their time of impact. */
-    int64_t guard_skipped = 0;         /**< Checks the guarantee settled without a CCD: bodies that did not move,
-                                            and motions sdfccd_guard_step_rigid's certificate proved clear. */
+    int64_t guard_skipped = 0;         /**< Checks the guarantee settled without a CCD (no motion, or certified clear). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (SdfShape::setFeatureSize). */
-    int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (Config::batch_threads);
-                                            they are counted in queries, end_pose_queries and sdf_evaluations too. */
+    int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (also counted above). */
     int64_t batches = 0;               /**< sdfccd_query_batch calls (Config::batch_threads; up to 3 per step). */
     double last_toi_fraction = 1;      /**< Fraction of the last hit (1 when none). */
     int last_state = 0;                /**< sdfccd_ResultState of the last query. */

@@ -3,6 +3,7 @@
 #ifndef SDFCCD_BULLET_SDF_SHAPE_H
 #define SDFCCD_BULLET_SDF_SHAPE_H
 
+#include <memory>
 #include <vector>
 
 #include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
@@ -10,9 +11,6 @@
 
 #include "sdfccd/sdfccd.h"
 #include "config.h"
-
-class btBvhTriangleMeshShape;
-class btTriangleIndexVertexArray;
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
@@ -32,13 +30,13 @@ public:
     /** The constructor, or NULL (and `*status`, if given) when `sdf` is not a live handle. */
     static SdfShape* create(sdfccd_SdfId sdf, int shape_type = kDefaultSdfShapeType, sdfccd_Status* status = nullptr);
     /** False when the handle was not live at construction: an empty box, and no pairs. */
-    bool isValid() const { return m_valid; }
+    bool isValid() const;
     ~SdfShape() override;
     SdfShape(const SdfShape&) = delete;
     SdfShape& operator=(const SdfShape&) = delete;
 
     /** The wrapped handle, as given. */
-    sdfccd_SdfId sdf() const { return m_sdf; }
+    sdfccd_SdfId sdf() const;
 
     /** The wrapped SDF with the local scaling (owned by the shape; null handle on failure).
      * Non-uniform scaling s gives min(s) phi(x / s), never above the stretched shape's distance. */
@@ -54,22 +52,22 @@ public:
 
     /** The size (m, unscaled) of the field's smallest features (default 0: larger than the faces
      * meeting it). When positive, the bridge searches each face region by region down to it. */
-    void setFeatureSize(double size) { m_featureSize = size > 0 ? size : 0; }
+    void setFeatureSize(double size);
     /** The feature size times the smallest local scaling factor. */
     double getFeatureSize() const;
 
     /** Cells along the longest axis of the triangulation grid (default 48). */
     void setTriangulationResolution(int cells);
     /** Cells along the longest axis of the triangulation grid. */
-    int getTriangulationResolution() const { return m_resolution; }
+    int getTriangulationResolution() const;
     /** Builds the triangulation now (else on first use); its triangle count. */
     int buildTriangulation() const;
     /** Triangles of the cached triangulation (0 if not built). */
     int getTriangulationTriangleCount() const;
     /** The triangulation's vertices (x, y, z each; unscaled; empty if not built). */
-    const std::vector<btScalar>& triangulationVertices() const { return m_vertices; }
+    const std::vector<btScalar>& triangulationVertices() const;
     /** Three indices into triangulationVertices() per triangle. */
-    const std::vector<int>& triangulationIndices() const { return m_indices; }
+    const std::vector<int>& triangulationIndices() const;
 
     // ---- btCollisionShape ----
     /** The scaled local box, padded by the margin, transformed by `t`. */
@@ -77,15 +75,11 @@ public:
     /** Scales the shape about its origin by |scaling| (a zero or NaN component counts as 1). */
     void setLocalScaling(const btVector3& scaling) override;
     /** The local scaling (default 1, 1, 1). */
-    const btVector3& getLocalScaling() const override { return m_scaling; }
+    const btVector3& getLocalScaling() const override;
     /** Inertia of a solid box filling the scaled local box (zero when unbounded). */
     void calculateLocalInertia(btScalar mass, btVector3& inertia) const override;
     /** "sdfccd_SdfShape" (Bullet's serializer and debug output). */
     const char* getName() const override { return "sdfccd_SdfShape"; }
-    /** Collision margin (m) added to the box (the bridge's is Config::contact_margin). */
-    void setMargin(btScalar margin) override { m_margin = margin; }
-    /** The collision margin set with setMargin(). */
-    btScalar getMargin() const override { return m_margin; }
 
     // ---- btConcaveShape ----
     /** The triangulation's triangles (scaled) overlapping the box; Bullet's GImpact algorithm
@@ -94,24 +88,8 @@ public:
                              const btVector3& aabbMax) const override;
 
 private:
-    void dropDerived() const;
-
-    sdfccd_SdfId m_sdf;
-    bool m_valid;
-    btVector3 m_lo, m_hi;          // unscaled local bounds
-    btVector3 m_scaling;
-    btScalar m_margin;
-    int m_resolution;
-    double m_featureSize = 0;
-    mutable sdfccd_SdfId m_scaled; // owned, created on demand
-    mutable bool m_scaledValid;
-    // The triangulation, built on first use.
-    mutable bool m_triangulated;
-    mutable std::vector<btScalar> m_vertices;
-    mutable std::vector<int> m_indices;
-    mutable btTriangleIndexVertexArray* m_meshInterface;
-    mutable btBvhTriangleMeshShape* m_bvh;
-    mutable int m_misuseReported; // the last misuse reported (Status + 1; 0: none)
+    struct Impl; // the handle, bounds, scaling and the cached triangulation (sdf_shape.cpp)
+    std::unique_ptr<Impl> m_impl;
 };
 
 SDFCCD_BULLET_NAMESPACE_END

@@ -514,6 +514,32 @@ SDFCCD_API sdfccd_Status sdfccd_guard_face(sdfccd_SdfId sdf, sdfccd_DistanceCert
                                            double level, double tolerance, double lipschitz, const sdfccd_QueryParams* params,
                                            double duration, int32_t last_pass, sdfccd_FaceGuard* out, int64_t* io_sdf_evaluations);
 
+/** One check of sdfccd_guard_body(): a mesh (a body, or one part of it) against an SDF over the step. */
+typedef struct sdfccd_GuardPair {
+    sdfccd_SdfId sdf;                     /**< The SDF. */
+    const sdfccd_RigidMotion* sdf_motion; /**< Its motion (NULL: static at the world origin). */
+    sdfccd_MeshId mesh;                   /**< The mesh. */
+    sdfccd_RigidMotion executed;          /**< The motion the mesh executed over the step. */
+} sdfccd_GuardPair;
+
+/** What sdfccd_guard_body() found. */
+typedef struct sdfccd_GuardBodyResult {
+    sdfccd_GuardResult first; /**< The earliest rollback (`index`'s result); CLEAR with toi t1 when none. */
+    int32_t index;            /**< Its pair (the first of equal times), -1 when no pair rolled back. */
+    int32_t certified;        /**< Pairs proven clear without a CCD. */
+    int32_t failed;           /**< Pairs whose check returned an error: skipped. */
+    sdfccd_Status error;      /**< The first such error (::SDFCCD_OK when none). */
+    int64_t sdf_evaluations;  /**< SDF evaluations of every check. */
+} sdfccd_GuardBodyResult;
+
+/** The guarantee for one body over a step: sdfccd_guard_step_rigid() on each pair (its parts against
+ * the SDFs it can reach), and the earliest rollback of all, where the body goes back to. A pair whose
+ * check fails (its errors are sdfccd_guard_step_rigid()'s) is skipped and counted; the others still
+ * guard the body. Errors (nothing written): ::SDFCCD_INVALID_ARGUMENT for a NULL `out` or `params`,
+ * `count` < 0, NULL `pairs` with `count` > 0. */
+SDFCCD_API sdfccd_Status sdfccd_guard_body(sdfccd_Workspace* ws, const sdfccd_GuardPair* pairs, int32_t count, double t0, double t1,
+                                           const sdfccd_GuardParams* params, sdfccd_GuardBodyResult* out);
+
 #ifdef __cplusplus
 }
 #endif

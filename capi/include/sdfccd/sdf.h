@@ -88,6 +88,13 @@ SDFCCD_API sdfccd_Status sdfccd_create_csg(sdfccd_CsgOp op, sdfccd_SdfId a, sdfc
  * the division or the product overflows); else ::SDFCCD_INVALID_ARGUMENT. */
 SDFCCD_API sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, double scale, sdfccd_SdfId* out_sdf);
 
+/** `child` stretched by `scale` > 0 along each local axis (a non-uniform scaling):
+ * phi(x) = min(scale) * phi_child(x / scale), componentwise. It has the stretched shape's surface
+ * and sign, and never exceeds its distance (a lower bound, exact for a uniform scale). Each factor
+ * must be in [1e-100, 1e100], else ::SDFCCD_INVALID_ARGUMENT. The new SDF keeps `child` alive; its
+ * kind is ::SDFCCD_SDF_TRANSFORM. */
+SDFCCD_API sdfccd_Status sdfccd_create_stretched(sdfccd_SdfId child, sdfccd_Vec3 scale, sdfccd_SdfId* out_sdf);
+
 /** A user SDF. `eval` returns phi at p (local frame) and writes the gradient to *out_grad when
  * out_grad is not NULL. It must be pure and thread-safe. `lipschitz` bounds |grad phi|
  * everywhere (1 for a true distance field); the certified method is only as sound as this bound.
