@@ -97,13 +97,22 @@ struct SoftRecord {
     }
 };
 
-// The certificate's bound over the motion of n corners from x0[] to x1[] (sdfccd_distance_cert_bound).
-double certBound(const Cert& cert, const D3* x0, const D3* x1, int n, double L)
+// Does the certificate keep n corners moving from x0[] to x1[] at or above `need`
+// (sdfccd_distance_cert_bound)? Decided here, without the API call, unless within rounding of need.
+bool certClears(const Cert& cert, const D3* x0, const D3* x1, int n, double L, double need)
 {
+    if (!(cert.bound > -HUGE_VAL)) return false;
+    double d = 0;
+    for (int k = 0; k < n; ++k) {
+        const D3 a = fromSv(cert.anchor[k]);
+        d = std::max(d, std::max(len(x0[k] - a), len(x1[k] - a)));
+    }
+    const double fast = cert.bound - L * d;
+    if (std::fabs(fast - need) > 1e-9) return fast >= need;
     sdfccd_Vec3 s[3], e[3];
     for (int k = 0; k < n; ++k) s[k] = sv(x0[k]), e[k] = sv(x1[k]);
     double b;
-    return sdfccd_distance_cert_bound(&cert, s, e, n, L, &b) == SDFCCD_OK ? b : -HUGE_VAL;
+    return sdfccd_distance_cert_bound(&cert, s, e, n, L, &b) == SDFCCD_OK && b >= need;
 }
 
 struct SoftState;
@@ -259,6 +268,7 @@ sdfccd_QueryParams faceParams(const BridgeImpl* impl, double level)
 // sdfccd_triangle_clear)?
 bool faceClear(sdfccd_SdfId sdf, Cert& cert, const D3 s[3], const D3 e[3], double need, double L, int64_t* evals)
 {
+    if (certClears(cert, s, e, 3, L, need)) return true; // the kept certificate: no handle lookup
     const sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
     int32_t clear = 0;
     return sdfccd_triangle_clear(sdf, &cert, ss, ee, need, L, &clear, evals) == SDFCCD_OK && clear;
@@ -331,7 +341,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
         D3 g;
         const D3 b = F.toLocal(d3(n.m_x)), a = dcd ? b : F.toLocal(d3(n.m_q));
         Cert& cert = rec.node_certs[(size_t)i];
-        if (certBound(cert, &a, &b, 1, L) >= margin) continue;
+        if (certClears(cert, &a, &b, 1, L, margin)) continue;
         const bool hit = pointHit(sdf, a, b, margin, L, &f, &phi, &g, &evals, &cert.bound);
         cert.anchor[0] = sv(a);
         if (!hit) continue;
@@ -527,6 +537,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     for (int i = 0; i < nn; ++i) {
         S[(size_t)i] = F0.toLocal(rec.start[(size_t)i]);
         const D3 e = endOf(i);
+        if (certClears(rec.node_certs[(size_t)i], &S[(size_t)i], &e, 1, L, -tol)) continue; // sdfccd_guard_point's first check
         sdfccd_PointGuard pg;
         if (sdfccd_guard_point(rec.sdf, &rec.node_certs[(size_t)i], sv(S[(size_t)i]), sv(e), tol, L, &pg, &evals) != SDFCCD_OK) continue;
         level[(size_t)i] = pg.level;
@@ -576,6 +587,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
                 lev = std::min(lev, level[(size_t)idx[k]]);
             }
             if (pass > 0 && !touched[(size_t)idx[0]] && !touched[(size_t)idx[1]] && !touched[(size_t)idx[2]]) continue;
+            if (certClears(rec.face_certs[(size_t)fi], s, e, 3, L, lev)) continue; // what sdfccd_guard_face checks first
             const sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
             sdfccd_FaceGuard fg;
             const sdfccd_Status status = sdfccd_guard_face(rec.sdf, &rec.face_certs[(size_t)fi], ss, ee, lev, tol, L, &st->impl->cfg.query,
