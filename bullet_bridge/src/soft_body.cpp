@@ -60,6 +60,7 @@ struct Frame {
                    r[2][0] * v.x + r[2][1] * v.y + r[2][2] * v.z };
     }
     D3 toWorld(D3 p) const { return dirToWorld(p) + o; }
+    D3 dirToLocal(D3 v) const { return toLocal(v + o); }
 };
 
 // A lower bound of phi near a triangle's corners (or a point's) in the SDF's frame (contact.h). Kept
@@ -76,6 +77,14 @@ struct SoftRecord {
     std::vector<D3> start;
     bool fresh = false;
     std::vector<Cert> node_certs, face_certs;
+    // The contact planes collide() found, in the SDF body's frame (n . x + offset >= 0 on the free
+    // side), each held after Bullet's solve (holdRecord).
+    struct Hold {
+        int node;
+        D3 normal;
+        double offset, friction;
+    };
+    std::vector<Hold> holds;
     void setSdf(sdfccd_SdfId id) // another field: the certificates say nothing about it
     {
         if (id.index1 != sdf.index1 || id.generation != sdf.generation) node_certs.clear(), face_certs.clear();
@@ -88,13 +97,22 @@ struct SoftRecord {
     }
 };
 
-// The certificate's bound over the motion of n corners from x0[] to x1[] (sdfccd_distance_cert_bound).
-double certBound(const Cert& cert, const D3* x0, const D3* x1, int n, double L)
+// Does the certificate keep n corners moving from x0[] to x1[] at or above `need`
+// (sdfccd_distance_cert_bound)? Decided here, without the API call, unless within rounding of need.
+bool certClears(const Cert& cert, const D3* x0, const D3* x1, int n, double L, double need)
 {
+    if (!(cert.bound > -HUGE_VAL)) return false;
+    double d = 0;
+    for (int k = 0; k < n; ++k) {
+        const D3 a = fromSv(cert.anchor[k]);
+        d = std::max(d, std::max(len(x0[k] - a), len(x1[k] - a)));
+    }
+    const double fast = cert.bound - L * d;
+    if (std::fabs(fast - need) > 1e-9) return fast >= need;
     sdfccd_Vec3 s[3], e[3];
     for (int k = 0; k < n; ++k) s[k] = sv(x0[k]), e[k] = sv(x1[k]);
     double b;
-    return sdfccd_distance_cert_bound(&cert, s, e, n, L, &b) == SDFCCD_OK ? b : -HUGE_VAL;
+    return sdfccd_distance_cert_bound(&cert, s, e, n, L, &b) == SDFCCD_OK && b >= need;
 }
 
 struct SoftState;
@@ -250,6 +268,7 @@ sdfccd_QueryParams faceParams(const BridgeImpl* impl, double level)
 // sdfccd_triangle_clear)?
 bool faceClear(sdfccd_SdfId sdf, Cert& cert, const D3 s[3], const D3 e[3], double need, double L, int64_t* evals)
 {
+    if (certClears(cert, s, e, 3, L, need)) return true; // the kept certificate: no handle lookup
     const sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
     int32_t clear = 0;
     return sdfccd_triangle_clear(sdf, &cert, ss, ee, need, L, &clear, evals) == SDFCCD_OK && clear;
@@ -310,6 +329,11 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     };
     // Nodes: each one's path from m_q to the predicted m_x (DCD, the discrete baseline: m_x alone).
     const bool dcd = impl->cfg.query.method == SDFCCD_METHOD_DCD;
+    // Against a static or kinematic SDF body, with the bridge's solver wrapper in place, the contacts
+    // are held inside Bullet's position iterations (holdIteration) instead of becoming RContacts.
+    const bool hold = !dcd && co->isStaticOrKinematicObject() && st->wrapper;
+    const double friction = (double)(psb->m_cfg.kDF * co->getFriction());
+    rec.holds.clear();
     for (int i = 0; i < nn; ++i) {
         btSoftBody::Node& n = psb->m_nodes[i];
         if (n.m_battach) continue;
@@ -317,7 +341,7 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
         D3 g;
         const D3 b = F.toLocal(d3(n.m_x)), a = dcd ? b : F.toLocal(d3(n.m_q));
         Cert& cert = rec.node_certs[(size_t)i];
-        if (certBound(cert, &a, &b, 1, L) >= margin) continue;
+        if (certClears(cert, &a, &b, 1, L, margin)) continue;
         const bool hit = pointHit(sdf, a, b, margin, L, &f, &phi, &g, &evals, &cert.bound);
         cert.anchor[0] = sv(a);
         if (!hit) continue;
@@ -328,10 +352,12 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     }
 
     // Faces: per-vertex linear motion; a contact inside a face holds each of its nodes. A face point
-    // counts when it comes halfway into the soft margin (the nodes hold the rest; a face lying on the
-    // surface at the margin then needs no query).
+    // counts when it comes 0.7 of the way into the soft margin (the nodes hold the rest; a face lying
+    // on the surface at the margin then needs no query). Halfway, the planes of faces sagging over the
+    // bunny's curved top came and went every few steps: the Fig. 9 cloth never rested (0.03-0.05 m/s
+    // against 0.005-0.015 m/s at 0.2-0.4 of the margin).
     const double dt = psb->m_sst.sdt;
-    const double face_level = soft_margin > 0 ? 0.5 * soft_margin : margin;
+    const double face_level = soft_margin > 0 ? 0.3 * soft_margin : margin;
     const sdfccd_QueryParams qp = faceParams(impl, face_level);
     if (st->contacts.size() < 8) st->contacts.resize(8);
     for (int fi = 0; fi < psb->m_faces.size(); ++fi) {
@@ -376,7 +402,13 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     for (int i = 0; i < 2 * nn; ++i) {
         const SoftState::Plane& pl = st->planes[(size_t)i];
         if (!(pl.dist < HUGE_VAL)) continue;
-        addContact(psb, psb->m_nodes[i / 2], co, pl.normal, pl.offset);
+        btSoftBody::Node& n = psb->m_nodes[i / 2];
+        if (hold) {
+            rec.holds.push_back(SoftRecord::Hold{ i / 2, F.dirToLocal(pl.normal), pl.offset + dot(pl.normal, F.o), friction });
+            ++(pl.face ? st->stats.face_contacts : st->stats.node_contacts);
+            continue;
+        }
+        addContact(psb, n, co, pl.normal, pl.offset);
         ++(pl.face ? st->stats.face_contacts : st->stats.node_contacts);
     }
     st->stats.sdf_evaluations += evals;
@@ -398,6 +430,80 @@ void stopInto(btSoftBody::Node& n, D3 nw)
     const btVector3 nrm = btv(nw);
     const btScalar vn = n.m_v.dot(nrm);
     if (vn < 0) n.m_v -= nrm * vn;
+}
+
+// One pass over the contact planes collide() found for the soft body's nodes (Section 4's contacts
+// with per-vertex linear motion), solved the way Bullet solves its links, by position projection: a
+// node below a plane goes onto it (in the SDF body's frame); a node above it is free (Bullet's
+// RContact would pull it down toward the plane by kKHR times its height every step, and nodes held
+// up by the cloth would swing). Friction (Coulomb, kDF times the body's friction): the node's
+// sideways motion over the step stops while it is within friction times its pushes so far; the last
+// pass shortens a longer one by that much and sets the velocity of the nodes it moved by Bullet's
+// rule, v = (x - q) / dt damped by kDP, never more outward than the solver left it. push: per plane.
+void holdIteration(SoftState* st, btSoftBody* psb, std::vector<double>& push, bool last)
+{
+    const double vc = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
+    size_t hi = 0;
+    for (auto& r : st->records) {
+        SoftRecord& rec = r.second;
+        if (rec.soft != psb || !rec.fresh) continue;
+        const Frame F0(rec.sdf_pose), F(rec.sdf_object->getWorldTransform());
+        for (const SoftRecord::Hold& h : rec.holds) {
+            double& pushed = push[hi++];
+            btSoftBody::Node& n = psb->m_nodes[h.node];
+            if (!(n.m_im > 0)) continue;
+            D3 x = F.toLocal(d3(n.m_x));
+            const double d = dot(h.normal, x) + h.offset;
+            if (d < 0) {
+                x = x - h.normal * d;
+                pushed -= d;
+            }
+            if (!(pushed > 0)) continue;
+            const D3 step = x - F0.toLocal(rec.start[(size_t)h.node]), side = step - h.normal * dot(step, h.normal);
+            const double sl = len(side), lim = h.friction * pushed;
+            if (sl <= lim) x = x - side;
+            else if (last) x = x - side * (lim / sl);
+            n.m_x = btv(F.toWorld(x));
+            if (!last) continue;
+            const D3 nw = F.dirToWorld(h.normal);
+            D3 v = (d3(n.m_x) - rec.start[(size_t)h.node]) * vc;
+            const double out = dot(v, nw) - std::max(dot(d3(n.m_v), nw), 0.0);
+            if (out > 0) v = v - nw * out;
+            n.m_v = btv(v);
+            ++st->stats.held_nodes;
+        }
+    }
+}
+
+// Bullet's soft-body position solve (btSoftBody::solveConstraints) with the contact planes held
+// after each of its piterations passes: one call per pass with piterations = 1 is the same solve
+// (links and anchors are prepared from m_q, velocities set from m_x - m_q at the end of each call)
+// when the body has no velocity or drift passes and no clusters; otherwise the planes are held once,
+// after the solve.
+void solveHeld(SoftState* st, btSoftBody* psb)
+{
+    bool any = false;
+    for (auto& r : st->records) any = any || (r.second.soft == psb && r.second.fresh && !r.second.holds.empty());
+    if (!any) {
+        psb->solveConstraints();
+        return;
+    }
+    size_t count = 0;
+    for (auto& r : st->records)
+        if (r.second.soft == psb && r.second.fresh) count += r.second.holds.size();
+    std::vector<double> push(count, 0.0);
+    const int passes = psb->m_cfg.piterations;
+    if (passes <= 1 || psb->m_cfg.viterations > 0 || psb->m_cfg.diterations > 0 || psb->m_clusters.size() > 0) {
+        psb->solveConstraints();
+        holdIteration(st, psb, push, true);
+        return;
+    }
+    psb->m_cfg.piterations = 1;
+    for (int k = 0; k < passes; ++k) {
+        psb->solveConstraints();
+        holdIteration(st, psb, push, k + 1 == passes);
+    }
+    psb->m_cfg.piterations = passes;
 }
 
 int guardRecord(SoftState* st, SoftRecord& rec, double tol)
@@ -431,6 +537,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     for (int i = 0; i < nn; ++i) {
         S[(size_t)i] = F0.toLocal(rec.start[(size_t)i]);
         const D3 e = endOf(i);
+        if (certClears(rec.node_certs[(size_t)i], &S[(size_t)i], &e, 1, L, -tol)) continue; // sdfccd_guard_point's first check
         sdfccd_PointGuard pg;
         if (sdfccd_guard_point(rec.sdf, &rec.node_certs[(size_t)i], sv(S[(size_t)i]), sv(e), tol, L, &pg, &evals) != SDFCCD_OK) continue;
         level[(size_t)i] = pg.level;
@@ -480,6 +587,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
                 lev = std::min(lev, level[(size_t)idx[k]]);
             }
             if (pass > 0 && !touched[(size_t)idx[0]] && !touched[(size_t)idx[1]] && !touched[(size_t)idx[2]]) continue;
+            if (certClears(rec.face_certs[(size_t)fi], s, e, 3, L, lev)) continue; // what sdfccd_guard_face checks first
             const sdfccd_Vec3 ss[3] = { sv(s[0]), sv(s[1]), sv(s[2]) }, ee[3] = { sv(e[0]), sv(e[1]), sv(e[2]) };
             sdfccd_FaceGuard fg;
             const sdfccd_Status status = sdfccd_guard_face(rec.sdf, &rec.face_certs[(size_t)fi], ss, ee, lev, tol, L, &st->impl->cfg.query,
@@ -614,7 +722,14 @@ public:
     void predictMotion(btScalar dt) override { m_inner->predictMotion(dt); }
     void solveConstraints(btScalar dt) override
     {
-        m_inner->solveConstraints(dt);
+        if (m_state && m_state->dispatcher) { // Bullet's solver's loop, with the contact planes held
+            btSoftBodyArray& softs = m_world->getSoftBodyArray();
+            for (int i = 0; i < softs.size(); ++i)
+                if (softs[i]->isActive() && !softs[i]->isStaticObject()) solveHeld(m_state, softs[i]);
+            for (auto& r : m_state->records) r.second.holds.clear(); // this step's planes
+        } else {
+            m_inner->solveConstraints(dt);
+        }
         if (m_state && m_state->dispatcher && m_state->auto_guard && m_state->impl->cfg.query.method != SDFCCD_METHOD_DCD) {
             guardWorld(m_state, m_world, m_state->auto_tolerance);
             m_state->guarded_this_step = true;

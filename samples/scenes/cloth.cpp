@@ -180,7 +180,9 @@ public:
     {
         // Bullet's kDP damps a fraction of the velocity per step: 5% per 10 ms at any step.
         m_cloth->m_cfg.kDP = (btScalar)(1 - std::pow(1 - kDamping, dt / 0.01));
+        const int64_t before = m_bridge ? contactsFound() : 0;
         m_world->stepSimulation((btScalar)dt, 0, (btScalar)dt);
+        m_step_contacts = m_bridge ? contactsFound() - before : 0;
         sync();
     }
 
@@ -196,7 +198,8 @@ public:
             c.freezes = s.guard_nodes;
         }
         c.triangles_tested = -1;
-        c.contacts = m_cloth ? m_cloth->m_rcontacts.size() : 0;
+        // The bridge's contacts of the step (RContacts, or planes held in Bullet's position iterations).
+        c.contacts = m_bridge ? (int)m_step_contacts : m_cloth ? m_cloth->m_rcontacts.size() : 0;
         return c;
     }
     double energy() const override { return NAN; }
@@ -214,6 +217,12 @@ public:
     }
 
 private:
+    int64_t contactsFound() const
+    {
+        const sdfccd_bullet::SoftBodyStats s = sdfccd_bullet::softBodyStats(*m_bridge);
+        return s.node_contacts + s.face_contacts;
+    }
+
     void sync()
     {
         std::vector<double> x(3 * (size_t)m_cloth->m_nodes.size());
@@ -287,6 +296,7 @@ private:
     std::vector<std::unique_ptr<btCollisionShape>> m_shapes;
     std::vector<std::unique_ptr<btRigidBody>> m_rigid;
     btSoftBody* m_cloth = nullptr;
+    int64_t m_step_contacts = 0;
     std::vector<char> m_file;
     std::vector<btScalar> m_iso_v;
     std::vector<int> m_iso_f;

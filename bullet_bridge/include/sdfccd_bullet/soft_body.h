@@ -8,16 +8,18 @@
  * to the positions the solver predicts (m_x): every node's path is checked with the CCD against
  * the SDF within the soft body's collision margin plus Config::contact_margin (its contact plane at
  * that margin), every face's per-vertex linear motion (sdfccd_query_triangle_linear) for a point
- * coming halfway into that margin (held there: the nodes hold the rest of it), and each contact
- * found becomes a btSoftBody::RContact on the nodes (a face point's contact on each of its face's
- * nodes, the plane shifted by the node's offset from the point along the normal, so that the face
- * point cannot pass the plane while the nodes hold theirs). The normal is the SDF gradient at the contact; friction (kDF x the SDF body's friction)
- * and hardness (kKHR against static/kinematic SDF bodies, kCHR against dynamic ones) are the soft
- * body's own. A moving SDF body (dynamic or kinematic): the guard checks the nodes' motion
+ * coming 0.7 of the way into that margin (each of its face's nodes gets a plane shifted by its offset
+ * from the point, so that the face point cannot pass while the nodes hold theirs). The normal is the
+ * SDF gradient at the contact. Against a static or kinematic SDF body in a btSoftRigidDynamicsWorld
+ * with Bullet's own solver, the planes are held inside Bullet's position iterations like its links
+ * (a node below its plane goes onto it, one above it is free; Coulomb friction with kDF x the SDF
+ * body's friction), so a draped cloth comes to rest; Bullet's soft RContact (kKHR) let the cloth's
+ * weight pull nodes through and pulled nodes above their plane down toward it. Against a dynamic SDF
+ * body, or under another solver, each contact is a btSoftBody::RContact (kCHR, kKHR and kDF as in
+ * Bullet). A moving SDF body: the guard checks the nodes' motion
  * relative to it, from their positions in its frame at the start of the step (a kinematic body's
  * pose there from its velocity) to their positions in its frame at the end, linearly in its frame.
- * Tested with a kinematic body (moving_sdf) and a dynamic one (dynamic_sdf: a 10 cm SDF ball, 1 kg,
- * dropped at 10 m/s on a cloth pinned at its corners and thrown back: 0.46 mm at face points).
+ * Tested with a kinematic body (moving_sdf) and a dynamic one (dynamic_sdf).
  * With Config::query.method DCD (the discrete baseline) the nodes are checked at their predicted
  * positions only and the automatic guard is off.
  * Not covered: btDeformableMultiBodyDynamicsWorld. Its solver takes node and face contacts of
@@ -54,13 +56,14 @@ SDFCCD_BULLET_NAMESPACE_BEGIN
 /** Counters of the soft-body side of a bridge (since its construction). */
 struct SoftBodyStats {
     int64_t pair_steps = 0;     /**< (soft body, SDF) pairs processed in collision detection. */
-    int64_t node_contacts = 0;  /**< RContacts written for nodes whose own path meets the SDF. */
-    int64_t face_contacts = 0;  /**< RContacts written for face points (one per node of the face). */
+    int64_t node_contacts = 0;  /**< Contacts (RContacts or held planes) of nodes whose own path meets the SDF. */
+    int64_t face_contacts = 0;  /**< Contacts of face points (one per node of the face). */
     int64_t face_queries = 0;   /**< sdfccd_query_triangle_linear calls (contacts and guard). */
     int64_t sdf_evaluations = 0;/**< SDF evaluations of all those queries and of the node checks. */
     int64_t guard_nodes = 0;    /**< Nodes the guard moved back to a time of impact. */
     int64_t query_errors = 0;   /**< Queries that failed (no contact written for that face). */
     int64_t refused = 0;        /**< Pairs refused: an SdfShape with a dead handle (reported as misuse). */
+    int64_t held_nodes = 0;     /**< Nodes a held plane moved in the solve's last pass (per plane and step). */
 };
 
 /** The soft-body counters of `bridge`. */
