@@ -403,6 +403,64 @@ static void test_ball_on_torus()
     CHECK(mean_z > 0.0, "the ball fell past the torus (mean node z = %.3f)", mean_z);
 }
 
+// The bunny grid: bullet3's bunny.obj baked in-tree to a 32^3 grid (the grid itself is the SDF),
+// stood up with its y axis along z; the scene's ball is dropped onto its back.
+static sdfccd_SdfId bunnyGrid(btTransform* pose)
+{
+    sdfccd_SdfId grid{};
+    sdfccd_MeshId mesh{};
+    const std::string path = std::string(SDFCCD_DATA_DIR) + "/bullet3/bunny.obj";
+    const sdfccd_MeshLoadDef load = sdfccd_default_mesh_load_def();
+    CHECK(sdfccd_load_mesh(path.c_str(), &load, &mesh) == SDFCCD_OK, "bunny mesh: %s", sdfccd_last_error());
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 32;
+    def.padding = 0.1;
+    def.threads = 2;
+    CHECK(sdfccd_create_grid_from_mesh(mesh, &def, &grid) == SDFCCD_OK, "bunny grid: %s", sdfccd_last_error());
+    sdfccd_destroy_mesh(mesh);
+    pose->setIdentity();
+    pose->setRotation(btQuaternion(btVector3(1, 0, 0), (btScalar)(M_PI / 2)));
+    return grid;
+}
+
+static btSoftBody* addBunnyBall(SoftWorld& w)
+{
+    btSoftBody* b = btSoftBodyHelpers::CreateEllipsoid(w.world.getWorldInfo(), btVector3(0.05f, -0.1f, 1.15f),
+                                                       btVector3(0.25f, 0.25f, 0.25f), 128);
+    b->m_cfg.kPR = 20;
+    w.setup(b, -3.0);
+    return b;
+}
+
+// A volumetric soft ball dropped at 3 m/s onto the bunny grid (issue 21's SoftDemo-style ball): its
+// nodes and surface faces stay out of the grid's isosurface at every step.
+static void test_ball_on_bunny()
+{
+    btTransform pose;
+    const sdfccd_SdfId grid = bunnyGrid(&pose);
+    double worst = 0, lowest = 1e30;
+    int64_t contacts = 0;
+    {
+        Bridge bridge;
+        SdfShape shape(grid);
+        SoftWorld w(&bridge);
+        w.addStatic(&shape, pose);
+        btSoftBody* ball = addBunnyBall(w);
+        for (int s = 0; s < 90; ++s) {
+            w.step();
+            worst = std::max(worst, softPenetration(ball, grid, pose));
+            lowest = std::min(lowest, minZ(ball));
+        }
+        checkNoErrors(bridge, "ball_on_bunny");
+        contacts = sdfccd_bullet::softBodyStats(bridge).node_contacts + sdfccd_bullet::softBodyStats(bridge).face_contacts;
+    }
+    sdfccd_destroy_sdf(grid);
+    std::printf("  soft ball on the bunny grid: max penetration %.4f mm, lowest node z %.3f, contacts %lld\n", worst * 1e3, lowest,
+                (long long)contacts);
+    CHECK(contacts > 0, "no contact: the ball missed the bunny");
+    CHECK(worst <= 1e-3, "penetration %.4f mm > 1 mm", worst * 1e3);
+}
+
 // A rope pinned at one end swings through a standing torus ring (ring 0.25 m, tube 0.04 m, in the
 // xz plane): its nodes and 7 points inside each link stay out of the tube (with the nodes alone
 // checked, the link interiors went 7.14 mm deep).
@@ -867,7 +925,7 @@ struct ReportScene {
 };
 static const ReportScene kReportScenes[] = {
     { "cloth_on_torus", 240, 24 }, { "cloth_on_spikes", 90, 24 }, { "cloth_fast_plate", 60, 160 },
-    { "rope_through_ring", 180, 24 }, { "ball_on_torus", 90, 24 },
+    { "rope_through_ring", 180, 24 }, { "ball_on_torus", 90, 24 }, { "ball_on_bunny", 90, 32 },
 };
 
 static sdfccd_SdfId reportSdf(const std::string& n, btTransform* pose, sdfccd_Aabb* box)
@@ -886,6 +944,9 @@ static sdfccd_SdfId reportSdf(const std::string& n, btTransform* pose, sdfccd_Aa
         def.count_y = 7;
         sdfccd_create_spike_grid(&def, &sdf);
         *box = sdfccd_Aabb{ { -0.5, -0.5, -0.05 }, { 0.5, 0.5, 0.12 } };
+    } else if (n == "ball_on_bunny") {
+        sdf = bunnyGrid(pose);
+        *box = sdfccd_Aabb{ { -0.5, -0.7, -1.0 }, { 0.5, 0.8, 1.05 } };
     } else if (n == "cloth_fast_plate") {
         sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.005 }, &sdf);
         *box = sdfccd_Aabb{ { -0.4, -0.4, -0.02 }, { 0.4, 0.4, 0.02 } };
@@ -913,6 +974,7 @@ static btSoftBody* reportBody(const std::string& n, SoftWorld& w)
         w.setup(b, -3.0);
         return b;
     }
+    if (n == "ball_on_bunny") return addBunnyBall(w);
     btSoftBody* r = btSoftBodyHelpers::CreateRope(w.world.getWorldInfo(), btVector3(0, -0.6f, 0.3f), btVector3(0, 0.4f, 0.3f), 40, 1);
     w.setup(r, 0.0);
     return r;
@@ -1060,6 +1122,7 @@ static const Test kTests[] = {
     { "friction_slope", test_friction_slope },
     { "cloth_on_spikes", test_cloth_on_spikes },
     { "ball_on_torus", test_ball_on_torus },
+    { "ball_on_bunny", test_ball_on_bunny },
     { "rope_through_ring", test_rope_through_ring },
     { "moving_sdf", test_moving_sdf },
     { "dynamic_sdf", test_dynamic_sdf },
