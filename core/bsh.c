@@ -344,7 +344,10 @@ static int march(trav* tr, uint32_t i, uint32_t s, double from, double to, doubl
  * its earliest region stalls at REGION_MAX_DEPTH levels (or after REGION_MAX_EVALS evaluations of
  * its regions, for a face landing flat, where every region stalls together): the time of that
  * region is then a proven lower bound of its contacts. A triangle whose regions all pass the end
- * of the searched interval is never searched. */
+ * of the searched interval is never searched. A region found in contact goes at once, and so does
+ * a leaf whose sphere touches at the query's start (a resting contact, where the narrow phase is
+ * cheap and the regions would only add evaluations: Bullet bunny scene 289,491 evaluations
+ * before the regions, 332,550 with them for these, 295,055 without). */
 #define REGION_MAX_DEPTH 5
 #define REGION_MAX_EVALS 48
 
@@ -394,7 +397,9 @@ static int region_step(trav* tr, item* it, item kids[4], int* n_kids)
         rad = fmax(rad, scc_dist(x, c));
     }
     rad += 1e-9 * (1.0 + rad); /* the corners' rounding */
-    const double clear = (field(tr, c) - tr->in->p->margin) / tr->lipschitz - rad;
+    const double gap = field(tr, c) - tr->in->p->margin;
+    if (!(gap > 0.0)) return 0; /* in contact at this time: the triangle's turn */
+    const double clear = gap / tr->lipschitz - rad;
     if (clear > rad) { /* a useful step: at least the region's radius */
         it->key += clear / speed;
         return 1;
@@ -565,9 +570,18 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
         if (n->is_leaf) {
             uint32_t t = n->first;
             if (tested[t]) continue; /* bounded below its leaf already (from an earlier segment) or searched */
+            if (!(it.key > mm->t0)) { /* its sphere touches at the start (a resting contact): the triangle's turn */
+                tested[t] = 0xffu;
+                stats->candidates += 1;
+                ok = visit(user, t, it.key, &te);
+                continue;
+            }
             tested[t] = 0x80u;
-            item r = { it.key, it.node, s | SEG_REGION, 0 };
-            ok = item_heap_push(&heap, r);
+            /* the whole triangle is no tighter than its leaf's sphere, which has just stalled: its four halves start */
+            for (uint32_t k = 0; k < 4 && ok; ++k) {
+                item r = { it.key, it.node, s | SEG_REGION, (1u << 24) | k };
+                ok = item_heap_push(&heap, r);
+            }
             continue;
         }
         for (uint32_t k = 0; k < 2 && ok; ++k) {
