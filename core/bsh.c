@@ -344,8 +344,7 @@ static int march(trav* tr, uint32_t i, uint32_t s, double from, double to, doubl
  * its earliest region stalls at REGION_MAX_DEPTH levels (or after REGION_MAX_EVALS evaluations of
  * its regions, for a face landing flat, where every region stalls together): the time of that
  * region is then a proven lower bound of its contacts. A triangle whose regions all pass the end
- * of the searched interval is never searched. A region found in contact, or whose sphere already
- * reaches the surface (its halves would not step on either), goes at once, and so does
+ * of the searched interval is never searched. A region found in contact goes at once, and so does
  * a leaf whose sphere touches at the query's start (a resting contact, where the narrow phase is
  * cheap and the regions would only add evaluations: Bullet bunny scene 289,491 evaluations
  * before the regions, 332,550 with them for these, 295,055 without). */
@@ -377,7 +376,7 @@ static void sub_triangle(uint32_t sub, double u[3], double v[3])
 
 /* One step of region `it` (of the triangle of leaf it.node) from its time: 1 when it advanced
  * (it->key moved on) or was split (children written to kids[0..3], *n_kids = 4); 0 when it
- * stalls (in contact, its sphere reaching the surface, or at the depth limit). */
+ * stalls (in contact, or at the depth limit). */
 static int region_step(trav* tr, item* it, item kids[4], int* n_kids)
 {
     const uint32_t tri = tr->bsh->nodes[it->node].first;
@@ -406,7 +405,7 @@ static int region_step(trav* tr, item* it, item kids[4], int* n_kids)
         return 1;
     }
     const uint32_t depth = it->sub >> 24;
-    if (depth >= REGION_MAX_DEPTH || !(clear > 0.0)) return 0;
+    if (depth >= REGION_MAX_DEPTH) return 0;
     for (uint32_t k = 0; k < 4; ++k) {
         kids[k] = *it;
         kids[k].sub = ((depth + 1) << 24) | (it->sub & 0xffffffu) | (k << (2 * depth));
