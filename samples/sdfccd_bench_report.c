@@ -390,10 +390,7 @@ static void section_scaling(FILE* md, const char* dir, const table* t)
     }
     fprintf(md, "\nThe paper reports FWGSS+BSH 3.5× faster than DCD+BSH at 100K (86.85 ms against 306.66 ms, 0.96 µs per tested "
                 "triangle, so some 90,000 narrow-phase tests). Here the hierarchy is tight (one triangle per leaf, padded only by the "
-                "motion's curvature), and below a leaf the tracing goes on over the triangle's sub-triangles in the same "
-                "earliest-first queue (a leaf's sphere is 5-18 mm here, several ms of the fall ahead of its triangle's contact), "
-                "so a triangle is searched from a proven lower bound of its own contacts, in that order, or not at all once the "
-                "earliest contact found lies before it (100K: 13 triangles searched, 33 before); those are the hard ones; "
+                "motion's curvature), so only the few triangles that really reach a spike are tested, and those are the hard ones; "
                 "DCD pays a Frank-Wolfe descent per touching triangle at the end pose only, FWGSS a search over the whole step. "
                 "FWGSS's TOI is its earliest witness; the check proves no contact more than max(0.3 x time tolerance, 1e-8 s) (3e-8 s) "
                 "before it, and replaces it by an earlier contact it finds. At 100K the contact is a spike's tip under the armadillo: "
