@@ -8,6 +8,8 @@
 void scc_fw_begin(scc_fw_state* s, const scc_sdf* sdf, const scc_tri_motion* m, const scc_params* p, double ta, double tb)
 {
     s->sdf = sdf;
+    s->torus = sdf->kind == SCC_SDF_TORUS && sdf->eval == scc_sdf_torus_eval ? (const scc_sdf_torus*)sdf : NULL;
+    s->margin = p->margin;
     s->m = m;
     s->p = p;
     s->ts = ta;
@@ -55,7 +57,7 @@ void scc_fw_start_order(scc_fw_state* s, int order[3])
     for (int i = 0; i < 3; ++i) {
         double b[3] = { i == 0, i == 1, i == 2 };
         scc_vec3 g;
-        double phi = scc_sdf_eval_builtin(s->sdf, st.x[i], &g);
+        double phi = scc_fw_sdf(s, st.x[i], &g);
         s->evals++;
         scc_fw_witness(s, s->ts, b, phi);
         score[i] = scc_dot(st.v[i], g);
@@ -95,7 +97,7 @@ void scc_fw_finish(scc_fw_state* s, int converged, int64_t iterations, scc_tri_h
         out->toi = s->hit_t;
         for (int j = 0; j < 3; ++j) out->bary[j] = s->hit_b[j];
         out->point = scc_fw_point(s, s->hit_b, s->hit_t, NULL);
-        out->distance = scc_sdf_eval_builtin(s->sdf, out->point, &out->normal);
+        out->distance = scc_fw_sdf(s, out->point, &out->normal);
         s->evals++;
         out->state = !converged ? SCC_NOT_CONVERGED : (s->hit_t <= s->ts ? SCC_PENETRATING : SCC_HIT);
     } else {

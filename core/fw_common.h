@@ -11,6 +11,8 @@
 
 typedef struct scc_fw_state {
     const scc_sdf* sdf;
+    const scc_sdf_torus* torus; /* sdf when it is the built-in torus (NULL otherwise): tested once per sample (scc_fw_sdf) */
+    double margin;          /* p->margin, one load per sample instead of two */
     const scc_tri_motion* m;
     const scc_params* p;
     double ts, te;          /* the interval; te shrinks to the earliest witnessed contact */
@@ -184,10 +186,20 @@ static inline void scc_fw_tri_state(scc_fw_state* s, double t, scc_tri_state* st
 /* The three vertices at time t (st->v unset on the closed-form path). */
 static inline void scc_fw_tri_points(scc_fw_state* s, double t, scc_tri_state* st) { scc_fw_tri_state_ex(s, t, st, 0); }
 
+/* phi (and its gradient when g is not NULL) at x: the built-in torus (the data set's field) inline, by
+ * one test of a pointer set once per solve (scc_fw_begin) instead of scc_sdf_eval_builtin's tests of the
+ * kind and the eval pointer per sample; any other field by one call of its eval function, which keeps
+ * the solvers' loops short (the same values: the eval functions of the inlined kinds run the same code). */
+SCC_HOT_INLINE double scc_fw_sdf(const scc_fw_state* s, scc_vec3 x, scc_vec3* g)
+{
+    if (s->torus) return scc_sdf_torus_value(s->torus, x, g);
+    return s->sdf->eval(s->sdf, x, g);
+}
+
 /* Records a contact witness (phi <= margin) at time t with weights b: shrinks te. */
 static inline void scc_fw_witness(scc_fw_state* s, double t, const double b[3], double phi)
 {
-    if (phi <= s->p->margin && (!s->hit || t < s->hit_t)) {
+    if (phi <= s->margin && (!s->hit || t < s->hit_t)) {
         s->hit = 1;
         s->hit_t = t;
         s->hit_b[0] = b[0]; s->hit_b[1] = b[1]; s->hit_b[2] = b[2];
@@ -199,7 +211,7 @@ static inline void scc_fw_witness(scc_fw_state* s, double t, const double b[3], 
 static inline double scc_fw_eval(scc_fw_state* s, const double b[3], double t, scc_vec3* x, scc_vec3* g, scc_vec3* v)
 {
     *x = scc_fw_point(s, b, t, v);
-    double phi = scc_sdf_eval_builtin(s->sdf, *x, g);
+    double phi = scc_fw_sdf(s, *x, g);
     s->evals++;
     scc_fw_witness(s, t, b, phi);
     return phi;

@@ -19,10 +19,10 @@ SCC_HOT_INLINE double phi_at_time(double t, void* c)
     time_ctx* k = c;
     scc_fw_state* s = k->s;
     scc_vec3 x = scc_fw_path_point(s, &k->path, t);
-    double phi = scc_sdf_eval_builtin(s->sdf, x, NULL);
+    double phi = scc_fw_sdf(s, x, NULL);
     s->evals++;
     scc_fw_witness(s, t, k->path.b, phi);
-    return phi - s->p->margin;
+    return phi - s->margin;
 }
 
 static double unsigned_phi_at_time(double t, void* c) { return fabs(phi_at_time(t, c)); }
@@ -118,10 +118,10 @@ typedef struct space_ctx {
 SCC_HOT_INLINE double eval_on_segment(space_ctx* k, double l, double* df)
 {
     scc_vec3 g;
-    double phi = scc_sdf_eval_builtin(k->s->sdf, scc_madd(k->a, k->d, l), df ? &g : NULL);
+    double phi = scc_fw_sdf(k->s, scc_madd(k->a, k->d, l), df ? &g : NULL);
     k->s->evals++;
     if (df) *df = scc_dot(g, k->d);
-    if (phi <= k->s->p->margin) {
+    if (phi <= k->s->margin) {
         double b[3];
         for (int j = 0; j < 3; ++j) b[j] = (1.0 - l) * k->ba[j] + l * k->bb[j];
         scc_fw_witness(k->s, k->t, b, phi);
@@ -208,7 +208,7 @@ static double spatial_step(scc_fw_state* s, double tn, double* out_gap)
      * towards an interior optimum (a spike apex under a face took more than 32 iterations and
      * stopped 62 us late), while the projected gradient points at it. */
     scc_vec3 xn, gn;
-    double gap = scc_fw_eval(s, s->b, tn, &xn, &gn, NULL) - s->p->margin; /* no velocity needed here */
+    double gap = scc_fw_eval(s, s->b, tn, &xn, &gn, NULL) - s->margin; /* no velocity needed here */
     if (out_gap) *out_gap = gap;
     scc_tri_state st;
     scc_fw_tri_points(s, tn, &st);
@@ -298,12 +298,12 @@ static double step_lipschitz(const scc_fw_state* s, scc_vec3 x, double phi)
  * triangles' descents by a late time). */
 static void refine_entry(scc_fw_state* s, const scc_fw_path* path, double lo, double flo, double* io_t, double* io_phi)
 {
-    const double margin = s->p->margin;
+    const double margin = s->margin;
     double hi = *io_t, fhi = *io_phi - margin;
     for (int k = 0; k < 3 && hi - lo > 1e-3 * s->p->time_tol; ++k) {
         double t = hi - fhi * (hi - lo) / (fhi - flo);
         if (!(t > lo && t < hi)) t = 0.5 * (lo + hi);
-        double phi = scc_sdf_eval_builtin(s->sdf, scc_fw_path_point(s, path, t), NULL);
+        double phi = scc_fw_sdf(s, scc_fw_path_point(s, path, t), NULL);
         s->evals++;
         if (phi - margin > 0.0) {
             lo = t;
@@ -347,9 +347,9 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
     scc_fw_path_init(s, b, &path);
     for (int k = 0; k < cap && t < s->te && s->evals < s->p->max_evals; ++k) {
         scc_vec3 x = scc_fw_path_point(s, &path, t);
-        double phi = scc_sdf_eval_builtin(s->sdf, x, NULL);
+        double phi = scc_fw_sdf(s, x, NULL);
         s->evals++;
-        if (phi <= s->p->margin) {
+        if (phi <= s->margin) {
             if (k > 0) refine_entry(s, &path, t_prev, f_prev, &t, &phi);
             scc_fw_witness(s, t, b, phi);
             if (r && t < r->hit_t) { r->hit_t = t; r->hit_phi = phi; }
@@ -357,8 +357,8 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
             break;
         }
         t_prev = t;
-        f_prev = phi - s->p->margin;
-        double step = (phi - s->p->margin) / (step_lipschitz(s, x, phi) * speed);
+        f_prev = phi - s->margin;
+        double step = (phi - s->margin) / (step_lipschitz(s, x, phi) * speed);
         /* Near the surface the steps shrink geometrically; a step of the time tolerance can then
          * pass a crossing by at most that tolerance. */
         t += scc_fmax(step, s->p->time_tol);
@@ -416,7 +416,7 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
     stack[n] = (clear_region){ { 1, 0, 0 }, { 0, 1, 0 }, ta, 0.0, 0 };
     stack[n].rad = region_radius_rigid(s, stack[n].u, stack[n].v);
     ++n;
-    const double margin = s->p->margin;
+    const double margin = s->margin;
     while (n > 0) {
         clear_region r = stack[--n];
         const double cu = (r.u[0] + r.u[1] + r.u[2]) / 3.0, cv = (r.v[0] + r.v[1] + r.v[2]) / 3.0;
@@ -434,7 +434,7 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
                 c = scc_add(scc_add(scc_scale(st.x[0], bc[0]), scc_scale(st.x[1], bc[1])), scc_scale(st.x[2], bc[2]));
                 rad = region_radius(st.x, r.u, r.v, c);
             }
-            double phi = scc_sdf_eval_builtin(s->sdf, c, NULL);
+            double phi = scc_fw_sdf(s, c, NULL);
             s->evals++;
             if (phi <= margin) {
                 scc_fw_witness(s, r.t, bc, phi);
@@ -526,7 +526,7 @@ static int sharp_at_witness(scc_fw_state* s)
 {
     scc_vec3 g0, g;
     const scc_vec3 x = scc_fw_point(s, s->hit_b, s->hit_t, NULL);
-    scc_sdf_eval_builtin(s->sdf, x, &g0);
+    scc_fw_sdf(s, x, &g0);
     s->evals++;
     scc_tri_state st;
     scc_fw_tri_points(s, s->hit_t, &st);
@@ -536,7 +536,7 @@ static int sharp_at_witness(scc_fw_state* s)
     for (int i = 0; i < 3; ++i) {
         const double l = scc_len(dirs[i]);
         if (!(l > 0.0)) continue;
-        scc_sdf_eval_builtin(s->sdf, scc_add(x, scc_scale(dirs[i], 1e-3 / l)), &g);
+        scc_fw_sdf(s, scc_add(x, scc_scale(dirs[i], 1e-3 / l)), &g);
         s->evals++;
         const double lg = scc_len(g);
         if (!(l0 > 0.0 && lg > 0.0) || scc_dot(g0, g) < cos(0.2) * l0 * lg) return 1;
