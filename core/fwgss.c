@@ -63,6 +63,10 @@ static scc_gss_result crossing_by_bisection(time_ctx* tc, double lo, double hi, 
  * bisection step bounds the worst case by the bisection's. `fhi` (<= 0) is phi - margin at hi. */
 static scc_gss_result crossing_by_secant(time_ctx* tc, double lo, double hi, double fhi, const scc_params* p)
 {
+    /* the parameters the loop reads, read once (a sample's stores through the solver's pointer could
+     * alias them for the compiler) */
+    const double time_tol = p->time_tol;
+    const int max_ls_iter = p->max_ls_iter;
     scc_gss_result r;
     r.evals = 0;
     r.converged = 1;
@@ -73,7 +77,7 @@ static scc_gss_result crossing_by_secant(time_ctx* tc, double lo, double hi, dou
         return r;
     }
     int it = 0, side = 0, slow = 0;
-    while (hi - lo > p->time_tol && it++ < p->max_ls_iter) {
+    while (hi - lo > time_tol && it++ < max_ls_iter) {
         double width = hi - lo, t;
         if (slow >= 2) {
             t = 0.5 * (lo + hi);
@@ -81,7 +85,7 @@ static scc_gss_result crossing_by_secant(time_ctx* tc, double lo, double hi, dou
         } else {
             t = hi - fhi * (hi - lo) / (fhi - flo);
             /* keep the sample strictly inside, at least a quarter tolerance from either end */
-            double m = 0.25 * p->time_tol;
+            double m = 0.25 * time_tol;
             if (!(t > lo + m)) t = lo + m;
             if (!(t < hi - m)) t = hi - m;
         }
@@ -99,7 +103,7 @@ static scc_gss_result crossing_by_secant(time_ctx* tc, double lo, double hi, dou
         }
         slow = hi - lo > 0.5 * width ? slow + 1 : 0;
     }
-    r.converged = hi - lo <= p->time_tol;
+    r.converged = hi - lo <= time_tol;
     r.l = hi;
     r.f = fabs(fhi);
     return r;
@@ -346,7 +350,12 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
     double t_prev = t, f_prev = INFINITY, clear_to = t;
     scc_fw_path path;
     scc_fw_path_init(s, b, &path);
-    for (int k = 0; k < cap && t < s->te && s->evals < s->p->max_evals; ++k) {
+    /* L x S of the step's bound, once per trace when the field has one global bound (the same product) */
+    const int local_bound = s->sdf->lipschitz_in != NULL;
+    const double ls = local_bound ? NAN : step_lipschitz(s, s->g0, 0.0) * speed;
+    const int64_t max_evals = s->p->max_evals;
+    const double time_tol = s->p->time_tol;
+    for (int k = 0; k < cap && t < s->te && s->evals < max_evals; ++k) {
         scc_vec3 x = scc_fw_path_point(s, &path, t);
         double phi = scc_fw_sdf(s, x, NULL);
         s->evals++;
@@ -359,10 +368,10 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
         }
         t_prev = t;
         f_prev = phi - s->margin;
-        double step = (phi - s->margin) / (step_lipschitz(s, x, phi) * speed);
+        double step = (phi - s->margin) / (local_bound ? step_lipschitz(s, x, phi) * speed : ls);
         /* Near the surface the steps shrink geometrically; a step of the time tolerance can then
          * pass a crossing by at most that tolerance. */
-        t += scc_fmax(step, s->p->time_tol);
+        t += scc_fmax(step, time_tol);
         clear_to = t;
     }
     if (!r || !(clear_to > start)) return;
