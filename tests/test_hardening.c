@@ -162,6 +162,36 @@ START_TEST(test_budget_shared_by_triangles)
 }
 END_TEST
 
+/* The mesh queries name the bad argument in their message ("function: argument"), though the name is
+ * built only when a check fails (ccd_api.c, convert_arg: a failed conversion runs again with it). */
+START_TEST(test_query_argument_names)
+{
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_sphere(1.0, &s), SDFCCD_OK);
+    sdfccd_MeshId mesh = make_sheet(1, 0.5, 2.0);
+    sdfccd_QueryParams p = sdfccd_default_query_params();
+    sdfccd_QueryResult r;
+    sdfccd_RigidMotion ok = sdfccd_default_rigid_motion(), bad = ok;
+    bad.linear_velocity.y = NAN;
+    ck_assert_int_eq(sdfccd_query_mesh(s, NULL, mesh, &ok, 0, 1, &p, NULL, 0, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_query_mesh: out_result is NULL");
+    ck_assert_int_eq(sdfccd_query_mesh(s, NULL, mesh, NULL, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_query_mesh: motion is NULL");
+    ck_assert_int_eq(sdfccd_query_mesh(s, NULL, mesh, &bad, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "sdfccd_query_mesh: motion is not finite"));
+    ck_assert_int_eq(sdfccd_query_mesh(s, &bad, mesh, &ok, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "sdfccd_query_mesh: sdf_motion is not finite"));
+    ck_assert_int_eq(sdfccd_query_mesh(s, &ok, mesh, &ok, 0, 1, &p, NULL, 0, &r), SDFCCD_OK); /* both valid */
+    sdfccd_Vec3 v[4] = { { 0, 0, 2 }, { 1, 0, 2 }, { 0, 1, 2 }, { 1, 1, 2 } };
+    ck_assert_int_eq(sdfccd_query_mesh_linear(s, NULL, mesh, NULL, v, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_query_mesh_linear: start is NULL");
+    ck_assert_int_eq(sdfccd_query_mesh_linear(s, NULL, mesh, v, NULL, 0, 1, &p, NULL, 0, &r), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_str_eq(sdfccd_last_error(), "sdfccd_query_mesh_linear: end is NULL");
+    sdfccd_destroy_mesh(mesh);
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
 /* Finding "NaN behind OK": huge but finite inputs used to give NaN poses, segment starts and
  * fractions with SDFCCD_OK. They are now rejected where overflow starts. */
 START_TEST(test_overflowing_query_inputs_rejected)
@@ -719,6 +749,7 @@ int main(void)
     tcase_add_test(tc, test_budget_shared_by_segments);
     tcase_add_test(tc, test_budget_shared_by_triangles);
     tcase_add_test(tc, test_overflowing_query_inputs_rejected);
+    tcase_add_test(tc, test_query_argument_names);
     tcase_add_test(tc, test_analytic_far_points_finite);
     tcase_add_test(tc, test_transform_scale_limits);
     tcase_add_test(tc, test_csg_nan_operand);
