@@ -154,11 +154,14 @@ static inline void scc_fw_path_init(const scc_fw_state* s, const double b[3], sc
  * in the data set's vertex traces), so the angle is computed without looking at the cache first. */
 static inline scc_vec3 scc_fw_path_point(scc_fw_state* s, const scc_fw_path* path, double t)
 {
-    if (path->motion == 0) return scc_tri_point_at(s->m, path->b, t, NULL);
-    scc_vec3 rr = path->r;
-    if (path->motion == 2) {
+    scc_vec3 rr;
+    if (path->motion == 2) { /* the common case first */
         scc_fw_angle_at(s, t);
         rr = scc_fw_rodrigues(s, path->r, path->kr, path->kd);
+    } else if (path->motion == 1) {
+        rr = path->r;
+    } else {
+        return scc_tri_point_at(s->m, path->b, t, NULL);
     }
     return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
 }
