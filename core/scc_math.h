@@ -9,6 +9,14 @@
 
 #define SCC_PI 3.14159265358979323846
 
+/* A branch the caller expects to be taken (laid out as the fall-through path): only the code's layout
+ * changes. */
+#if defined(__GNUC__) || defined(__clang__)
+#define SCC_LIKELY(x) __builtin_expect(!!(x), 1)
+#else
+#define SCC_LIKELY(x) (x)
+#endif
+
 typedef struct scc_vec3 { double x, y, z; } scc_vec3;
 typedef struct scc_quat { double w, x, y, z; } scc_quat;
 /* Row-major 3x3 matrix: m[row][col]. */
@@ -35,7 +43,7 @@ static inline double scc_hypot3(double x, double y, double z)
      * >= 1e-150 and s >= 1e-300, the plain formula's conditions below; so the same result, with
      * two comparisons instead of the coordinates' magnitudes. */
     const double s0 = x * x + y * y + z * z;
-    if (s0 >= 4e-300 && s0 <= 1e299) return sqrt(s0);
+    if (SCC_LIKELY(s0 >= 4e-300 && s0 <= 1e299)) return sqrt(s0);
     /* a NaN coordinate gives NaN either way below: plain comparisons (no libm call) suffice */
     double ax = fabs(x), ay = fabs(y), az = fabs(z);
     double m = ax > ay ? ax : ay;
@@ -56,7 +64,7 @@ __attribute__((always_inline))
 static inline double scc_hypot2(double x, double y)
 {
     const double s0 = x * x + y * y; /* the common case first, as in scc_hypot3 */
-    if (s0 >= 4e-300 && s0 <= 1e299) return sqrt(s0);
+    if (SCC_LIKELY(s0 >= 4e-300 && s0 <= 1e299)) return sqrt(s0);
     double ax = fabs(x), ay = fabs(y);
     double m = ax > ay ? ax : ay;
     if (m <= 1e150 && m >= 1e-150) {
