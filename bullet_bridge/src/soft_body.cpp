@@ -412,11 +412,11 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
         if (psb->m_nodes.size() == 0) continue;
         btVector3 lo = psb->m_nodes[0].m_q, hi = lo;
         for (int i = 0; i < psb->m_nodes.size(); ++i) {
-            lo.setMin(psb->m_nodes[i].m_q);
-            lo.setMin(psb->m_nodes[i].m_x);
-            hi.setMax(psb->m_nodes[i].m_q);
-            hi.setMax(psb->m_nodes[i].m_x);
+            lo.setMin(psb->m_nodes[i].m_q), lo.setMin(psb->m_nodes[i].m_x);
+            hi.setMax(psb->m_nodes[i].m_q), hi.setMax(psb->m_nodes[i].m_x);
         }
+        const btVector3 reach((btScalar)tolerance, (btScalar)tolerance, (btScalar)tolerance);
+        lo -= reach, hi += reach;
         for (int i = 0; i < objs.size(); ++i) {
             const btCollisionObject* co = objs[i];
             if (co == psb) continue;
@@ -428,12 +428,8 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
             btVector3 bmin, bmax, smin, smax; // the SDF body's box at the start and at the end of the step
             co->getCollisionShape()->getAabb(co->getWorldTransform(), bmin, bmax);
             co->getCollisionShape()->getAabb(startPose(co, psb->m_sst.sdt), smin, smax);
-            bmin.setMin(smin);
-            bmax.setMax(smax);
-            const btScalar reach = (btScalar)tolerance;
-            if (bmin.x() > hi.x() + reach || bmin.y() > hi.y() + reach || bmin.z() > hi.z() + reach ||
-                bmax.x() < lo.x() - reach || bmax.y() < lo.y() - reach || bmax.z() < lo.z() - reach)
-                continue;
+            bmin.setMin(smin), bmax.setMax(smax);
+            if (!TestAabbAgainstAabb2(lo, hi, bmin, bmax)) continue;
             SoftRecord& rec = st->records[key];
             rec.begin(psb, co, sdf, startPose(co, psb->m_sst.sdt));
             moved += guardRecord(st, rec, tolerance);
@@ -443,7 +439,6 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
     st->stats.guard_nodes += moved;
     return moved;
 }
-
 
 // Bullet's solver, with the guard after each solve (the world owns this wrapper; the wrapper owns the
 // solver it wraps when the world did).

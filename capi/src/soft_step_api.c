@@ -60,10 +60,10 @@ static sdfccd_Status check_body(const sdfccd_SoftBody* b, const char* fn)
     if ((b->node_count > 0 && (!b->start || !b->end)) || (b->face_count > 0 && !b->faces) || (b->link_count > 0 && !b->links))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: a NULL array in body", fn);
     for (int64_t k = 0; k < 3 * (int64_t)b->face_count; ++k)
-        if (b->faces[k] < 0 || b->faces[k] >= b->node_count)
+        if ((uint32_t)b->faces[k] >= (uint32_t)b->node_count)
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: face %d names node %d (of %d)", fn, (int)(k / 3), (int)b->faces[k], (int)b->node_count);
     for (int64_t k = 0; k < 2 * (int64_t)b->link_count; ++k)
-        if (b->links[k] < 0 || b->links[k] >= b->node_count)
+        if ((uint32_t)b->links[k] >= (uint32_t)b->node_count)
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: link %d names node %d (of %d)", fn, (int)(k / 2), (int)b->links[k], (int)b->node_count);
     return SDFCCD_OK;
 }
@@ -253,16 +253,12 @@ typedef struct guard_state {
     const sdfccd_Frame* F;
     sdfccd_SoftGuardNode* out;
     scc_vec3* S;      /* start positions in the start frame */
+    scc_vec3* E;      /* end positions (as the engine stores them) in the frame now */
     double* level;    /* per node: the level its paths are held to */
     char* touched;    /* moved in the last pass */
     char* touched_next;
 } guard_state;
 
-static scc_vec3 end_of(const guard_state* g, int32_t i)
-{
-    const scc_vec3 w = g->out[i].moved ? stored(sdfccd__v(g->out[i].position), g->body->single_precision) : sdfccd__v(g->body->end[i]);
-    return to_local(g->F, w);
-}
 
 /* The node's executed motion becomes start -> `local` (SDF frame now); stop: then it loses its
  * velocity into the unit gradient direction of `grad`. */
@@ -270,6 +266,7 @@ static void set_end(guard_state* g, int32_t i, scc_vec3 local, int stop, scc_vec
 {
     sdfccd_SoftGuardNode* o = &g->out[i];
     o->position = sdfccd__pv(to_world(g->F, local));
+    g->E[i] = to_local(g->F, stored(sdfccd__v(o->position), g->body->single_precision));
     o->moved = 1;
     o->stop = stop;
     o->normal = sdfccd__pv(stop ? dir_to_world(g->F, unit_or_z(grad)) : scc_v3(0, 0, 1));
@@ -301,11 +298,12 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
     if (!(isfinite(dt) && dt > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: duration = %g is not finite and > 0", fn, dt);
     if (!sdfccd__sdf_acquire(sdf)) return SDFCCD_INVALID_HANDLE;
     const double L = lipschitz_of(sdf);
-    const size_t bytes = (size_t)nn * (sizeof(scc_vec3) + sizeof(double) + 2);
+    const size_t bytes = (size_t)nn * (2 * sizeof(scc_vec3) + sizeof(double) + 2);
     void* mem = nn > 0 ? sdfccd__alloc(bytes) : NULL;
     if (nn > 0 && !mem) return sdfccd__oom(fn);
-    guard_state g = { body, F, out, (scc_vec3*)mem, NULL, NULL, NULL };
-    g.level = (double*)(g.S + nn);
+    guard_state g = { body, F, out, (scc_vec3*)mem, NULL, NULL, NULL, NULL };
+    g.E = g.S + nn;
+    g.level = (double*)(g.E + nn);
     g.touched = (char*)(g.level + nn);
     g.touched_next = g.touched + nn;
     int64_t evals = 0;
@@ -313,12 +311,13 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
         out[i].moved = out[i].stop = 0;
         out[i].position = body->end[i];
         out[i].normal = (sdfccd_Vec3){ 0, 0, 1 };
+        g.E[i] = to_local(F, sdfccd__v(body->end[i]));
         g.level[i] = -tol;
         g.touched[i] = g.touched_next[i] = 0;
     }
     /* Nodes: each one's level, and where it goes back to. */
     for (int32_t i = 0; i < nn; ++i) {
-        const scc_vec3 s = g.S[i] = to_local(F0, sdfccd__v(body->start[i])), e = end_of(&g, i);
+        const scc_vec3 s = g.S[i] = to_local(F0, sdfccd__v(body->start[i])), e = g.E[i];
         if (cert_clears(&node_certs[i], &s, &e, 1, L, -tol)) continue; /* what sdfccd_guard_point checks first */
         sdfccd_PointGuard pg;
         if (sdfccd_guard_point(sdf, &node_certs[i], sdfccd__pv(s), sdfccd__pv(e), tol, L, &pg, &evals) != SDFCCD_OK) continue;
@@ -336,7 +335,7 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
         for (int32_t li = 0; nf == 0 && li < nl; ++li) {
             const int32_t a = body->links[2 * (int64_t)li], b = body->links[2 * (int64_t)li + 1];
             if (pass > 0 && !g.touched[a] && !g.touched[b]) continue;
-            const scc_vec3 s[3] = { g.S[a], g.S[b], g.S[b] }, e[3] = { end_of(&g, a), end_of(&g, b), end_of(&g, b) };
+            const scc_vec3 s[3] = { g.S[a], g.S[b], g.S[b] }, e[3] = { g.E[a], g.E[b], g.E[b] };
             const double lev = fmin(g.level[a], g.level[b]);
             sdfccd_DistanceCert* fc = &face_certs[nf + li];
             if (cert_clears(fc, s, e, 3, L, lev)) continue;
@@ -356,7 +355,7 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
             double lev = 0;
             for (int k = 0; k < 3; ++k) {
                 s[k] = g.S[idx[k]];
-                e[k] = end_of(&g, idx[k]);
+                e[k] = g.E[idx[k]];
                 lev = fmin(lev, g.level[idx[k]]);
             }
             if (pass > 0 && !g.touched[idx[0]] && !g.touched[idx[1]] && !g.touched[idx[2]]) continue;
