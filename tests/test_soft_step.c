@@ -300,6 +300,18 @@ START_TEST(test_guard_face_and_link_through_ball)
                 }
             }
     }
+    /* With faces, links are left to them: a link crossing the ball beside a far face moves nothing. */
+    const sdfccd_Vec3 s5[5] = { v3(5, 0, 0.3), v3(6, 0, 0.3), v3(5, 1, 0.3), v3(-1, 0, 0.3), v3(1, 0, 0.3) };
+    const sdfccd_Vec3 e5[5] = { v3(5, 0, -0.3), v3(6, 0, -0.3), v3(5, 1, -0.3), v3(-1, 0, -0.3), v3(1, 0, -0.3) };
+    const int32_t far_face[3] = { 0, 1, 2 }, cross_link[2] = { 3, 4 };
+    const sdfccd_SoftBody mixed = { 5, s5, e5, NULL, 1, far_face, 1, cross_link, 0 };
+    sdfccd_DistanceCert nc5[5], fc5[2] = { sdfccd_empty_distance_cert(), sdfccd_empty_distance_cert() };
+    for (int k = 0; k < 5; ++k) nc5[k] = sdfccd_empty_distance_cert();
+    sdfccd_SoftGuardNode out5[5];
+    int32_t moved5 = -1;
+    sdfccd_SoftStats st5 = { 0, 0, 0 };
+    ck_assert(sdfccd_soft_guard(ball, &F, &F, &mixed, tol, 0.01, &qp, nc5, fc5, out5, &moved5, &st5) == SDFCCD_OK);
+    ck_assert_int_eq(moved5, 0);
     ck_assert(sdfccd_destroy_sdf(ball) == SDFCCD_OK);
 }
 END_TEST
