@@ -515,46 +515,39 @@ void softRegister(BridgeImpl* impl, btCollisionDispatcher* d)
 }
 
 
+// Puts `solver` in the world's private slot (the world frees it when `owns`) and in its soft bodies.
+static void installSolver(btSoftRigidDynamicsWorld* world, btSoftBodySolver* solver, bool owns)
+{
+    world->*reach(SolverField()) = solver;
+    world->*reach(OwnsField()) = owns;
+    btSoftBodyArray& softs = world->getSoftBodyArray();
+    for (int i = 0; i < softs.size(); ++i) softs[i]->setSoftBodySolver(solver);
+}
+
 void softAttach(BridgeImpl* impl, btCollisionWorld* cw)
 {
     btSoftRigidDynamicsWorld* world = dynamic_cast<btSoftRigidDynamicsWorld*>(cw);
     SoftState* st = softOf(impl);
     if (!world || !st || st->wrapper) return;
-    btSoftBodySolver*& slot = world->*reach(SolverField());
-    bool& owns = world->*reach(OwnsField());
-    if (!slot || slot->getSolverType() != btSoftBodySolver::DEFAULT_SOLVER) return; // only Bullet's CPU solver
-    void* mem = btAlignedAlloc(sizeof(GuardingSolver), 16);
-    GuardingSolver* g = new (mem) GuardingSolver(slot, owns, st, world);
-    st->world = world;
-    st->inner = slot;
-    st->world_owned_inner = owns;
-    st->wrapper = g;
-    slot = g;
-    owns = true; // the world frees the wrapper (and the wrapper its solver when the world owned it)
-    btSoftBodyArray& softs = world->getSoftBodyArray();
-    for (int i = 0; i < softs.size(); ++i) softs[i]->setSoftBodySolver(g);
+    btSoftBodySolver* inner = world->*reach(SolverField());
+    if (!inner || inner->getSolverType() != btSoftBodySolver::DEFAULT_SOLVER) return; // only Bullet's CPU solver
+    st->world = world, st->inner = inner, st->world_owned_inner = world->*reach(OwnsField());
+    st->wrapper = new (btAlignedAlloc(sizeof(GuardingSolver), 16)) GuardingSolver(inner, st->world_owned_inner, st, world);
+    installSolver(world, st->wrapper, true); // the world frees the wrapper (and the wrapper its solver when the world owned it)
 }
 
 // Puts the world's own solver back (the world must still exist: see Bridge's lifetime note).
 void softDetach(SoftState* st)
 {
     if (!st->wrapper || !st->world) return;
-    btSoftRigidDynamicsWorld* world = st->world;
-    btSoftBodySolver*& slot = world->*reach(SolverField());
-    bool& owns = world->*reach(OwnsField());
-    if (slot == st->wrapper) {
-        slot = st->inner;
-        owns = st->world_owned_inner;
-        btSoftBodyArray& softs = world->getSoftBodyArray();
-        for (int i = 0; i < softs.size(); ++i) softs[i]->setSoftBodySolver(st->inner);
+    if (st->world->*reach(SolverField()) == st->wrapper) {
+        installSolver(st->world, st->inner, st->world_owned_inner);
         GuardingSolver* g = st->wrapper;
-        g->m_owns = false;
-        g->m_state = nullptr;
+        g->m_owns = false, g->m_state = nullptr;
         g->~GuardingSolver();
         btAlignedFree(g);
     }
-    st->wrapper = nullptr;
-    st->world = nullptr;
+    st->wrapper = nullptr, st->world = nullptr;
 }
 
 void softUnregister(BridgeImpl* impl)
