@@ -2,7 +2,8 @@
 /** @file soft.h  One step of a soft body (cloth, rope, volumetric body) against an SDF: the contact
  * planes of its nodes and faces, holding a node on its planes inside an engine's position solve, and
  * the no-tunnelling guard after the solve. Nodes move linearly over the step (the paper's deformable
- * case, Section 4). An engine bridge only converts its own types to these arrays and back. */
+ * case, Section 4). Paths are advanced with the SDF's Lipschitz bound (sdfccd_sdf_get_info(), taken
+ * as 1 when below 1). An engine bridge only converts its own types to these arrays and back. */
 #ifndef SDFCCD_SOFT_H
 #define SDFCCD_SOFT_H
 
