@@ -3,44 +3,27 @@
  *
  * Bridge::registerWith() also registers the bridge for (btSoftBody, SdfShape) and (btSoftBody,
  * btSdfCollisionShape) in both body orders (world: btSoftRigidDynamicsWorld with
- * btSoftBodyRigidBodyCollisionConfiguration). Each step, in Bullet's collision detection, the soft
- * body's nodes move linearly from their positions at the start of the step (btSoftBody::Node::m_q)
- * to the positions the solver predicts (m_x): every node's path is checked with the CCD against
- * the SDF within the soft body's collision margin plus Config::contact_margin (its contact plane at
- * that margin), every face's per-vertex linear motion (sdfccd_query_triangle_linear) for a point
- * coming 0.7 of the way into that margin (each of its face's nodes gets a plane shifted by its offset
- * from the point, so that the face point cannot pass while the nodes hold theirs). The normal is the
- * SDF gradient at the contact. Against a static or kinematic SDF body in a btSoftRigidDynamicsWorld
- * with Bullet's own solver, the planes are held inside Bullet's position iterations like its links
- * (a node below its plane goes onto it, one above it is free; Coulomb friction with kDF x the SDF
- * body's friction), so a draped cloth comes to rest; Bullet's soft RContact (kKHR) let the cloth's
- * weight pull nodes through and pulled nodes above their plane down toward it. Against a dynamic SDF
- * body, or under another solver, each contact is a btSoftBody::RContact (kCHR, kKHR and kDF as in
- * Bullet). A moving SDF body: the guard checks the nodes' motion
- * relative to it, from their positions in its frame at the start of the step (a kinematic body's
- * pose there from its velocity) to their positions in its frame at the end, linearly in its frame.
- * Tested with a kinematic body (moving_sdf) and a dynamic one (dynamic_sdf).
- * With Config::query.method DCD (the discrete baseline) the nodes are checked at their predicted
+ * btSoftBodyRigidBodyCollisionConfiguration). Each step, the soft body's nodes move linearly from
+ * their positions at the start of the step (btSoftBody::Node::m_q) to the predicted ones (m_x), and
+ * the C API's sdfccd_soft_contacts() (sdfccd/soft.h) gives their contact planes, within the soft
+ * body's collision margin plus Config::contact_margin. Against a static or kinematic SDF body, in a
+ * btSoftRigidDynamicsWorld with Bullet's own solver, the planes are held inside Bullet's position
+ * iterations (sdfccd_soft_hold(): friction kDF x the SDF body's friction), so a draped cloth comes to
+ * rest. Otherwise each plane is a btSoftBody::RContact (kCHR, kKHR and kDF as in Bullet). A moving
+ * SDF body is followed in its own frame (a kinematic body's start pose from its velocity). With
+ * Config::query.method DCD (the discrete baseline) the nodes are checked at their predicted
  * positions only and the automatic guard is off.
- * Not covered: btDeformableMultiBodyDynamicsWorld. Its solver takes node and face contacts of
- * another kind (btSoftBody::m_nodeRigidContacts and m_faceRigidContacts, with their own Jacobians,
- * solved in its implicit velocity solve) and ignores the RContacts the bridge writes; the guard
- * wraps the soft-rigid world's btSoftBodySolver, which that world does not use. Not attempted.
  *
- * Cost: a node or face whose SDF distance is certified (a lower bound by the Lipschitz bound over
- * the face, split into pieces) beyond what its motion can close skips the CCD; the certificate is
- * kept while its nodes stay near where it was made, so a resting cloth costs about one SDF
- * evaluation per node and step.
+ * The guarantee, sdfccd_soft_guard(): no node or face point (rope: link point) ends a step deeper
+ * than the tolerance past its time of impact; a node put back loses its velocity into the surface.
+ * With Bullet's own (CPU) solver in a btSoftRigidDynamicsWorld it runs by itself after each
+ * soft-body solve, in every internal step: the bridge wraps the world's solver (put back by
+ * Bridge::unregister(); the world frees it otherwise). Other solvers, or a world registered as a
+ * bare dispatcher: call guardSoftBodies() after each stepSimulation with at most one internal step.
  *
- * The guarantee: a node or face point that ended a step deeper than the tolerance goes back along
- * its motion to its time of impact, and the nodes lose their velocity into the surface there. In a
- * body without faces (a rope) the points along each link are held too. When
- * the bridge is registered with a btSoftRigidDynamicsWorld using Bullet's own (CPU) soft-body
- * solver, it runs by itself right after each soft-body solve, in every internal step: the bridge
- * wraps the world's solver (Bullet's soft-rigid world offers no callback after that solve; the
- * wrapper is put back by Bridge::unregister(), and the world frees it otherwise). Other solvers, or
- * a world registered as a bare dispatcher: call guardSoftBodies() after each stepSimulation with at
- * most one internal step.
+ * Not covered: btDeformableMultiBodyDynamicsWorld, whose solver takes node and face contacts of
+ * its own kind and ignores the RContacts the bridge writes, and does not use the soft-rigid world's
+ * solver the guard wraps.
  */
 #ifndef SDFCCD_BULLET_SOFT_BODY_H
 #define SDFCCD_BULLET_SOFT_BODY_H
@@ -74,17 +57,11 @@ SoftBodyStats softBodyStats(const Bridge& bridge);
  * tolerance, bridge never registered, or no btSoftRigidDynamicsWorld with Bullet's solver). */
 bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance = 5e-4);
 
-/** The soft-body guarantee for the step just taken by `world` (see the file comment). Returns 0
- * at once when the automatic guard already checked that step. Checks the
- * motion of every soft body the bridge collided with an SDF in that step, from its nodes'
- * positions at the start of the step to their positions now: a node whose path went deeper than
- * `tolerance` (m, > 0) below the surface, or a face whose motion took a point of it that deep, is
- * put back at the first time it reached that depth (a face: its three nodes), and its nodes'
- * velocity into the surface is removed. Repeats over the faces whose nodes moved until no face
- * crosses (at most a few passes; then the nodes of a face still crossing go back to their start
- * positions, where the last check left them). Nodes and faces already deeper at the start may not
- * end deeper than they started (a face that does goes back to its start). Returns the number of nodes moved, or -1 on bad input (NULL
- * world, tolerance not > 0, bridge not registered with the world's dispatcher). */
+/** The soft-body guarantee (sdfccd_soft_guard(), see the file comment) for the step just taken by
+ * `world`, over every soft body the bridge collided with an SDF in it, from its nodes' start
+ * positions to their positions now. Returns 0 at once when the automatic guard already checked that
+ * step. Returns the number of nodes moved, or -1 on bad input (NULL world, tolerance (m) not > 0,
+ * bridge not registered with the world's dispatcher). */
 int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tolerance = 5e-4);
 
 SDFCCD_BULLET_NAMESPACE_END

@@ -11,6 +11,7 @@
 #include "extract.h"
 #include "grid.h"
 #include "contact.h"
+#include "soft.h"
 #include "cases.h"
 #include "sampled.h"
 
