@@ -26,27 +26,22 @@ private:
     BridgeImpl* m_bridge;
 };
 
-// The box a shape can occupy while its object moves from t0 to t1 (origin lerp and any rotation
-// about the origin): the two end boxes when the rotation does not change, else the bounding
-// sphere about the origin around both end positions.
-void sweptBox(const btCollisionShape* s, const btTransform& t0, const btTransform& t1, btVector3& lo, btVector3& hi)
+// The box a shape can occupy while its object moves from t0 to t1 (sdfccd_swept_aabb: origin lerp,
+// any turn about the origin; false for a NaN pose or box).
+bool sweptBox(const btCollisionShape* s, const btTransform& t0, const btTransform& t1, btVector3& lo, btVector3& hi)
 {
-    btVector3 lo1, hi1;
-    s->getAabb(t0, lo, hi);
-    s->getAabb(t1, lo1, hi1);
-    lo.setMin(lo1);
-    hi.setMax(hi1);
-    if (t0.getBasis() == t1.getBasis()) return;
-    btVector3 c;
+    btVector3 lo0, hi0, lo1, hi1, c;
     btScalar r;
+    s->getAabb(t0, lo0, hi0);
+    s->getAabb(t1, lo1, hi1);
     s->getBoundingSphere(c, r);
-    const btVector3 e = btVector3(1, 1, 1) * (c.length() + r);
-    btVector3 slo = t0.getOrigin(), shi = t0.getOrigin();
-    slo.setMin(t1.getOrigin());
-    shi.setMax(t1.getOrigin());
-    lo.setMax(slo - e); // the tighter of the two bounds on each side
-    hi.setMin(shi + e);
-    lo.setMin(hi); // (never inverted)
+    const sdfccd_Aabb b0 = { v3(lo0), v3(hi0) }, b1 = { v3(lo1), v3(hi1) };
+    const sdfccd_Pose p0 = toPose(t0), p1 = toPose(t1);
+    sdfccd_Aabb out;
+    if (sdfccd_swept_aabb(&b0, &b1, &p0, &p1, (double)(c.length() + r), &out) != SDFCCD_OK) return false;
+    lo = bt(out.lo);
+    hi = bt(out.hi);
+    return true;
 }
 
 // The mesh parts of a shape with their offsets in the body frame: the shape itself, or the
@@ -152,8 +147,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             o.t1 = objs[i]->getWorldTransform();
             if (objs[i]->isStaticObject() && !objs[i]->isKinematicObject()) o.t0 = o.t1;
             else startOf(i, o.t0);
-            sweptBox(s, o.t0, o.t1, o.lo, o.hi);
-            if (motionFromPoses(o.t0, o.t1, btVector3(0, 0, 0), dt, &o.motion) != SDFCCD_OK) {
+            if (!sweptBox(s, o.t0, o.t1, o.lo, o.hi) || motionFromPoses(o.t0, o.t1, btVector3(0, 0, 0), dt, &o.motion) != SDFCCD_OK) {
                 stats.query_errors++;
                 continue;
             }
@@ -162,8 +156,6 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         std::vector<std::pair<const btCollisionShape*, btTransform>> parts;
         std::vector<sdfccd_GuardPair> pairs;
         std::vector<std::pair<const SdfObject*, btTransform>> which; // each pair's SDF and part offset
-        btTransform id;
-        id.setIdentity();
         for (int i = 0; i < objs.size() && !sdfs.empty(); ++i) {
             btRigidBody* body = btRigidBody::upcast(objs[i]);
             if (!body || body->isStaticOrKinematicObject()) continue;
@@ -172,7 +164,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             const btTransform t1 = body->getWorldTransform();
             const btCollisionShape* shape = body->getCollisionShape();
             btVector3 lo, hi, pad = btVector3(1, 1, 1) * (btScalar)gp.tolerance;
-            sweptBox(shape, t0, t1, lo, hi);
+            if (!sweptBox(shape, t0, t1, lo, hi)) continue;
             lo -= pad;
             hi += pad;
             parts.clear();
@@ -184,7 +176,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
                     stats.guard_skipped++;
                     continue;
                 }
-                if (parts.empty()) leaves(shape, id, parts);
+                if (parts.empty()) leaves(shape, btTransform::getIdentity(), parts);
                 for (const auto& part : parts) {
                     if (part.first == o.co->getCollisionShape() || !isMeshLike(part.first)) continue;
                     const MeshEntry* me = shapes.meshFor(part.first);
