@@ -344,15 +344,11 @@ Status Bridge::registerWith(btCollisionDispatcher* d)
     return verify();
 }
 
-Status Bridge::verify() const { return verifyImpl(m_impl); }
-
-namespace detail {
-
-Status verifyImpl(const BridgeImpl* impl)
+Status Bridge::verify() const
 {
-    btCollisionDispatcher* d = impl->dispatcher;
+    btCollisionDispatcher* d = m_impl->dispatcher;
     if (!d) return Status::NotRegistered;
-    const Config& cfg = impl->cfg;
+    const Config& cfg = m_impl->cfg;
     Probe probe;
     // A valid SDF for the probe shape (a sphere), so the create function takes it as ours.
     sdfccd_SdfId sphere = kNullSdf;
@@ -383,8 +379,6 @@ Status verifyImpl(const BridgeImpl* impl)
     return result;
 }
 
-} // namespace detail
-
 Status Bridge::check(btCollisionWorld* world, std::string* message) const
 {
     say(message, "ok");
@@ -397,7 +391,7 @@ Status Bridge::check(btCollisionWorld* world, std::string* message) const
                      "after creating the world, before adding bodies");
         return Status::NotRegistered;
     }
-    if (verifyImpl(m_impl) != Status::Ok) {
+    if (verify() != Status::Ok) {
         say(message, "the dispatcher no longer creates the bridge's algorithm (registerCollisionCreateFunc or "
                      "btGImpactCollisionAlgorithm::registerAlgorithm was called after Bridge::registerWith)");
         return Status::Overwritten;
@@ -572,14 +566,7 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported)
                   "Bullet's GImpact algorithm is colliding a GImpact mesh with an SdfShape, without CCD (it can pass through): %s; "
                   "Bridge::check(world) names the problem",
                   what);
-    MisuseHandler h;
-    void* user;
-    {
-        std::lock_guard<std::mutex> lock(g_misuse_mutex);
-        h = g_misuse_handler ? g_misuse_handler : defaultMisuseHandler;
-        user = g_misuse_user;
-    }
-    h(status, message, shape, user);
+    callMisuseHandler(status, message, shape);
 }
 
 } // namespace detail

@@ -153,8 +153,6 @@ struct PairStageHash {
 
 class MeshSdfAlgorithm;
 
-/** Bridge::verify() of `impl`. */
-Status verifyImpl(const BridgeImpl* impl);
 /** True when `callback` is Bullet's GImpact algorithm's triangle callback (btGImpactTriangleCallback). */
 bool isGImpactCallback(const btTriangleCallback* callback);
 /** Diagnoses Bullet's GImpact algorithm colliding with `shape` and reports it through the misuse
