@@ -239,8 +239,7 @@ struct Probe {
 // True when the dispatcher creates our algorithm for (a, b) in `table`.
 bool createsOurs(btCollisionDispatcher* d, btCollisionObject& a, btCollisionObject& b, ebtDispatcherQueryType table)
 {
-    btCollisionObjectWrapper wa(nullptr, a.getCollisionShape(), &a, a.getWorldTransform(), -1, -1);
-    btCollisionObjectWrapper wb(nullptr, b.getCollisionShape(), &b, b.getWorldTransform(), -1, -1);
+    ObjectWrapper wa(&a), wb(&b);
     btCollisionAlgorithm* alg = d->findAlgorithm(&wa, &wb, nullptr, table);
     bool ours = dynamic_cast<MeshSdfAlgorithm*>(alg) != nullptr;
     if (alg) {
@@ -413,8 +412,7 @@ Status Bridge::check(btCollisionWorld* world, std::string* message) const
         if (!p.m_algorithm || !p.m_pProxy0 || !p.m_pProxy1) continue;
         const btCollisionObject* a = static_cast<const btCollisionObject*>(p.m_pProxy0->m_clientObject);
         const btCollisionObject* b = static_cast<const btCollisionObject*>(p.m_pProxy1->m_clientObject);
-        btCollisionObjectWrapper wa(nullptr, a->getCollisionShape(), a, a->getWorldTransform(), -1, -1);
-        btCollisionObjectWrapper wb(nullptr, b->getCollisionShape(), b, b->getWorldTransform(), -1, -1);
+        const ObjectWrapper wa(a), wb(b);
         bool swapped;
         if (m_impl->orient(&wa, &wb, swapped) && !dynamic_cast<MeshSdfAlgorithm*>(p.m_algorithm)) {
             say(message, "a mesh-SDF pair has an algorithm created before Bridge::registerWith (register before adding "
