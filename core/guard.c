@@ -320,3 +320,14 @@ void scc_guard_response(scc_vec3 point, scc_vec3 normal, int pinned, int repeate
     const double kt = inv_effective_mass(body, point, t);
     if (kt > 0.0) apply_impulse(body, scc_scale(t, -fmin(mu * j, ul / kt)), point);
 }
+
+void scc_swept_aabb(const scc_aabb* a, const scc_aabb* b, scc_vec3 o0, scc_vec3 o1, double reach, double angle, scc_aabb* out)
+{
+    scc_aabb r = { scc_vmin(a->lo, b->lo), scc_vmax(a->hi, b->hi) };
+    if (angle > 0.0) {
+        const scc_vec3 g = scc_v3(1, 1, 1), e = scc_scale(g, reach), bow = scc_scale(g, reach * angle * angle / 8.0);
+        r.lo = scc_vmax(scc_sub(r.lo, bow), scc_sub(scc_vmin(o0, o1), e)); /* the tighter of the two bounds */
+        r.hi = scc_vmin(scc_add(r.hi, bow), scc_add(scc_vmax(o0, o1), e));
+    }
+    *out = r;
+}

@@ -57,6 +57,15 @@ static inline int scc_guard_earlier(int rolled_back, double toi, double best_toi
     return rolled_back && toi < best_toi;
 }
 
+/* The guard's broad phase (Section 4.6): a box holding a rigid body at every time of a step in which
+ * its origin moves on the segment o0 -> o1 while it turns by `angle` (rad, <= pi) about a fixed axis
+ * through the origin at a constant rate. `a` and `b` hold it at the two ends. Without a turn their
+ * union holds the whole translation. With one, a point at distance r <= `reach` from the origin
+ * leaves the segment between its end positions by at most r angle^2 / 8 (its acceleration r angle^2
+ * over the step, zero at both ends): the union grown by that much, cut by the origin segment's box
+ * grown by `reach`. Inputs are not checked here. */
+void scc_swept_aabb(const scc_aabb* a, const scc_aabb* b, scc_vec3 o0, scc_vec3 o1, double reach, double angle, scc_aabb* out);
+
 /* A rigid body's velocity state for the guard's response (world frame). */
 typedef struct scc_body_state {
     scc_vec3 center;         /* centre of mass */

@@ -1022,6 +1022,110 @@ START_TEST(test_guard_body_earliest)
 }
 END_TEST
 
+/* sdfccd_swept_aabb against a brute-force reference: points of a body at 400 times of a motion built
+ * here (origin linear, a turn by a known angle <= pi about a known axis at a constant rate) must lie in
+ * the box; the end boxes are the exact boxes of the points at the two poses. */
+static sdfccd_Aabb points_box(const sdfccd_Vec3* x, int n, sdfccd_Vec3 origin, sdfccd_Quat q)
+{
+    sdfccd_Aabb b = { v3(INFINITY, INFINITY, INFINITY), v3(-INFINITY, -INFINITY, -INFINITY) };
+    for (int i = 0; i < n; ++i) {
+        const sdfccd_Vec3 r = rotate(q, x[i]);
+        const double p[3] = { origin.x + r.x, origin.y + r.y, origin.z + r.z };
+        b.lo = v3(fmin(b.lo.x, p[0]), fmin(b.lo.y, p[1]), fmin(b.lo.z, p[2]));
+        b.hi = v3(fmax(b.hi.x, p[0]), fmax(b.hi.y, p[1]), fmax(b.hi.z, p[2]));
+    }
+    return b;
+}
+
+/* The largest distance (m) by which a point of the sampled motion leaves `box` (0: all inside). */
+static double swept_escape(const sdfccd_Vec3* x, int n, sdfccd_Pose a, sdfccd_Vec3 axis, double angle, sdfccd_Vec3 end, const sdfccd_Aabb* box)
+{
+    double worst = 0;
+    for (int k = 0; k <= 400; ++k) {
+        const double s = k / 400.0;
+        const sdfccd_Vec3 o = v3(a.position.x + s * (end.x - a.position.x), a.position.y + s * (end.y - a.position.y),
+                                 a.position.z + s * (end.z - a.position.z));
+        const sdfccd_Aabb at = points_box(x, n, o, qmul(axis_angle(axis, s * angle), a.orientation));
+        worst = fmax(worst, fmax(fmax(box->lo.x - at.lo.x, box->lo.y - at.lo.y), box->lo.z - at.lo.z));
+        worst = fmax(worst, fmax(fmax(at.hi.x - box->hi.x, at.hi.y - box->hi.y), at.hi.z - box->hi.z));
+    }
+    return worst;
+}
+
+START_TEST(test_swept_aabb)
+{
+    /* Translation only: the union of the two boxes, exactly (reach unused). */
+    sdfccd_Aabb a = { v3(0, 0, 0), v3(1, 1, 1) }, b = { v3(2, 0, 0), v3(3, 1, 1) }, out;
+    sdfccd_Pose p0 = sdfccd_pose_identity(), p1 = sdfccd_pose_identity();
+    p0.position = v3(0.5, 0.5, 0.5);
+    p1.position = v3(2.5, 0.5, 0.5);
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, -1.0, &out), SDFCCD_OK);
+    ck_assert(out.lo.x == 0 && out.lo.y == 0 && out.lo.z == 0 && out.hi.x == 3 && out.hi.y == 1 && out.hi.z == 1);
+    /* A 2 m rod along x turning half a revolution about z: both end boxes are flat in y, but at the
+     * quarter turn the rod lies along y. The box is the reach box [-1, 1]^3 (its bow, pi^2 / 8 m, is
+     * wider). */
+    const sdfccd_Vec3 rod[2] = { v3(-1, 0, 0), v3(1, 0, 0) };
+    p0 = sdfccd_pose_identity();
+    p1 = sdfccd_pose_identity();
+    p1.orientation = axis_angle(v3(0, 0, 1), M_PI);
+    a = points_box(rod, 2, p0.position, p0.orientation);
+    b = points_box(rod, 2, p1.position, p1.orientation);
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, 1.0, &out), SDFCCD_OK);
+    ck_assert_double_eq_tol(out.lo.y, -1.0, 1e-12);
+    ck_assert_double_eq_tol(out.hi.y, 1.0, 1e-12);
+    ck_assert_double_eq_tol(out.lo.z, -1.0, 1e-12);
+    ck_assert(swept_escape(rod, 2, p0, v3(0, 0, 1), M_PI, p1.position, &out) <= 1e-12);
+    /* A small turn: a point at (1, 0, 0) from -0.1 to +0.1 rad about z passes x = 1 while both ends
+     * have x = cos(0.1); with reach 1.2 the box reaches x = cos(0.1) + 1.2 * 0.2^2 / 8 >= 1. */
+    const sdfccd_Vec3 tip[1] = { v3(1, 0, 0) };
+    p0.orientation = axis_angle(v3(0, 0, 1), -0.1);
+    p1.orientation = axis_angle(v3(0, 0, 1), 0.1);
+    a = points_box(tip, 1, p0.position, p0.orientation);
+    b = points_box(tip, 1, p1.position, p1.orientation);
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, 1.2, &out), SDFCCD_OK);
+    ck_assert_double_eq_tol(out.hi.x, cos(0.1) + 1.2 * 0.2 * 0.2 / 8.0, 1e-12);
+    ck_assert(swept_escape(tip, 1, p0, v3(0, 0, 1), 0.2, p1.position, &out) <= 1e-12);
+    /* Seeded sweep: 200 bodies of 12 points within reach 0.5 of the origin, random translations and
+     * turns of up to pi. Every sampled point is inside; the box never exceeds the reach box. */
+    test_rng rng = { 1919 };
+    for (int i = 0; i < 200; ++i) {
+        sdfccd_Vec3 x[12];
+        for (int j = 0; j < 12; ++j) {
+            const sdfccd_Vec3 u = test_rng_unit_vector(&rng);
+            const double r = 0.5 * test_rng_uniform(&rng, 0.2, 1.0);
+            x[j] = v3(r * u.x, r * u.y, r * u.z);
+        }
+        const sdfccd_Vec3 axis = test_rng_unit_vector(&rng), t = test_rng_unit_vector(&rng);
+        const double angle = test_rng_uniform(&rng, 0.0, 1.0) * test_rng_uniform(&rng, 0.0, M_PI);
+        const double travel = test_rng_uniform(&rng, 0.0, 2.0);
+        p0.position = test_rng_unit_vector(&rng);
+        p0.orientation = axis_angle(test_rng_unit_vector(&rng), test_rng_uniform(&rng, -3, 3));
+        p1.position = v3(p0.position.x + travel * t.x, p0.position.y + travel * t.y, p0.position.z + travel * t.z);
+        p1.orientation = qmul(axis_angle(axis, angle), p0.orientation);
+        a = points_box(x, 12, p0.position, p0.orientation);
+        b = points_box(x, 12, p1.position, p1.orientation);
+        ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, 0.5, &out), SDFCCD_OK);
+        ck_assert_msg(swept_escape(x, 12, p0, axis, angle, p1.position, &out) <= 1e-12, "body %d, turn %g", i, angle);
+        ck_assert(out.lo.x >= fmin(p0.position.x, p1.position.x) - 0.5 - 1e-12 && out.hi.z <= fmax(p0.position.z, p1.position.z) + 0.5 + 1e-12);
+    }
+    /* Bad input: nothing written. */
+    const sdfccd_Aabb keep = out, nan_box = { v3(NAN, 0, 0), v3(1, 1, 1) };
+    ck_assert_int_eq(sdfccd_swept_aabb(NULL, &b, &p0, &p1, 0.5, &out), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, NULL, 0.5, &out), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, 0.5, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_swept_aabb(&nan_box, &b, &p0, &p1, 0.5, &out), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, NAN, &out), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, -0.5, &out), SDFCCD_INVALID_ARGUMENT);
+    p1.orientation.w = p1.orientation.x = p1.orientation.y = p1.orientation.z = 0;
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, 0.5, &out), SDFCCD_INVALID_ARGUMENT);
+    p1.orientation = p0.orientation;
+    p1.position.y = INFINITY;
+    ck_assert_int_eq(sdfccd_swept_aabb(&a, &b, &p0, &p1, 0.5, &out), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(memcmp(&keep, &out, sizeof out) == 0);
+    ck_assert(strstr(sdfccd_last_error(), "sdfccd_swept_aabb") != NULL);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("guard");
@@ -1042,6 +1146,7 @@ int main(void)
     tcase_add_test(tc, test_guard_linear_cloth);
     tcase_add_test(tc, test_shuriken_battery);
     tcase_add_test(tc, test_motion_from_poses);
+    tcase_add_test(tc, test_swept_aabb);
     tcase_add_test(tc, test_bad_input);
     tcase_add_test(tc, test_step_spun_through_wall);
     tcase_add_test(tc, test_step_clear_and_certified);

@@ -217,37 +217,27 @@ std::vector<std::pair<int, int>> slots(const Config& cfg)
     return s;
 }
 
-// A probe pair for verify(): a one-triangle GImpact mesh, a box, our shape, Bullet's SDF shape.
-struct Probe {
-    btVector3 verts[3];
-    int idx[3];
-    btTriangleIndexVertexArray mesh;
-    btGImpactMeshShape gimpact;
-    btBoxShape box;
-    btCollisionObject gimpact_object, box_object;
-    Probe()
-        : verts{ btVector3(0, 0, 0), btVector3(1, 0, 0), btVector3(0, 1, 0) }, idx{ 0, 1, 2 },
-          mesh(1, idx, 3 * (int)sizeof(int), 3, &verts[0][0], (int)sizeof(btVector3)), gimpact(&mesh),
-          box(btVector3(1, 1, 1))
+// The dispatcher's tables, read without creating anything (findAlgorithm would allocate from a world
+// that may be stepping on another thread). A pointer to a protected member, formed through a derived
+// class, applies to any btCollisionDispatcher.
+struct DispatchTable : btCollisionDispatcher {
+    static btCollisionAlgorithmCreateFunc* func(const btCollisionDispatcher* d, bool closest, int a, int b)
     {
-        gimpact.updateBound();
-        gimpact_object.setCollisionShape(&gimpact);
-        box_object.setCollisionShape(&box);
+        return closest ? (d->*(&DispatchTable::m_doubleDispatchClosestPoints))[a][b] : (d->*(&DispatchTable::m_doubleDispatchContactPoints))[a][b];
     }
 };
 
-// True when the dispatcher creates our algorithm for (a, b) in `table`.
-bool createsOurs(btCollisionDispatcher* d, btCollisionObject& a, btCollisionObject& b, ebtDispatcherQueryType table)
+// Whether the registered bridge's create functions still fill the slots `which` of its dispatcher's contact
+// table (and closest-points table when `closest`).
+bool intact(const BridgeImpl* impl, const std::vector<std::pair<int, int>>& which, bool closest)
 {
-    btCollisionObjectWrapper wa(nullptr, a.getCollisionShape(), &a, a.getWorldTransform(), -1, -1);
-    btCollisionObjectWrapper wb(nullptr, b.getCollisionShape(), &b, b.getWorldTransform(), -1, -1);
-    btCollisionAlgorithm* alg = d->findAlgorithm(&wa, &wb, nullptr, table);
-    bool ours = dynamic_cast<MeshSdfAlgorithm*>(alg) != nullptr;
-    if (alg) {
-        alg->~btCollisionAlgorithm();
-        d->freeCollisionAlgorithm(alg);
-    }
-    return ours;
+    const btCollisionDispatcher* d = impl->dispatcher;
+    if (!d) return false;
+    for (const auto& s : which)
+        if (DispatchTable::func(d, false, s.first, s.second) != impl->fn[0].get() ||
+            (closest && DispatchTable::func(d, true, s.first, s.second) != impl->fn[1].get()))
+            return false;
+    return true;
 }
 
 void say(std::string* message, const char* fmt, const char* a = "", long long n = 0)
@@ -344,46 +334,11 @@ Status Bridge::registerWith(btCollisionDispatcher* d)
     return verify();
 }
 
-Status Bridge::verify() const { return verifyImpl(m_impl); }
-
-namespace detail {
-
-Status verifyImpl(const BridgeImpl* impl)
+Status Bridge::verify() const
 {
-    btCollisionDispatcher* d = impl->dispatcher;
-    if (!d) return Status::NotRegistered;
-    const Config& cfg = impl->cfg;
-    Probe probe;
-    // A valid SDF for the probe shape (a sphere), so the create function takes it as ours.
-    sdfccd_SdfId sphere = kNullSdf;
-    if (sdfccd_create_sphere(1.0, &sphere) != SDFCCD_OK) return Status::InvalidArgument;
-    Status result = Status::Ok;
-    {
-        SdfShape ours(sphere, cfg.sdf_shape_type);
-        btCollisionObject ours_object;
-        ours_object.setCollisionShape(&ours);
-        btSdfCollisionShape theirs;
-        btCollisionObject theirs_object;
-        theirs_object.setCollisionShape(&theirs);
-        std::vector<std::pair<btCollisionObject*, btCollisionObject*>> probes;
-        probes.push_back(std::make_pair(&probe.gimpact_object, &ours_object));
-        if (cfg.handle_bt_sdf_shape && cfg.sdf_shape_type != SDF_SHAPE_PROXYTYPE)
-            probes.push_back(std::make_pair(&probe.gimpact_object, &theirs_object));
-        if (cfg.convex_shapes) probes.push_back(std::make_pair(&probe.box_object, &ours_object));
-        for (const auto& p : probes) {
-            bool ok = createsOurs(d, *p.first, *p.second, BT_CONTACT_POINT_ALGORITHMS) &&
-                      createsOurs(d, *p.second, *p.first, BT_CONTACT_POINT_ALGORITHMS);
-            if (cfg.closest_points)
-                ok = ok && createsOurs(d, *p.first, *p.second, BT_CLOSEST_POINT_ALGORITHMS) &&
-                     createsOurs(d, *p.second, *p.first, BT_CLOSEST_POINT_ALGORITHMS);
-            if (!ok) result = Status::Overwritten;
-        }
-    }
-    sdfccd_destroy_sdf(sphere);
-    return result;
+    if (!m_impl->dispatcher) return Status::NotRegistered;
+    return intact(m_impl, slots(m_impl->cfg), m_impl->cfg.closest_points) ? Status::Ok : Status::Overwritten;
 }
-
-} // namespace detail
 
 Status Bridge::check(btCollisionWorld* world, std::string* message) const
 {
@@ -397,7 +352,7 @@ Status Bridge::check(btCollisionWorld* world, std::string* message) const
                      "after creating the world, before adding bodies");
         return Status::NotRegistered;
     }
-    if (verifyImpl(m_impl) != Status::Ok) {
+    if (verify() != Status::Ok) {
         say(message, "the dispatcher no longer creates the bridge's algorithm (registerCollisionCreateFunc or "
                      "btGImpactCollisionAlgorithm::registerAlgorithm was called after Bridge::registerWith)");
         return Status::Overwritten;
@@ -419,8 +374,7 @@ Status Bridge::check(btCollisionWorld* world, std::string* message) const
         if (!p.m_algorithm || !p.m_pProxy0 || !p.m_pProxy1) continue;
         const btCollisionObject* a = static_cast<const btCollisionObject*>(p.m_pProxy0->m_clientObject);
         const btCollisionObject* b = static_cast<const btCollisionObject*>(p.m_pProxy1->m_clientObject);
-        btCollisionObjectWrapper wa(nullptr, a->getCollisionShape(), a, a->getWorldTransform(), -1, -1);
-        btCollisionObjectWrapper wb(nullptr, b->getCollisionShape(), b, b->getWorldTransform(), -1, -1);
+        const ObjectWrapper wa(a), wb(b);
         bool swapped;
         if (m_impl->orient(&wa, &wb, swapped) && !dynamic_cast<MeshSdfAlgorithm*>(p.m_algorithm)) {
             say(message, "a mesh-SDF pair has an algorithm created before Bridge::registerWith (register before adding "
@@ -509,29 +463,6 @@ void detail::callMisuseHandler(Status status, const char* message, const btColli
     h(status, message, shape, user);
 }
 
-namespace {
-
-// The dispatcher's contact-point table, read without creating anything (findAlgorithm would
-// allocate from a world that may be stepping on another thread). A pointer to the protected
-// member, formed through a derived class, applies to any btCollisionDispatcher.
-struct DispatchTable : btCollisionDispatcher {
-    static btCollisionAlgorithmCreateFunc* contactFunc(const btCollisionDispatcher* d, int a, int b)
-    {
-        return (d->*(&DispatchTable::m_doubleDispatchContactPoints))[a][b];
-    }
-};
-
-// Both body orders of (GImpact, SdfShape) still create the bridge's algorithm.
-bool slotsIntact(const BridgeImpl* impl)
-{
-    const btCollisionDispatcher* d = impl->dispatcher;
-    const int t = impl->cfg.sdf_shape_type;
-    return d && DispatchTable::contactFunc(d, GIMPACT_SHAPE_PROXYTYPE, t) == impl->fn[0].get() &&
-           DispatchTable::contactFunc(d, t, GIMPACT_SHAPE_PROXYTYPE) == impl->fn[0].get();
-}
-
-} // namespace
-
 namespace detail {
 
 bool isGImpactCallback(const btTriangleCallback* callback)
@@ -554,8 +485,10 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported)
             // (The dispatcher tables are read, not probed with findAlgorithm: another world may be
             // stepping on another thread.)
             status = Status::TooLate;
-            for (const auto& r : g_registered)
-                if (!slotsIntact(r.second)) status = Status::Overwritten;
+            for (const auto& r : g_registered) {
+                const int t = r.second->cfg.sdf_shape_type; // both orders of (GImpact, SdfShape)
+                if (!intact(r.second, { { GIMPACT_SHAPE_PROXYTYPE, t }, { t, GIMPACT_SHAPE_PROXYTYPE } }, false)) status = Status::Overwritten;
+            }
         }
     }
     if (last_reported == (int)status + 1) return; // said already
@@ -572,14 +505,7 @@ void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported)
                   "Bullet's GImpact algorithm is colliding a GImpact mesh with an SdfShape, without CCD (it can pass through): %s; "
                   "Bridge::check(world) names the problem",
                   what);
-    MisuseHandler h;
-    void* user;
-    {
-        std::lock_guard<std::mutex> lock(g_misuse_mutex);
-        h = g_misuse_handler ? g_misuse_handler : defaultMisuseHandler;
-        user = g_misuse_user;
-    }
-    h(status, message, shape, user);
+    callMisuseHandler(status, message, shape);
 }
 
 } // namespace detail

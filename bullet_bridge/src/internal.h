@@ -35,6 +35,10 @@ inline sdfccd_Vec3 v3(const btVector3& v)
 }
 inline btVector3 bt(const sdfccd_Vec3& v) { return btVector3((btScalar)v.x, (btScalar)v.y, (btScalar)v.z); }
 sdfccd_Pose toPose(const btTransform& t);
+// A top-level object as Bullet's dispatcher sees it (its own shape at its world transform).
+struct ObjectWrapper : btCollisionObjectWrapper {
+    explicit ObjectWrapper(const btCollisionObject* o) : btCollisionObjectWrapper(nullptr, o->getCollisionShape(), o, o->getWorldTransform(), -1, -1) {}
+};
 
 // Start and end pose of a body (or compound child) over a step, and the constant velocities that
 // connect them in Bullet's motion model (origin lerp + exponential-map rotation), sdfccd's too.
@@ -153,8 +157,6 @@ struct PairStageHash {
 
 class MeshSdfAlgorithm;
 
-/** Bridge::verify() of `impl`. */
-Status verifyImpl(const BridgeImpl* impl);
 /** True when `callback` is Bullet's GImpact algorithm's triangle callback (btGImpactTriangleCallback). */
 bool isGImpactCallback(const btTriangleCallback* callback);
 /** Diagnoses Bullet's GImpact algorithm colliding with `shape` and reports it through the misuse

@@ -190,6 +190,16 @@ int32_t queryPointSample(sdfccd_Vec3 p, double* out_value, void* shape)
     return 1;
 }
 
+// The shape's box in its own frame, and its diagonal.
+sdfccd_Aabb localBox(const btCollisionShape* shape, double* diagonal)
+{
+    btVector3 lo, hi;
+    shape->getAabb(btTransform::getIdentity(), lo, hi);
+    *diagonal = (double)(hi - lo).length();
+    const sdfccd_Aabb box = { v3(lo), v3(hi) };
+    return box;
+}
+
 } // namespace
 
 ShapeCache::~ShapeCache()
@@ -265,14 +275,10 @@ sdfccd_SdfId ShapeCache::btSdfFor(const btSdfCollisionShape* shape)
     auto it = m_bt_sdfs.find(shape);
     if (it != m_bt_sdfs.end()) return it->second;
     // queryPoint in the shape's box (queryPoint is non-const but only reads).
-    btTransform id;
-    id.setIdentity();
-    btVector3 lo, hi;
-    shape->getAabb(id, lo, hi);
-    const sdfccd_Aabb box = { v3(lo), v3(hi) };
+    double diagonal;
+    const sdfccd_Aabb box = localBox(shape, &diagonal);
     sdfccd_SdfId& sdf = m_bt_sdfs[shape];
-    if (sdfccd_create_sampled_sdf(queryPointField, const_cast<btSdfCollisionShape*>(shape), box, 0.05 * (double)(hi - lo).length(), &sdf) !=
-        SDFCCD_OK)
+    if (sdfccd_create_sampled_sdf(queryPointField, const_cast<btSdfCollisionShape*>(shape), box, 0.05 * diagonal, &sdf) != SDFCCD_OK)
         sdf = kNullSdf;
     return sdf;
 }
@@ -282,14 +288,10 @@ bool ShapeCache::setBtSdfData(const btSdfCollisionShape* shape, const void* data
     sdfccd_SdfId grid;
     if (!shape || !data || sdfccd_load_grid_memory(data, size, &grid) != SDFCCD_OK) return false;
     // The same field as the shape's (queryPoint) at 125 points of its box, to the float build's precision.
-    btTransform id;
-    id.setIdentity();
-    btVector3 lo, hi;
-    shape->getAabb(id, lo, hi);
-    const sdfccd_Aabb box = { v3(lo), v3(hi) };
-    double diff = 0;
+    double diagonal, diff = 0;
+    const sdfccd_Aabb box = localBox(shape, &diagonal);
     if (sdfccd_sdf_compare_samples(grid, queryPointSample, const_cast<btSdfCollisionShape*>(shape), box, 5, &diff, nullptr) != SDFCCD_OK ||
-        !(diff <= 1e-5 * (double)(hi - lo).length())) {
+        !(diff <= 1e-5 * diagonal)) {
         sdfccd_destroy_sdf(grid);
         return false;
     }

@@ -540,6 +540,22 @@ typedef struct sdfccd_GuardBodyResult {
 SDFCCD_API sdfccd_Status sdfccd_guard_body(sdfccd_Workspace* ws, const sdfccd_GuardPair* pairs, int32_t count, double t0, double t1,
                                            const sdfccd_GuardParams* params, sdfccd_GuardBodyResult* out);
 
+/** The box a rigid body can occupy at any time of a step (the guard's broad phase, world frame, m),
+ * for the motion sdfccd_rigid_motion_from_poses() makes of its two poses about its origin (for
+ * Bullet the centre of mass): the origin moves linearly from `start`'s position to `end`'s, and the
+ * body turns at a constant rate by the shortest arc between the two orientations (angle a <= pi).
+ * `start_box` and `end_box` hold the body at the two poses; `reach` (m) bounds its points' distance
+ * from the origin. Without a turn (equal orientations) the result is the union of the two boxes.
+ * With one, a point leaves the segment between its two end positions by at most reach a^2 / 8, so
+ * the union grows by that much on every side, and each side is then cut to the origin segment's box
+ * grown by `reach` where that is tighter. `reach` is not used without a turn.
+ *
+ * Errors (::SDFCCD_INVALID_ARGUMENT, nothing written): a NULL pointer, a NaN box coordinate (infinite
+ * ones are allowed: an unbounded body), a non-finite pose or a zero orientation, and with a turn a
+ * `reach` that is not finite and >= 0. */
+SDFCCD_API sdfccd_Status sdfccd_swept_aabb(const sdfccd_Aabb* start_box, const sdfccd_Aabb* end_box, const sdfccd_Pose* start,
+                                           const sdfccd_Pose* end, double reach, sdfccd_Aabb* out_box);
+
 #ifdef __cplusplus
 }
 #endif
