@@ -464,7 +464,7 @@ int scc_generate_contacts(const scc_sdf* sdf, const scc_mesh_motion* mm_in, cons
     int32_t* idx = scc_ws_get(ws, SCC_WS_REDUCE, (size_t)capacity * sizeof *idx);
     double* scratch = idx ? scc_ws_get(ws, SCC_WS_REDUCE_SCRATCH, n * sizeof *scratch) : NULL;
     if (!scratch) return 0;
-    sum->reduced = scc_reduce_weighted(c, n, cand_item, same, fmin(DEPTH_SCALE_MAX, DEPTH_SCALE_SHARE * radius), -1, k, idx, scratch);
+    sum->reduced = scc_reduce_kept(c, n, cand_item, same, fmin(DEPTH_SCALE_MAX, DEPTH_SCALE_SHARE * radius), &cp->keep, k, idx, scratch);
     sum->written = sum->reduced;
     if (cp->cover_depth > 0.0 && sum->reduced > 0 && sum->reduced < (size_t)capacity) {
         /* the body's turn (relative to the SDF) about axes in the contact plane over the step */

@@ -5,6 +5,7 @@
 #define SCC_CONTACTS_H
 
 #include "ccd.h"
+#include "reduce.h"
 
 typedef enum scc_feature_kind { SCC_FEATURE_VERTEX, SCC_FEATURE_EDGE, SCC_FEATURE_FACE } scc_feature_kind;
 
@@ -43,6 +44,7 @@ typedef struct scc_contact_params {
     int reduced;             /* points of the reduction (0: the whole capacity); the rest of the capacity: cover points */
     double cover_depth;      /* the cover points' depth (m; 0: none) */
     double end_skip_travel;  /* > 0 (continuous): no end-pose query when the step's travel is at most this */
+    scc_reduce_keep keep;    /* the previous step's points, preferred by the reduction (keep.n 0: none) */
 } scc_contact_params;
 
 /* The feature (vertex, edge or face) of triangle t at barycentric weights b, and its stable id,

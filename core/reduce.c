@@ -24,6 +24,7 @@ typedef struct reducer {
                                   within tol of one (taken); NULL: recomputed from the chosen points */
     double depth_scale;        /* > 0: scores weighted by exp(-(gap - first gap) / depth_scale) */
     double gap0;               /* the first point's gap */
+    const scc_reduce_keep* keep; /* the previous step's points (NULL: none) */
 } reducer;
 
 static scc_reduce_item item(const reducer* r, size_t i)
@@ -158,13 +159,64 @@ static double score(const reducer* r, size_t i, const scc_reduce_item* it, int a
     return s;
 }
 
+/* The rank of `id` among the previous step's points, -1 when it is not one of them. */
+static long keep_rank(const reducer* r, uint64_t id)
+{
+    for (size_t j = 0; j < r->keep->n; ++j)
+        if (r->keep->ids[j] == id) return (long)j;
+    return -1;
+}
+
+/* The previous step's point that replaces `pick` (see scc_reduce_keep), -1 when none. The first choice
+ * compares depth only; later ones the score of the pass too (`along`, `fill`), which must exceed
+ * `enough`. */
+static long keep_choice(const reducer* r, long pick, int first_choice, int along, int fill, double enough)
+{
+    if (!r->keep || r->keep->n == 0 || pick < 0) return -1;
+    const scc_reduce_item pit = item(r, (size_t)pick);
+    const double floor_s = first_choice ? 0.0 : r->keep->share * score(r, (size_t)pick, &pit, along, fill);
+    long best = -1, best_rank = 0;
+    double best_gap = 0.0;
+    for (size_t i = 0; i < r->n; ++i) {
+        scc_reduce_item it = item(r, i);
+        const long rank = keep_rank(r, it.id);
+        if (rank < 0 || !(it.gap <= pit.gap + r->keep->depth)) continue;
+        if (!first_choice) {
+            if (taken(r, i, it.p)) continue;
+            const double s = score(r, i, &it, along, fill);
+            if (!(s >= floor_s) || !(s > enough)) continue;
+        }
+        if (best < 0 || rank < best_rank || (rank == best_rank && it.gap < best_gap)) {
+            best = (long)i;
+            best_rank = rank;
+            best_gap = it.gap;
+        }
+    }
+    return best;
+}
+
+static size_t reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, long first,
+                     const scc_reduce_keep* keep, size_t k, int32_t* out, double* scratch);
+
 size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, long first, size_t k, int32_t* out, double* scratch)
 {
-    return scc_reduce_weighted(set, n, get, tol, 0.0, first, k, out, scratch);
+    return reduce(set, n, get, tol, 0.0, first, NULL, k, out, scratch);
 }
 
 size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, long first, size_t k,
                            int32_t* out, double* scratch)
+{
+    return reduce(set, n, get, tol, depth_scale, first, NULL, k, out, scratch);
+}
+
+size_t scc_reduce_kept(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, const scc_reduce_keep* keep,
+                       size_t k, int32_t* out, double* scratch)
+{
+    return reduce(set, n, get, tol, depth_scale, -1, keep, k, out, scratch);
+}
+
+static size_t reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, long first,
+                     const scc_reduce_keep* keep, size_t k, int32_t* out, double* scratch)
 {
     if (n == 0 || k == 0) return 0;
     reducer r;
@@ -177,6 +229,7 @@ size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, do
     r.chosen = out;
     r.mind = scratch;
     r.depth_scale = depth_scale;
+    r.keep = keep;
     /* the first point: given, or the deepest; among equally deep ones (a face landing flat) the one
      * farthest from their centre, a corner, so the polygon grows to the region's corners */
     long best = first >= 0 && (size_t)first < n ? first : -1;
@@ -186,6 +239,8 @@ size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, do
     /* weighted: distances on the plane of the deepest point's normal from the start */
     const int plane = best < 0 && depth_scale > 0.0;
     if (plane) r.nref = scc_normalize_or(item(&r, (size_t)deepest).n, scc_v3(0, 0, 1));
+    /* the previous step's first point, when about as deep: it also gives the contact plane */
+    if (best < 0 && (best = keep_choice(&r, deepest, 1, 0, 0, 0.0)) >= 0) r.nref = scc_normalize_or(item(&r, (size_t)best).n, scc_v3(0, 0, 1));
     if (best < 0) {
         const double g0 = item(&r, (size_t)deepest).gap;
         const double same = fmax(1e-9 * fmax(1.0, fabs(g0)), depth_scale > 0.0 ? 1e-3 * tol : 0.0);
@@ -241,6 +296,8 @@ size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, do
                     if (score(&r, i, &it, along, fill) >= floor_s) { pick = (long)i; bit = it; }
                 }
             }
+            const long kept = keep_choice(&r, pick, 0, along, fill, enough);
+            if (kept >= 0) pick = kept;
         }
         if (pick < 0) {
             if (fill || r.m == 1) break;

@@ -46,6 +46,25 @@ size_t scc_reduce(const void* set, size_t n, scc_reduce_get_fn* get, double tol,
 size_t scc_reduce_weighted(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, long first, size_t k,
                            int32_t* out, double* scratch);
 
+/* The previous step's kept points, for a reduction that keeps a resting contact set's points (and
+ * their order) from step to step: `ids` (n of them, in the order they were chosen then). At every
+ * choice, a candidate with one of these ids (not taken) replaces the point the reduction would pick
+ * when its gap is at most `depth` (m) above that point's and, after the first choice, its score is
+ * at least `share` of that point's (and adds more than tol); among several, the one earliest in
+ * `ids` (then the smaller gap, the lower index). The first point kept this way also gives the
+ * contact plane (its normal). */
+typedef struct scc_reduce_keep {
+    const uint64_t* ids;
+    size_t n;
+    double depth;
+    double share;
+} scc_reduce_keep;
+
+/* scc_reduce_weighted with the previous step's points preferred (keep NULL or keep->n 0: the same as
+ * scc_reduce_weighted). O(n keep->n) more reads of the set per choice. */
+size_t scc_reduce_kept(const void* set, size_t n, scc_reduce_get_fn* get, double tol, double depth_scale, const scc_reduce_keep* keep,
+                       size_t k, int32_t* out, double* scratch);
+
 /* Cover points (cover.c): up to k more indices of `set`, none in chosen[0..chosen_count-1], each the
  * point whose end gap could fall furthest below `depth` while every held point (chosen, then picked)
  * stays out, for a turn of `tilt` (m per m) of the body about an axis in the contact plane; a held

@@ -222,7 +222,13 @@ int main(void)
     OFF(sdfccd_ContactParams, reduced_count);
     OFF(sdfccd_ContactParams, cover_depth);
     OFF(sdfccd_ContactParams, end_skip_travel);
+    OFF(sdfccd_ContactParams, previous);
     OFF(sdfccd_ContactParams, internal_value);
+    SIZE(sdfccd_KeepPrevious);
+    OFF(sdfccd_KeepPrevious, ids);
+    OFF(sdfccd_KeepPrevious, count);
+    OFF(sdfccd_KeepPrevious, depth);
+    OFF(sdfccd_KeepPrevious, share);
     SIZE(sdfccd_ContactSet);
     OFF(sdfccd_ContactSet, count);
     OFF(sdfccd_ContactSet, candidates);

@@ -386,6 +386,211 @@ START_TEST(test_reduce_weighted_bad_input)
 }
 END_TEST
 
+/* ---- the previous step's points (sdfccd_reduce_contacts_kept, sdfccd_KeepPrevious) ---- */
+
+static const double KEEP_SCALE = 0.1; /* the weighted reduction's depth scale below */
+
+/* sdfccd_reduce_contacts_kept with the ids `prev` (count n_prev; NULL: none), checked as reduce_w. */
+static int32_t reduce_k(const sdfccd_ContactPoint* c, int32_t n, const uint64_t* prev, int32_t n_prev, double depth, double share,
+                        int32_t cap, int32_t* idx)
+{
+    sdfccd_KeepPrevious k = { prev, n_prev, depth, share };
+    int32_t count = -1;
+    ck_assert_msg(sdfccd_reduce_contacts_kept(c, n, SAME, KEEP_SCALE, prev ? &k : NULL, idx, cap, &count) == SDFCCD_OK, "%s",
+                  sdfccd_last_error());
+    ck_assert(count >= 0 && count <= cap && count <= n);
+    for (int32_t i = 0; i < count; ++i) {
+        ck_assert(idx[i] >= 0 && idx[i] < n);
+        for (int32_t j = 0; j < i; ++j) {
+            sdfccd_Vec3 a = c[idx[i]].surface_point, b = c[idx[j]].surface_point;
+            ck_assert(hypot(hypot(a.x - b.x, a.y - b.y), a.z - b.z) > SAME);
+        }
+    }
+    return count;
+}
+
+/* The ids of the chosen points. */
+static void chosen_ids(const sdfccd_ContactPoint* c, const int32_t* idx, int32_t n, uint64_t* ids)
+{
+    for (int32_t i = 0; i < n; ++i) ids[i] = c[idx[i]].id;
+}
+
+/* A resting set one step and the next, as a wedged body gives it: the two deepest points, A (0, 0)
+ * and B (1, 0), trade the first place by 2 micrometres of rounding (-1e-6 and +1e-6 m, then the other
+ * way); C (1, 1) and D (0, 1) 1 mm above. */
+static void wedge_set(sdfccd_ContactPoint* c, int step)
+{
+    const double s = step == 1 ? 1.0 : -1.0;
+    c[0] = cp(0.0, 0.0, 0.0, -1e-6 * s, 460);
+    c[1] = cp(1.0, 0.0, 0.0, 1e-6 * s, 2);
+    c[2] = cp(1.0, 1.0, 0.0, 1e-3, 543);
+    c[3] = cp(0.0, 1.0, 0.0, 1e-3, 176);
+}
+
+/* Three points of a set, the third of two candidates that trade it by 1e-5 m of depth: A (0, 0) the
+ * deepest (-1 mm), C (1, 1) the farthest, then E (0, 1) at 0 and F (1, 0) at +1e-5 m, then -1e-5 m
+ * (both add the same area, and the deeper one within 95 % of the best score is chosen). */
+static void third_set(sdfccd_ContactPoint* c, int step)
+{
+    c[0] = cp(0.0, 0.0, 0.0, -1e-3, 460);
+    c[1] = cp(1.0, 1.0, 0.0, 0.0, 543);
+    c[2] = cp(0.0, 1.0, 0.0, 0.0, 176);
+    c[3] = cp(1.0, 0.0, 0.0, step == 1 ? 1e-5 : -1e-5, 178);
+}
+
+START_TEST(test_reduce_kept_persist)
+{
+    sdfccd_ContactPoint c[4];
+    int32_t idx[4], idx2[4];
+    uint64_t ids1[4], ids2[4];
+    /* without the previous points, the first point flips with the rounding (and the order with it) */
+    wedge_set(c, 1);
+    ck_assert_int_eq(reduce_k(c, 4, NULL, 0, 0, 0, 4, idx), 4);
+    chosen_ids(c, idx, 4, ids1);
+    wedge_set(c, 2);
+    ck_assert_int_eq(reduce_k(c, 4, NULL, 0, 0, 0, 4, idx2), 4);
+    chosen_ids(c, idx2, 4, ids2);
+    ck_assert(ids1[0] == 460 && ids2[0] == 2);
+    /* with them (depth 5e-4 m, share 0.8): the same points in the same order, step after step */
+    for (int step = 2; step <= 5; ++step) {
+        wedge_set(c, step % 2 ? 1 : 2);
+        ck_assert_int_eq(reduce_k(c, 4, ids1, 4, 5e-4, 0.8, 4, idx2), 4);
+        chosen_ids(c, idx2, 4, ids2);
+        for (int i = 0; i < 4; ++i) ck_assert(ids2[i] == ids1[i]);
+    }
+    /* step 2's own choice, kept, is kept in turn: whichever came first stays */
+    wedge_set(c, 2);
+    ck_assert_int_eq(reduce_k(c, 4, NULL, 0, 0, 0, 4, idx), 4);
+    chosen_ids(c, idx, 4, ids1);
+    wedge_set(c, 1);
+    ck_assert_int_eq(reduce_k(c, 4, ids1, 4, 5e-4, 0.8, 4, idx2), 4);
+    chosen_ids(c, idx2, 4, ids2);
+    for (int i = 0; i < 4; ++i) ck_assert(ids2[i] == ids1[i]);
+    /* the identity of a later point: without them, E then F; with them, E both times */
+    third_set(c, 1);
+    ck_assert_int_eq(reduce_k(c, 4, NULL, 0, 0, 0, 3, idx), 3);
+    chosen_ids(c, idx, 3, ids1);
+    ck_assert(ids1[0] == 460 && ids1[1] == 543 && ids1[2] == 176);
+    third_set(c, 2);
+    ck_assert_int_eq(reduce_k(c, 4, NULL, 0, 0, 0, 3, idx), 3);
+    ck_assert(c[idx[2]].id == 178);
+    ck_assert_int_eq(reduce_k(c, 4, ids1, 3, 5e-4, 0.8, 3, idx), 3);
+    chosen_ids(c, idx, 3, ids2);
+    for (int i = 0; i < 3; ++i) ck_assert(ids2[i] == ids1[i]);
+    /* a previous first point is the contact plane: two walls (normals 90 degrees apart), the other
+     * one the deeper by 2 micrometres; on the kept wall's plane (normal +x) the two points are 0.3 m
+     * apart, so both are chosen */
+    sdfccd_ContactPoint w[2] = { cp(0.0, 0.0, 0.0, -1e-6, 1), cp(0.0, 0.3, 0.0, 1e-6, 2) };
+    w[1].normal = (sdfccd_Vec3){ 1.0, 0.0, 0.0 };
+    const uint64_t first_wall[1] = { 2 };
+    ck_assert_int_eq(reduce_k(w, 2, first_wall, 1, 5e-4, 0.8, 2, idx), 2);
+    ck_assert(idx[0] == 1 && idx[1] == 0);
+}
+END_TEST
+
+START_TEST(test_reduce_kept_better_wins)
+{
+    sdfccd_ContactPoint c[5];
+    int32_t idx[4];
+    uint64_t ids1[4], ids[4];
+    wedge_set(c, 1);
+    ck_assert_int_eq(reduce_k(c, 4, NULL, 0, 0, 0, 4, idx), 4);
+    chosen_ids(c, idx, 4, ids1);
+    /* a new point deeper by more than the depth (0.6 mm against 0.5) is first; by less (0.4 mm), not */
+    for (int deeper = 0; deeper <= 1; ++deeper) {
+        wedge_set(c, 2);
+        c[4] = cp(0.5, 0.5, 0.0, deeper ? -6e-4 : -4e-4, 999);
+        ck_assert_int_eq(reduce_k(c, 5, ids1, 4, 5e-4, 0.8, 4, idx), 4);
+        ck_assert(c[idx[0]].id == (deeper ? 999u : 460u));
+    }
+    /* depth 0: the deeper point is first again */
+    wedge_set(c, 2);
+    ck_assert_int_eq(reduce_k(c, 4, ids1, 4, 0.0, 0.8, 4, idx), 4);
+    ck_assert(c[idx[0]].id == 2);
+    /* a new point H (x, 1) adding more than 1 / 0.8 of the kept E's area (1.5 x at x = -0.5) wins; one
+     * adding 1.2 x (x = -0.2; the plain reduction takes it) does not */
+    third_set(c, 1);
+    ck_assert_int_eq(reduce_k(c, 4, NULL, 0, 0, 0, 3, idx), 3);
+    chosen_ids(c, idx, 3, ids1);
+    for (int far = 0; far <= 1; ++far) {
+        third_set(c, 2);
+        c[4] = cp(far ? -0.5 : -0.2, 1.0, 0.0, 0.0, 777);
+        ck_assert_int_eq(reduce_k(c, 5, NULL, 0, 0, 0, 3, idx), 3);
+        ck_assert(c[idx[2]].id == 777);
+        ck_assert_int_eq(reduce_k(c, 5, ids1, 3, 5e-4, 0.8, 3, idx), 3);
+        chosen_ids(c, idx, 3, ids);
+        ck_assert(ids[0] == 460 && ids[1] == 543);
+        ck_assert(ids[2] == (far ? 777u : 176u));
+    }
+    /* share 1: only as good a point is kept (F scores a little more than E: its weight) */
+    third_set(c, 2);
+    ck_assert_int_eq(reduce_k(c, 4, ids1, 3, 5e-4, 1.0, 3, idx), 3);
+    ck_assert(c[idx[2]].id == 178);
+}
+END_TEST
+
+START_TEST(test_reduce_kept_deterministic)
+{
+    enum { N = 1000 };
+    static sdfccd_ContactPoint c[N], shuffled[N];
+    test_rng rng = { 23 };
+    random_set(&rng, c, N);
+    int32_t idx[16], idx2[16], plain[16];
+    uint64_t prev[16], none[3] = { 5000001, 5000002, 5000003 };
+    int plain_flipped = 0;
+    for (int cap = 1; cap <= 16; cap *= 2) {
+        /* no previous points, or none in the set: exactly the weighted reduction */
+        int32_t count = -1;
+        ck_assert_int_eq(sdfccd_reduce_contacts_weighted(c, N, SAME, KEEP_SCALE, plain, cap, &count), SDFCCD_OK);
+        ck_assert_int_eq(reduce_k(c, N, NULL, 0, 5e-4, 0.8, cap, idx), count);
+        for (int i = 0; i < count; ++i) ck_assert_int_eq(idx[i], plain[i]);
+        ck_assert_int_eq(reduce_k(c, N, none, 3, 5e-4, 0.8, cap, idx), count);
+        for (int i = 0; i < count; ++i) ck_assert_int_eq(idx[i], plain[i]);
+        /* the set a step later, moved by up to 1e-4 m in gap and 1e-5 m in place: each choice is a
+         * previous point (no new one is clearly better), in the same order; without them, the choice
+         * follows the noise (checked below over the caps) */
+        chosen_ids(c, plain, count, prev);
+        for (int i = 0; i < N; ++i) {
+            shuffled[i] = c[i];
+            shuffled[i].surface_point.x += test_rng_uniform(&rng, -1e-5, 1e-5);
+            shuffled[i].gap += test_rng_uniform(&rng, -1e-4, 1e-4);
+        }
+        int32_t n = reduce_k(shuffled, N, prev, count, 5e-4, 0.8, cap, idx);
+        ck_assert_int_eq(n, count);
+        for (int i = 0; i < n; ++i) ck_assert(shuffled[idx[i]].id == prev[i]);
+        const int32_t np = reduce_k(shuffled, N, NULL, 0, 0, 0, cap, idx2);
+        for (int i = 0; i < np && !plain_flipped; ++i) plain_flipped = np != n || shuffled[idx2[i]].id != prev[i];
+        /* the order of the input does not matter (distinct ids) */
+        for (int i = 0; i < N; ++i) c[i] = shuffled[(i * 617 + 13) % N];
+        ck_assert_int_eq(reduce_k(c, N, prev, count, 5e-4, 0.8, cap, idx2), n);
+        for (int i = 0; i < n; ++i) ck_assert(c[idx2[i]].id == prev[i]);
+        /* and twice the same call, the same answer */
+        ck_assert_int_eq(reduce_k(c, N, prev, count, 5e-4, 0.8, cap, idx), n);
+        for (int i = 0; i < n; ++i) ck_assert_int_eq(idx[i], idx2[i]);
+    }
+    ck_assert(plain_flipped);
+}
+END_TEST
+
+START_TEST(test_reduce_kept_bad_input)
+{
+    sdfccd_ContactPoint c[2] = { cp(0, 0, 0, 0, 1), cp(1, 0, 0, 0, 2) };
+    const uint64_t ids[2] = { 1, 2 };
+    int32_t idx[2], count = -7;
+    const sdfccd_KeepPrevious bad[5] = { { ids, -1, 5e-4, 0.8 }, { NULL, 2, 5e-4, 0.8 }, { ids, 2, NAN, 0.8 }, { ids, 2, -1e-3, 0.8 },
+                                         { ids, 2, 5e-4, 1.5 } };
+    for (int i = 0; i < 5; ++i) {
+        ck_assert_int_eq(sdfccd_reduce_contacts_kept(c, 2, SAME, 0.1, &bad[i], idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+        ck_assert(strstr(sdfccd_last_error(), "sdfccd_reduce_contacts_kept") != NULL);
+    }
+    const sdfccd_KeepPrevious nan_share = { ids, 2, 5e-4, NAN };
+    ck_assert_int_eq(sdfccd_reduce_contacts_kept(c, 2, SAME, 0.1, &nan_share, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts_kept(c, 2, SAME, -0.1, NULL, idx, 2, &count), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_reduce_contacts_kept(c, 2, SAME, 0.1, NULL, idx, 2, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(count, -7);
+}
+END_TEST
+
 /* ---- cover points (sdfccd_cover_contacts) ---- */
 
 static int32_t cover(const sdfccd_ContactPoint* c, int32_t n, const int32_t* chosen, int32_t m, double tilt, double depth, int32_t cap,
@@ -777,6 +982,67 @@ START_TEST(test_generate_resting_box)
     ck_assert_int_eq(sdfccd_generate_contacts(ws, floor, NULL, coarse, &m, 0.0, DT, &p, c, 4, &set), SDFCCD_OK);
     assert_bottom_corners(c, set.count, m.pose.position, 0.0);
     ck_assert_int_eq(sdfccd_destroy_mesh(coarse), SDFCCD_OK);
+    sdfccd_destroy_workspace(ws);
+    ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
+}
+END_TEST
+
+/* A box resting on the floor, tilted by +-1e-5 rad about y from step to step (the rounding of a
+ * resting body): without the previous points the first point swaps sides; with them (the bridge
+ * passes its last step's), the same four points in the same order. */
+START_TEST(test_generate_kept_ids)
+{
+    sdfccd_MeshId cube = test_box_mesh((sdfccd_Vec3){ H, H, H }, 4, 4, 4);
+    sdfccd_SdfId floor = make_floor();
+    sdfccd_Workspace* ws;
+    ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+    sdfccd_ContactPoint c[4];
+    sdfccd_ContactSet set;
+    uint64_t ids[2][4], kept[4];
+    for (int with = 0; with <= 1; ++with)
+        for (int step = 0; step < 4; ++step) {
+            const double a = (step % 2 ? 1e-5 : -1e-5) / 2;
+            sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+            m.pose.position = (sdfccd_Vec3){ 0.3, -0.2, H - 1e-6 };
+            m.pose.orientation = (sdfccd_Quat){ 0.0, sin(a), 0.0, cos(a) };
+            sdfccd_ContactParams p = sdfccd_default_contact_params();
+            p.previous.ids = with && step > 0 ? kept : NULL;
+            p.previous.count = with && step > 0 ? 4 : 0;
+            ck_assert_msg(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0.0, DT, &p, c, 4, &set) == SDFCCD_OK, "%s",
+                          sdfccd_last_error());
+            ck_assert_int_eq(set.count, 4);
+            for (int i = 0; i < 4; ++i) { /* the bottom corners (tilted by 5e-6 rad: within 1e-6 m) */
+                ck_assert(fabs(fabs(c[i].point.x - m.pose.position.x) - H) < 1e-6 && fabs(fabs(c[i].point.y - m.pose.position.y) - H) < 1e-6);
+                ck_assert(fabs(c[i].gap) < 2e-6);
+            }
+            for (int i = 0; i < 4; ++i) {
+                if (step < 2) ids[step][i] = c[i].id;
+                else ck_assert(c[i].id == ids[step % 2][i]); /* deterministic */
+                kept[i] = c[i].id;
+            }
+        }
+    /* without: the first point's side (x of the corner) follows the tilt; with: steps 1 and 0 agree */
+    sdfccd_ContactParams p = sdfccd_default_contact_params();
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.pose.position = (sdfccd_Vec3){ 0.3, -0.2, H - 1e-6 };
+    double side[2];
+    for (int step = 0; step < 2; ++step) {
+        const double a = (step % 2 ? 1e-5 : -1e-5) / 2;
+        m.pose.orientation = (sdfccd_Quat){ 0.0, sin(a), 0.0, cos(a) };
+        ck_assert_int_eq(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0.0, DT, &p, c, 4, &set), SDFCCD_OK);
+        side[step] = c[0].point.x - m.pose.position.x;
+    }
+    ck_assert(side[0] * side[1] < 0.0);
+    for (int i = 0; i < 4; ++i) ck_assert(ids[0][i] == ids[1][i]);
+    /* bad previous points are refused */
+    p.previous.count = 2;
+    p.previous.ids = NULL;
+    ck_assert_int_eq(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0.0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(strstr(sdfccd_last_error(), "previous") != NULL);
+    p.previous.ids = kept;
+    p.previous.share = 2.0;
+    ck_assert_int_eq(sdfccd_generate_contacts(ws, floor, NULL, cube, &m, 0.0, DT, &p, c, 4, &set), SDFCCD_INVALID_ARGUMENT);
     sdfccd_destroy_workspace(ws);
     ck_assert_int_eq(sdfccd_destroy_sdf(floor), SDFCCD_OK);
     ck_assert_int_eq(sdfccd_destroy_mesh(cube), SDFCCD_OK);
@@ -1409,6 +1675,7 @@ int main(void)
     test_add_memory_fixture(tg);
     tcase_add_test(tg, test_generate_no_allocation_after_warm_up); /* first: it installs an allocator */
     tcase_add_test(tg, test_generate_resting_box);
+    tcase_add_test(tg, test_generate_kept_ids);
     tcase_add_test(tg, test_generate_falling_box);
     tcase_add_test(tg, test_generate_fast_plate_thin_wall);
     tcase_add_test(tg, test_generate_linear_cloth);
@@ -1438,6 +1705,10 @@ int main(void)
     tcase_add_test(tc, test_reduce_weighted_rounding);
     tcase_add_test(tc, test_reduce_weighted_contact_plane);
     tcase_add_test(tc, test_reduce_weighted_bad_input);
+    tcase_add_test(tc, test_reduce_kept_persist);
+    tcase_add_test(tc, test_reduce_kept_better_wins);
+    tcase_add_test(tc, test_reduce_kept_deterministic);
+    tcase_add_test(tc, test_reduce_kept_bad_input);
     tcase_add_test(tc, test_cover_no_tilt);
     tcase_add_test(tc, test_cover_tilt_closed_form);
     tcase_add_test(tc, test_cover_order_and_neighbours);

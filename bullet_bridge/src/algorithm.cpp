@@ -68,15 +68,15 @@ public:
             m_manifold = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
             m_own = true;
         }
-        btPersistentManifold* all[1 + kMaxExtra] = { m_manifold };
+        btPersistentManifold* all[1 + kExtraManifolds] = { m_manifold };
         int count = 1;
         if (!m_closest && m_bridge->cfg.max_contacts >= MANIFOLD_CACHE_SIZE)
-            for (int i = 0; i < kMaxExtra; ++i) {
+            for (int i = 0; i < kExtraManifolds; ++i) {
                 if (!m_extra[i]) m_extra[i] = m_dispatcher->getNewManifold(mw->getCollisionObject(), sw->getCollisionObject());
                 all[count++] = m_extra[i];
             }
         resultOut->setPersistentManifold(m_manifold);
-        m_bridge->process(mw, sw, dispatchInfo, resultOut, all, count, m_closest);
+        m_bridge->process(mw, sw, dispatchInfo, resultOut, all, count, m_closest, m_closest ? nullptr : &m_kept);
     }
 
     btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1, const btDispatcherInfo& dispatchInfo,
@@ -93,16 +93,23 @@ public:
             if (m) manifoldArray.push_back(m);
     }
 
-    static const int kMaxExtra = 3;
+    KeptIds* kept() { return m_closest ? nullptr : &m_kept; }
 
 private:
     BridgeImpl* m_bridge;
     btPersistentManifold* m_manifold;
-    btPersistentManifold* m_extra[kMaxExtra] = { nullptr, nullptr, nullptr }; // the cover points (contact_policy.cpp)
+    btPersistentManifold* m_extra[kExtraManifolds] = { nullptr, nullptr, nullptr }; // the cover points (contact_policy.cpp)
     bool m_own;
     bool m_mesh_is_body1;
     bool m_closest;
+    KeptIds m_kept = KeptIds(); // the reduction's points of the last step (contact_policy.cpp)
 };
+
+KeptIds* keptIdsOf(btCollisionAlgorithm* algorithm)
+{
+    MeshSdfAlgorithm* a = dynamic_cast<MeshSdfAlgorithm*>(algorithm);
+    return a ? a->kept() : nullptr;
+}
 
 // Bullet's collision-algorithm pool hands out 192-byte elements in both Debian builds; the
 // algorithm stays far below (and falls back to btAlignedAlloc if a pool is smaller).
@@ -151,7 +158,11 @@ BridgeImpl::BridgeImpl(const Config& c) : cfg(c)
     if (!(cfg.contact_margin >= 0)) cfg.contact_margin = 0;
 }
 
-BridgeImpl::~BridgeImpl() { sdfccd_destroy_workspace(workspace); }
+BridgeImpl::~BridgeImpl()
+{
+    sdfccd_destroy_workspace(workspace);
+    for (sdfccd_Workspace* ws : batch_ws) sdfccd_destroy_workspace(ws);
+}
 
 bool BridgeImpl::isOurSdf(const btCollisionShape* s) const
 {

@@ -204,8 +204,18 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         // keeping it for a first rollback raised the body and left the velocity that sank it, and
         // bodies rocking on a ring in gimpact-demo did not come to rest).
         const sdfccd_Quat& q = best.safe_pose.orientation;
-        body->setCenterOfMassTransform(btTransform(btQuaternion((btScalar)q.x, (btScalar)q.y, (btScalar)q.z, (btScalar)q.w).normalized(),
-                                                   bt(best.safe_pose.position)) * best_part.inverse());
+        btTransform safe = btTransform(btQuaternion((btScalar)q.x, (btScalar)q.y, (btScalar)q.z, (btScalar)q.w).normalized(),
+                                       bt(best.safe_pose.position)) * best_part.inverse();
+        // A moving SDF (kinematic or dynamic) goes on to its end pose: the body goes with it from the
+        // time of impact, so it keeps the safe pose relative to the SDF instead of being left behind
+        // inside it.
+        if (!(best_sdf->t0 == best_sdf->t1)) {
+            btTransform at_toi;
+            btTransformUtil::integrateTransform(best_sdf->t0, bt(best_sdf->motion.linear_velocity), bt(best_sdf->motion.angular_velocity),
+                                                (btScalar)best.toi, at_toi);
+            safe = best_sdf->t1 * at_toi.inverse() * safe;
+        }
+        body->setCenterOfMassTransform(safe);
         const btRigidBody* sb = btRigidBody::upcast(best_sdf->co);
         const sdfccd_BodyState ss = sb ? bodyState(sb) : sdfccd_BodyState();
         sdfccd_BodyState bs = bodyState(body);

@@ -2,8 +2,8 @@
 // sdfccd Bullet bridge, internal: what the bridge's source files share.
 //   shape_cache.cpp    Bullet shapes -> sdfccd meshes (GImpact, convex hulls, SDF triangulations)
 //                      and SDF handles (SdfShape, btSdfCollisionShape)
-//   contact_policy.cpp the queries of one pair and step, the contact set, its reduction to the
-//                      manifolds' points, and writing them with Bullet's callbacks
+//   contact_policy.cpp a pair's contact set in a step (the core's generator, batched over pairs),
+//                      written into its manifolds with Bullet's callbacks
 //   algorithm.cpp      the collision algorithm, its create functions, registration, check()
 //   guard.cpp          the guarantee: an action checks each body's executed motion after the step
 //                      and puts a body that went into an SDF back at its time of impact
@@ -40,16 +40,10 @@ struct ObjectWrapper : btCollisionObjectWrapper {
     explicit ObjectWrapper(const btCollisionObject* o) : btCollisionObjectWrapper(nullptr, o->getCollisionShape(), o, o->getWorldTransform(), -1, -1) {}
 };
 
-// Start and end pose of a body (or compound child) over a step, and the constant velocities that
-// connect them in Bullet's motion model (origin lerp + exponential-map rotation), sdfccd's too.
-struct BodyMotion {
-    btTransform t0, t1;
-    btVector3 v, w;
-    sdfccd_RigidMotion rigid() const;
-    btTransform at(double t) const;
-};
-// `wrapper_transform` is the wrapper's world transform (a compound child's includes its offset).
-BodyMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt);
+// The motion of a body (or compound child: `wrapper_transform` includes its offset) over a step:
+// from its start pose to its end pose with the constant velocities that connect them in Bullet's
+// motion model (origin lerp + exponential-map rotation), sdfccd's too.
+sdfccd_RigidMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt);
 
 // A shape packed as a triangle mesh for sdfccd (scaled, in the shape's local frame).
 struct MeshEntry {
@@ -57,7 +51,6 @@ struct MeshEntry {
     btVector3 scaling;
     btScalar margin = 0;
     int source_count = 0;
-    double radius = 0; // largest vertex distance from the local origin
     std::vector<double> vertices;
     std::vector<uint32_t> indices;
     bool ok = false;
@@ -84,78 +77,48 @@ private:
     std::unordered_map<const btCollisionShape*, sdfccd_SdfId> m_bt_sdfs;
 };
 
-// One contact candidate, in the frames at the START of the step.
-struct Candidate {
-    btVector3 local;  // material point in the mesh's (wrapper's) frame
-    btVector3 pA0;    // that point at step start (world)
-    btVector3 pB0;    // the SDF surface point it is constrained by (world, at step start)
-    btVector3 n0;     // normal at step start (world, out of the SDF)
-    double d;         // gap at step start along n0 (negative: penetrating)
-    int triangle;
-    bool speculative; // from an impact later in the step (restitution 0)
-};
-
-// Storage the contact policy reuses from pair to pair and step to step (no allocation once grown).
+// A pair's manifold points, last step and this one (reused: no allocation once grown).
 struct PairScratch {
-    std::vector<std::pair<uint32_t, double>> tris; // triangles of the CCD's contacts and their TOI
-    std::vector<uint32_t> pose_tris;              // triangles of a discrete query's contacts
-    std::vector<std::pair<uint32_t, uint32_t>> pose_vertices;                 // (vertex, triangle)
-    std::vector<std::pair<uint32_t, std::pair<double, uint32_t>>> toi_vertices; // (vertex, (TOI, triangle))
-    std::vector<sdfccd_ContactPoint> face_points;  // the face search's points
-    std::vector<btManifoldPoint> old_points, new_points; // a pair's manifold points, last step and this one
-    std::vector<char> matched;                    // old points that persist
+    std::vector<btManifoldPoint> old_points, new_points;
+    std::vector<char> matched; // old points that persist
 };
 
-// The inputs of one pair's queries in a step: gather() and the batch prefetch build them alike.
-struct PairPlan {
-    const MeshEntry* me = nullptr;
-    sdfccd_SdfId sdf = kNullSdf;
-    BodyMotion M, S;            // in the SDF's frame when static_sdf
-    bool static_sdf = false;
-    btTransform sdf_world;      // the SDF's world pose (static_sdf)
-    sdfccd_RigidMotion mm, sm_value;
-    sdfccd_QueryParams params;  // Config::query with the pair's margin
-    bool continuous = true;     // not the DCD baseline
-    double margin = 0, start_margin = 0, travel = 0, feature_size = 0;
-    const sdfccd_RigidMotion* sm() const { return static_sdf ? nullptr : &sm_value; }
+// Manifolds a pair has beyond its first (for the cover points).
+const int kExtraManifolds = 3;
+
+// The ids of a pair's reduced points in the last step (its first manifold's), which the next step's
+// reduction prefers (sdfccd_KeepPrevious): a resting set keeps its points and their slots.
+struct KeptIds {
+    uint64_t ids[MANIFOLD_CACHE_SIZE];
+    int32_t count;
 };
 
-// One query's arguments, compared byte for byte with those of a batched query.
-struct QueryInput {
+// One pair's arguments of sdfccd_generate_contacts (compared byte for byte with a batch's; the
+// previous ids by value in `kept`, params.previous.ids NULL) and its result.
+struct PairInput {
     sdfccd_SdfId sdf;
     sdfccd_MeshId mesh;
-    int has_sdf_motion;
-    sdfccd_RigidMotion sdf_motion, motion;
-    double t1;
-    sdfccd_QueryParams params;
+    sdfccd_RigidMotion motion, sdf_motion;
+    double dt;
+    sdfccd_ContactParams params;
+    int32_t capacity;
+    KeptIds kept;
 };
-QueryInput queryInput(sdfccd_SdfId sdf, sdfccd_MeshId mesh, const sdfccd_RigidMotion* sm, const sdfccd_RigidMotion& m, double t1,
-                      const sdfccd_QueryParams& p);
-
-// The stages of a pair's queries in a step, in their order.
-enum QueryStage { kStageStart = 0, kStageCcd = 1, kStageEnd = 2 };
-
-// A query run ahead in a step's batch (Config::batch_threads), keyed by its pair and stage.
-struct CachedQuery {
-    QueryInput in;
+struct PairResult {
+    PairInput in;
+    sdfccd_ContactParams run_params; // in.params with previous pointing at in.kept
     sdfccd_Status status = SDFCCD_OK;
-    sdfccd_QueryResult result;
-    std::vector<sdfccd_Contact> contacts; // capacity given to the query
+    sdfccd_ContactSet set;
+    std::vector<sdfccd_ContactPoint> points;
 };
-struct PairStageKey {
-    const btCollisionObject* mesh;
-    const btCollisionObject* sdf;
-    int stage;
-    bool operator==(const PairStageKey& o) const { return mesh == o.mesh && sdf == o.sdf && stage == o.stage; }
-};
-struct PairStageHash {
-    size_t operator()(const PairStageKey& k) const
-    {
-        return std::hash<const void*>()(k.mesh) * 31u + std::hash<const void*>()(k.sdf) * 7u + (size_t)k.stage;
-    }
+typedef std::pair<const btCollisionObject*, const btCollisionObject*> ObjectPair; // (mesh, SDF)
+struct ObjectPairHash {
+    size_t operator()(const ObjectPair& k) const { return std::hash<const void*>()(k.first) * 31u + std::hash<const void*>()(k.second); }
 };
 
 class MeshSdfAlgorithm;
+// The kept ids of a pair's algorithm when it is the bridge's (contact points), else NULL.
+KeptIds* keptIdsOf(btCollisionAlgorithm* algorithm);
 
 /** True when `callback` is Bullet's GImpact algorithm's triangle callback (btGImpactTriangleCallback). */
 bool isGImpactCallback(const btTriangleCallback* callback);
@@ -189,25 +152,22 @@ public:
     bool isMeshLike(const btCollisionShape* s) const;
 
     // contact_policy.cpp
-    // The pair's query inputs (false: no mesh or SDF to work with).
-    bool plan(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin, detail::PairPlan& P);
-    // The discrete queries' parameters (start and end pose) with margin `dcd_margin`.
-    sdfccd_QueryParams discreteParams(const detail::PairPlan& P, double dcd_margin) const;
-    bool faceSearch(const detail::PairPlan& P) const; // the face search runs for this pair
-    // Config::batch_threads: runs the queries of every pair of `world`'s pair cache the bridge
-    // handles and that the batch covers, stage by stage, into batch_cache (replacing it).
-    void prefetch(double dt, double margin);
-    // The batched result of (mesh, sdf, stage) when its inputs are exactly `in`, else NULL; *ran
-    // tells whether the batch ran that query (a result it cannot give: an error, or more contacts
-    // than the batch had room for, which the caller queries again).
-    const detail::CachedQuery* batched(const btCollisionObject* mo, const btCollisionObject* so, int stage, const detail::QueryInput& in,
-                                       bool* ran) const;
-    bool gather(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin,
-                std::vector<detail::Candidate>& cands, double* out_radius, btVector3* out_w);
+    // The pair's arguments of sdfccd_generate_contacts (false: no mesh or SDF to work with).
+    bool pairInput(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, double dt, double margin, int capacity,
+                   const detail::KeptIds* kept, detail::PairInput& in);
+    int stepCapacity() const;                                   // points per pair and step (all its manifolds)
+    bool generate(detail::PairResult& r, sdfccd_Workspace* ws); // r.in -> r.set, r.points
+    // Config::batch_threads: the contact sets of every pair of the world's pair cache the bridge
+    // handles (top level, SdfShape), on the threads, into batch_cache (replacing it).
+    void runBatch(double dt, double margin);
+    // The batched set of (mesh, sdf) when its inputs are exactly `in` (running the batch when they
+    // are not there), else NULL.
+    const detail::PairResult* batched(const btCollisionObject* mo, const btCollisionObject* so, const detail::PairInput& in);
     // Writes the pair's points into manifolds[0..manifold_count) (4 each; the first one is the
     // pair's primary manifold, which fires started/ended).
+    // `kept` (NULL for closest points): the pair's reduced ids of the last step, updated.
     void process(const btCollisionObjectWrapper* mw, const btCollisionObjectWrapper* sw, const btDispatcherInfo& info,
-                 btManifoldResult* out, btPersistentManifold* const* manifolds, int manifold_count, bool closest);
+                 btManifoldResult* out, btPersistentManifold* const* manifolds, int manifold_count, bool closest, detail::KeptIds* kept);
     double timeOfImpact(const btCollisionObject* mo, const btCollisionObject* so, double dt);
 
     // guard.cpp
@@ -227,16 +187,14 @@ public:
     std::vector<std::pair<const btCollisionObject*, btTransform>> start_poses;
     int64_t guard_step = 0, snapshot_step = -1;
     // Scratch (the narrow phase is single-threaded in Debian's Bullet builds).
-    std::vector<detail::Candidate> scratch;
-    std::vector<int32_t> pick;                  // the chosen candidates
     detail::PairScratch work;
-    std::vector<sdfccd_ContactPoint> cover_set; // the candidates for the reduction and the cover points
-    std::vector<sdfccd_Contact> contacts, start_contacts;
-    sdfccd_Workspace* workspace = nullptr; // the queries' scratch storage (no allocation per query)
-    // Config::batch_threads: the world whose pair cache the batch reads (registerWith(world)) and
-    // the last batch's results.
+    detail::PairResult single;             // a pair's set computed in the narrow phase
+    sdfccd_Workspace* workspace = nullptr; // the narrow phase's and the guarantee's (no allocation per query)
+    // Config::batch_threads: the world whose pair cache the batch reads (registerWith(world)), a
+    // workspace per thread and the last batch's results.
     btCollisionWorld* batch_world = nullptr;
-    std::unordered_map<detail::PairStageKey, detail::CachedQuery, detail::PairStageHash> batch_cache;
+    std::vector<sdfccd_Workspace*> batch_ws;
+    std::unordered_map<detail::ObjectPair, detail::PairResult, detail::ObjectPairHash> batch_cache;
 
     struct CreateFunc;
     std::unique_ptr<CreateFunc> fn[2]; // contact points, closest points

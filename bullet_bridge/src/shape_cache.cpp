@@ -23,48 +23,30 @@ sdfccd_Pose toPose(const btTransform& t)
     return p;
 }
 
-sdfccd_RigidMotion BodyMotion::rigid() const
+sdfccd_RigidMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt)
 {
+    btTransform t0 = wrapper_transform, t1 = wrapper_transform;
+    btVector3 v(0, 0, 0), w(0, 0, 0);
+    // A compound child's offset from its body (identity for a top-level shape).
+    const btTransform child = co->getWorldTransform().inverseTimes(wrapper_transform);
+    // Kinematic first: Bullet's idiom for a kinematic body (mass 0 plus CF_KINEMATIC_OBJECT)
+    // leaves CF_STATIC_OBJECT set as well. saveKinematicState has already moved its world transform
+    // to the END of the step: the start pose is rebuilt by integrating backwards. A dynamic body's
+    // interpolation transform is its predicted end (predictUnconstraintMotion).
+    const bool kinematic = co->isKinematicObject(), moving = dt > 0 && (kinematic || !co->isStaticObject());
+    if (moving && kinematic) {
+        btTransform body0;
+        btTransformUtil::integrateTransform(co->getWorldTransform(), -co->getInterpolationLinearVelocity(),
+                                            -co->getInterpolationAngularVelocity(), (btScalar)dt, body0);
+        t0 = body0 * child;
+    } else if (moving) {
+        t1 = co->getInterpolationWorldTransform() * child;
+    }
+    if (moving) btTransformUtil::calculateVelocity(t0, t1, (btScalar)dt, v, w); // a static body's stay exactly 0
     sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
     m.pose = toPose(t0);
     m.linear_velocity = v3(v);
     m.angular_velocity = v3(w);
-    return m;
-}
-
-btTransform BodyMotion::at(double t) const
-{
-    btTransform r;
-    btTransformUtil::integrateTransform(t0, v, w, (btScalar)t, r);
-    return r;
-}
-
-BodyMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt)
-{
-    BodyMotion m;
-    m.t0 = m.t1 = wrapper_transform;
-    m.v.setZero();
-    m.w.setZero();
-    if (!(dt > 0)) return m;
-    // A compound child's offset from its body (identity for a top-level shape).
-    const btTransform child = co->getWorldTransform().inverseTimes(wrapper_transform);
-    // Kinematic first: Bullet's idiom for a kinematic body (mass 0 plus CF_KINEMATIC_OBJECT)
-    // leaves CF_STATIC_OBJECT set as well.
-    if (co->isKinematicObject()) {
-        // saveKinematicState has already moved the world transform to the END of the step and
-        // set the interpolation velocities; rebuild the start pose by integrating backwards.
-        btTransform body0;
-        btTransformUtil::integrateTransform(co->getWorldTransform(), -co->getInterpolationLinearVelocity(),
-                                            -co->getInterpolationAngularVelocity(), (btScalar)dt, body0);
-        m.t0 = body0 * child;
-        btTransformUtil::calculateVelocity(m.t0, m.t1, (btScalar)dt, m.v, m.w);
-        return m;
-    }
-    if (co->isStaticObject()) return m;
-    // Dynamic: world transform = start, interpolation transform = predicted end (set by
-    // predictUnconstraintMotion before the narrow phase).
-    m.t1 = co->getInterpolationWorldTransform() * child;
-    btTransformUtil::calculateVelocity(m.t0, m.t1, (btScalar)dt, m.v, m.w);
     return m;
 }
 
@@ -247,9 +229,6 @@ const MeshEntry* ShapeCache::meshFor(const btCollisionShape* shape)
         packConvex(static_cast<const btConvexShape*>(shape), e);
     }
     if (e.indices.empty()) return nullptr;
-    for (size_t i = 0; i + 2 < e.vertices.size(); i += 3)
-        e.radius = std::max(e.radius, std::sqrt(e.vertices[i] * e.vertices[i] + e.vertices[i + 1] * e.vertices[i + 1] +
-                                                e.vertices[i + 2] * e.vertices[i + 2]));
     sdfccd_MeshDef def = sdfccd_default_mesh_def();
     def.vertices = e.vertices.data();
     def.vertex_count = (uint32_t)(e.vertices.size() / 3);

@@ -229,6 +229,23 @@ sdfccd_Status sdfccd_guard_linear(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const 
 
 /* ---- contact generation ---- */
 
+/* The checks of a sdfccd_KeepPrevious (`what` names it in the message). */
+static sdfccd_Status check_keep(const sdfccd_KeepPrevious* k, const char* fn, const char* what)
+{
+    if (k->count < 0 || (k->count > 0 && !k->ids))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %s.count (%d) < 0, or > 0 with ids NULL", fn, what, k->count);
+    if (!isfinite(k->depth) || k->depth < 0.0 || !(k->share >= 0.0 && k->share <= 1.0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %s.depth (%g) must be finite and >= 0, share (%g) in [0, 1]", fn, what, k->depth,
+                             k->share);
+    return SDFCCD_OK;
+}
+
+static scc_reduce_keep core_keep(const sdfccd_KeepPrevious* k)
+{
+    scc_reduce_keep r = { k->ids, (size_t)k->count, k->depth, k->share };
+    return r;
+}
+
 static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, const char* fn, scc_contact_params* out)
 {
     sdfccd_Status st;
@@ -241,6 +258,7 @@ static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, cons
                                  "%s: params->vertex_distance, same_place_distance, feature_size, cover_depth and end_skip_travel must "
                                  "be finite and >= 0 (got %g, %g, %g, %g, %g)", fn, d[0], d[1], d[2], d[3], d[4]);
     if (in->reduced_count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params->reduced_count (%d) < 0", fn, in->reduced_count);
+    if ((st = check_keep(&in->previous, fn, "params->previous"))) return st;
     if ((st = sdfccd__convert_params(&in->query, fn, &out->query))) return st;
     out->vertex_distance = in->vertex_distance;
     out->same_place = in->same_place_distance;
@@ -248,6 +266,7 @@ static sdfccd_Status convert_contact_params(const sdfccd_ContactParams* in, cons
     out->reduced = in->reduced_count;
     out->cover_depth = in->cover_depth;
     out->end_skip_travel = in->end_skip_travel;
+    out->keep = core_keep(&in->previous);
     return SDFCCD_OK;
 }
 
@@ -434,8 +453,11 @@ static void public_item(const void* set, size_t i, scc_reduce_item* out)
 }
 
 static sdfccd_Status reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance, double depth_scale,
-                                     int32_t* out_indices, int32_t capacity, int32_t* out_count, const char* fn)
+                                     const sdfccd_KeepPrevious* previous, int32_t* out_indices, int32_t capacity, int32_t* out_count,
+                                     const char* fn)
 {
+    sdfccd_Status st;
+    if (previous && (st = check_keep(previous, fn, "previous"))) return st;
     if (!out_count) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: out_count is NULL", fn);
     if (count < 0 || capacity < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: count (%d) and capacity (%d) must be >= 0", fn, count, capacity);
     if ((count > 0 && !points) || (capacity > 0 && !out_indices))
@@ -449,21 +471,30 @@ static sdfccd_Status reduce_contacts(const sdfccd_ContactPoint* points, int32_t 
         if (!scc_vfinite(sdfccd__v(c->surface_point)) || !scc_vfinite(sdfccd__v(c->normal)) || !isfinite(c->gap))
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: point %d has a non-finite surface point, normal or gap", fn, i);
     }
-    *out_count = (int32_t)scc_reduce_weighted(points, (size_t)count, public_item, same_place_distance, depth_scale, -1, (size_t)capacity, out_indices, NULL);
+    const scc_reduce_keep keep = previous ? core_keep(previous) : (scc_reduce_keep){ NULL, 0, 0.0, 0.0 };
+    *out_count = (int32_t)scc_reduce_kept(points, (size_t)count, public_item, same_place_distance, depth_scale, &keep, (size_t)capacity,
+                                          out_indices, NULL);
     return SDFCCD_OK;
 }
 
 sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance, int32_t* out_indices,
                                      int32_t capacity, int32_t* out_count)
 {
-    return reduce_contacts(points, count, same_place_distance, 0.0, out_indices, capacity, out_count, "sdfccd_reduce_contacts");
+    return reduce_contacts(points, count, same_place_distance, 0.0, NULL, out_indices, capacity, out_count, "sdfccd_reduce_contacts");
 }
 
 sdfccd_Status sdfccd_reduce_contacts_weighted(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
                                               double depth_scale, int32_t* out_indices, int32_t capacity, int32_t* out_count)
 {
-    return reduce_contacts(points, count, same_place_distance, depth_scale, out_indices, capacity, out_count,
+    return reduce_contacts(points, count, same_place_distance, depth_scale, NULL, out_indices, capacity, out_count,
                            "sdfccd_reduce_contacts_weighted");
+}
+
+sdfccd_Status sdfccd_reduce_contacts_kept(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance, double depth_scale,
+                                          const sdfccd_KeepPrevious* previous, int32_t* out_indices, int32_t capacity, int32_t* out_count)
+{
+    return reduce_contacts(points, count, same_place_distance, depth_scale, previous, out_indices, capacity, out_count,
+                           "sdfccd_reduce_contacts_kept");
 }
 
 sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points, int32_t count, const int32_t* chosen, int32_t chosen_count,

@@ -120,5 +120,9 @@ sdfccd_ContactParams sdfccd_default_contact_params(void)
     c.reduced_count = 0;
     c.cover_depth = 0.0;
     c.end_skip_travel = 0.0;
+    c.previous.ids = NULL;
+    c.previous.count = 0;
+    c.previous.depth = 5e-4;
+    c.previous.share = 0.8;
     return c;
 }

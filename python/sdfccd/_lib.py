@@ -294,6 +294,15 @@ class ContactPoint(C.Structure):
     ]
 
 
+class KeepPrevious(C.Structure):
+    _fields_ = [
+        ("ids", C.POINTER(C.c_uint64)),
+        ("count", C.c_int32),
+        ("depth", C.c_double),
+        ("share", C.c_double),
+    ]
+
+
 class ContactParams(C.Structure):
     _fields_ = [
         ("query", QueryParams),
@@ -303,6 +312,7 @@ class ContactParams(C.Structure):
         ("reduced_count", C.c_int32),
         ("cover_depth", C.c_double),
         ("end_skip_travel", C.c_double),
+        ("previous", KeepPrevious),
         ("internal_value", C.c_int32),
     ]
 
@@ -336,7 +346,7 @@ STRUCTS = {
 # contact.h's structs (compared only when the C headers have contact.h).
 CONTACT_STRUCTS = {
     "sdfccd_GuardParams": GuardParams, "sdfccd_GuardResult": GuardResult, "sdfccd_ContactPoint": ContactPoint,
-    "sdfccd_ContactParams": ContactParams, "sdfccd_ContactSet": ContactSet,
+    "sdfccd_ContactParams": ContactParams, "sdfccd_ContactSet": ContactSet, "sdfccd_KeepPrevious": KeepPrevious,
 }
 
 _S = C.c_int  # sdfccd_Status

@@ -80,9 +80,10 @@ struct Config {
      * against the other's field. Off: such pairs have no algorithm and pass through each other
      * (check() cannot see that; keep it on unless no two SDF bodies can meet). Default on. */
     bool sdf_pairs = true;
-    /** Threads for the queries of a step (1..256; default 1). With more, the first pair of a step runs
-     * the queries of every pair in the world's pair cache as batches (needs registerWith(world); a
-     * callback SDF must then be thread-safe); the results are bitwise the same as with 1. */
+    /** Threads for the contact sets of a step (1..256; default 1). With more, the first pair of a step
+     * makes the sets of every pair in the world's pair cache (sdfccd_generate_contacts_batch; needs
+     * registerWith(world); a callback SDF must then be thread-safe); each set is bitwise the one the
+     * pair would make itself. */
     int batch_threads = 1;
     /** Query parameters (margin replaced by contact_margin): the library's defaults without FWGSS
      * restarts and the certified check (the discrete queries and the guarantee catch their misses). */
@@ -93,13 +94,13 @@ struct Config {
 
 /** Counters for measurements (all since construction or resetStats()). */
 struct Stats {
-    int64_t queries = 0;               /**< CCD queries (sdfccd_query_mesh over the step) made by the algorithm. */
+    int64_t queries = 0;               /**< CCD queries over the step (sdfccd_ContactSet::ccd_ran). */
     int64_t end_pose_queries = 0;      /**< Discrete queries (at the start pose over the step's reach, at the predicted end pose). */
-    int64_t queries_skipped = 0;       /**< CCD queries the start-pose query made unnecessary (nothing within reach,
-                                            or already in contact). */
-    int64_t requeries = 0;             /**< Queries repeated because the contact buffer was too small. */
-    int64_t sdf_evaluations = 0;       /**< SDF evaluations of all those queries (the library's count). */
-    int64_t own_evaluations = 0;       /**< The bridge's own SDF evaluations (closest points at the start of the step). */
+    int64_t queries_skipped = 0;       /**< Pair-steps without a CCD query: nothing within reach (the start-pose query's
+                                            broad phase proves no contact), or the step starts in contact. */
+    int64_t sdf_evaluations = 0;       /**< SDF evaluations of the mesh queries and the face search (the library's count). */
+    int64_t own_evaluations = 0;       /**< The other SDF evaluations of contact generation (closest points at the start of
+                                            the step; sdfccd_ContactSet::own_evaluations). */
     int64_t candidates = 0;            /**< Contact candidates before the reduction to 4 points. */
     double query_seconds = 0;          /**< Wall time inside all those calls. */
     int64_t hits = 0;                  /**< Pair-steps with contact: CCD hits and steps that start in contact. */
@@ -111,8 +112,9 @@ struct Stats {
     int64_t rollbacks = 0;             /**< Bodies the guarantee put back at their time of impact. */
     int64_t guard_skipped = 0;         /**< Checks the guarantee settled without a CCD (no motion, or certified clear). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (SdfShape::setFeatureSize). */
-    int64_t batched_queries = 0;       /**< Queries whose results came from a step's batch (also counted above). */
-    int64_t batches = 0;               /**< sdfccd_query_batch calls (Config::batch_threads; up to 3 per step). */
+    int64_t batched_queries = 0;       /**< Queries of contact sets taken from a step's batch (Config::batch_threads);
+                                            they are counted in queries, end_pose_queries and sdf_evaluations too. */
+    int64_t batches = 0;               /**< sdfccd_generate_contacts_batch calls (Config::batch_threads; one per step). */
     double last_toi_fraction = 1;      /**< Fraction of the last hit (1 when none). */
     int last_state = 0;                /**< sdfccd_ResultState of the last query. */
 };

@@ -223,6 +223,34 @@ typedef struct sdfccd_ContactPoint {
 SDFCCD_API sdfccd_Status sdfccd_reduce_contacts(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
                                                 int32_t* out_indices, int32_t capacity, int32_t* out_count);
 
+/** The previous step's points of a pair, for a reduction that keeps a resting contact set's points,
+ * and their order, from step to step (an engine's solver visits them in order and warm-starts them
+ * by place; a set that trades one point for an equally good one every step makes a resting body
+ * rock). At each choice of the reduction, a candidate whose ::sdfccd_ContactPoint::id is in `ids`
+ * (and is not within the same-place distance of a chosen point) replaces the point the reduction
+ * would choose when its gap is at most `depth` above that point's and, after the first point, its
+ * score (distance or added area, weighted as the reduction weights it) is at least `share` times
+ * that point's and adds something; among several, the one earliest in `ids`, then the smaller gap,
+ * then the lower index. So a new point deeper by more than `depth`, or scoring more than 1 / share
+ * times every previous one, still wins. A previous first point also gives the contact plane (its
+ * normal). `ids` is read during the call only. */
+typedef struct sdfccd_KeepPrevious {
+    const uint64_t* ids;  /**< The ids of the points kept in the previous step, in the order returned then (NULL with count 0: none). */
+    int32_t count;        /**< Entries of ids (>= 0). */
+    double depth;         /**< m, finite, >= 0. */
+    double share;         /**< In [0, 1] (0: any previous point that adds something; 1: only as good ones). */
+} sdfccd_KeepPrevious;
+
+/** sdfccd_reduce_contacts_weighted() that prefers the previous step's points (`previous`, see
+ * ::sdfccd_KeepPrevious; NULL or a count of 0: the same result as sdfccd_reduce_contacts_weighted()).
+ * The same guarantees: deterministic, never two points within `same_place_distance`, never a prefix of
+ * the set. O(count x previous->count) more reads per choice. Errors: as
+ * sdfccd_reduce_contacts_weighted(), and a negative count, ids NULL with count > 0, depth not finite
+ * and >= 0, share outside [0, 1]. */
+SDFCCD_API sdfccd_Status sdfccd_reduce_contacts_kept(const sdfccd_ContactPoint* points, int32_t count, double same_place_distance,
+                                                     double depth_scale, const sdfccd_KeepPrevious* previous, int32_t* out_indices,
+                                                     int32_t capacity, int32_t* out_count);
+
 /** Cover points: the points to hold after a reduction (sdfccd_reduce_contacts()) where the chosen
  * ones still leave the body free to sink. A chosen point j with gap g_j keeps a point i of similar
  * normal (cosine at least 0.9) from ending deeper than g_j + tilt * |i - j| (surface points) while
@@ -306,6 +334,9 @@ typedef struct sdfccd_ContactParams {
                                       move relative to the SDF) is at most this runs no end-pose query, whose features
                                       are then the start pose's moved by at most this. The Bullet bridge passes its
                                       guarantee's tolerance. m, >= 0. Default 0 (always run). */
+    sdfccd_KeepPrevious previous; /**< The points of this pair kept in the previous step, which the reduction prefers
+                                      (::sdfccd_KeepPrevious). Default: none (ids NULL, count 0), depth 5e-4 m (the
+                                      guarantee's default tolerance), share 0.8. */
     int32_t internal_value;      /**< Set by sdfccd_default_contact_params(); do not change. */
 } sdfccd_ContactParams;
 
