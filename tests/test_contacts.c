@@ -27,15 +27,9 @@ static sdfccd_ContactPoint cp(double x, double y, double z, double gap, uint64_t
     return c;
 }
 
-/* sdfccd_reduce_contacts_weighted (scale 0: sdfccd_reduce_contacts), checked: never two at one
- * place, never one twice, within the room. */
-static int32_t reduce_w(const sdfccd_ContactPoint* c, int32_t n, double scale, int32_t cap, int32_t* idx)
+/* A reduction's result checked: never two at one place, never one twice, within the room. */
+static int32_t checked(const sdfccd_ContactPoint* c, int32_t n, int32_t cap, const int32_t* idx, int32_t count)
 {
-    int32_t count = -1;
-    if (scale > 0.0)
-        ck_assert_msg(sdfccd_reduce_contacts_weighted(c, n, SAME, scale, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
-    else
-        ck_assert_msg(sdfccd_reduce_contacts(c, n, SAME, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
     ck_assert(count >= 0 && count <= cap && count <= n);
     for (int32_t i = 0; i < count; ++i) {
         ck_assert(idx[i] >= 0 && idx[i] < n);
@@ -45,6 +39,17 @@ static int32_t reduce_w(const sdfccd_ContactPoint* c, int32_t n, double scale, i
         }
     }
     return count;
+}
+
+/* sdfccd_reduce_contacts_weighted (scale 0: sdfccd_reduce_contacts), checked. */
+static int32_t reduce_w(const sdfccd_ContactPoint* c, int32_t n, double scale, int32_t cap, int32_t* idx)
+{
+    int32_t count = -1;
+    if (scale > 0.0)
+        ck_assert_msg(sdfccd_reduce_contacts_weighted(c, n, SAME, scale, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
+    else
+        ck_assert_msg(sdfccd_reduce_contacts(c, n, SAME, idx, cap, &count) == SDFCCD_OK, "%s", sdfccd_last_error());
+    return checked(c, n, cap, idx, count);
 }
 
 static int32_t reduce(const sdfccd_ContactPoint* c, int32_t n, int32_t cap, int32_t* idx) { return reduce_w(c, n, 0.0, cap, idx); }
@@ -398,15 +403,7 @@ static int32_t reduce_k(const sdfccd_ContactPoint* c, int32_t n, const uint64_t*
     int32_t count = -1;
     ck_assert_msg(sdfccd_reduce_contacts_kept(c, n, SAME, KEEP_SCALE, prev ? &k : NULL, idx, cap, &count) == SDFCCD_OK, "%s",
                   sdfccd_last_error());
-    ck_assert(count >= 0 && count <= cap && count <= n);
-    for (int32_t i = 0; i < count; ++i) {
-        ck_assert(idx[i] >= 0 && idx[i] < n);
-        for (int32_t j = 0; j < i; ++j) {
-            sdfccd_Vec3 a = c[idx[i]].surface_point, b = c[idx[j]].surface_point;
-            ck_assert(hypot(hypot(a.x - b.x, a.y - b.y), a.z - b.z) > SAME);
-        }
-    }
-    return count;
+    return checked(c, n, cap, idx, count);
 }
 
 /* The ids of the chosen points. */
