@@ -22,9 +22,13 @@
  * advance by the excess. A node whose march stalls (excess below a small tolerance, or the step
  * cap reached) is a candidate at that time, which is a lower bound of any contact of its
  * triangles (as long as K is a true Lipschitz bound). Candidates are processed earliest first
- * (a priority queue keyed by that time); a child is marched from its parent's candidate time;
- * a leaf candidate goes to the caller, who may shrink the end of the searched interval (every
- * narrow-phase hit does), which stops the march of everything later.
+ * (a priority queue keyed by that time); a child is marched from its parent's candidate time.
+ * Where the narrow phase is costly (a mesh queried by FWGSS whose answers the certified search checks,
+ * on an analytic field with kinks) the tracing goes on below a leaf over its triangle's sub-triangles,
+ * in the same queue (bsh.c, "below the leaf": a leaf's sphere can be much wider than its triangle);
+ * the triangle goes to the caller at the time its earliest sub-triangle stalls, or never when they
+ * all pass the interval's end. The caller may shrink the end of the searched interval (every narrow-phase hit does), which
+ * stops the march of everything later.
  *
  * DCD (end pose only) uses the same tree statically: a node is culled when its sphere at the end
  * pose is clear.
@@ -74,7 +78,7 @@ void scc_bsh_refit_linear(const scc_bsh* bsh, const scc_mesh* mesh, const scc_ve
 
 /* Counters of one traversal. */
 typedef struct scc_bsh_stats {
-    int64_t evals;          /* SDF evaluations spent marching */
+    int64_t evals;          /* SDF evaluations spent marching (nodes and the sub-triangles below leaves) */
     int64_t nodes_visited;  /* node-segment marches */
     int64_t candidates;     /* leaves handed to the visitor */
 } scc_bsh_stats;

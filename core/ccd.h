@@ -111,6 +111,10 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
 #define SCC_VERIFY_MAX_EVALS 1000000
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                      const scc_allocator* alloc, scc_tri_hit* io);
+/* scc_fwgss_verify, and with `force` also where FWGSS's own no-contact proof held (io a no-hit made
+ * from a contact after tb: the check then proves [ta, tb] clear or finds a contact there). */
+int scc_fwgss_check(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                    const scc_allocator* alloc, int force, scc_tri_hit* io);
 /* Whether scc_fwgss_verify checks FWGSS on this field: fields with gradient jumps (analytic kinked
  * fields, grids, user fields) with fwgss_kink_guard and fwgss_verify on. On grids the search bounds
  * phi per cell by a first-order Taylor form (certified.c), not by the cells' Lipschitz bounds, and
@@ -151,6 +155,18 @@ typedef struct scc_query_summary {
 int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                        const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
                        scc_query_summary* sum);
+/* scc_query_triangle, except that with `raw` (not NULL) an FWGSS search of one segment on a field
+ * whose answers are checked (scc_fwgss_verified) stops before the check: *deferred = 1, *raw holds
+ * FWGSS's answer, `sum` its counts and no contact is written. The mesh query checks such answers
+ * once its earliest contact is known (mesh_query.c), by scc_triangle_finish_deferred: the check over
+ * [ta, tb] (a contact of raw after tb becomes a proof owed up to tb), then the contacts, exactly as
+ * scc_query_triangle would have (with the same tb); `sum` then counts only what the finish added. */
+int scc_query_triangle_deferred(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                                const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
+                                scc_query_summary* sum, scc_tri_hit* raw, int* deferred);
+int scc_triangle_finish_deferred(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                                 const scc_allocator* alloc, uint32_t triangle_index, scc_tri_hit raw, scc_contact* out,
+                                 int capacity, scc_query_summary* sum);
 
 /* A mesh whose triangles all follow one motion template: rigid (`body` set, vertices local) or
  * linear (`start`/`end` world vertex arrays). Returns 0 on allocation failure. */

@@ -650,9 +650,15 @@ static int grid_sharp_along(const scc_sdf* sdf, const scc_tri_motion* m, double 
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                      const scc_allocator* alloc, scc_tri_hit* io)
 {
+    return scc_fwgss_check(sdf, m, ta, tb, p, alloc, 0, io);
+}
+
+int scc_fwgss_check(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                    const scc_allocator* alloc, int force, scc_tri_hit* io)
+{
     if (!scc_fwgss_verified(sdf, p) || (io->hit && !(io->toi > ta))) return 1;
     /* No hit with no descent run: FWGSS's conservative no-contact proof (fwgss_clear_proof) held */
-    if (!io->hit && io->state == SCC_NO_HIT && io->iterations == 0) return 1;
+    if (!force && !io->hit && io->state == SCC_NO_HIT && io->iterations == 0) return 1;
     int64_t budget = p->max_evals - io->evals;
     /* at most SCC_VERIFY_FACTOR times FWGSS's own evaluations plus SCC_VERIFY_BASE_EVALS: a triangle
      * resting at the contact level (a guard's per-triangle levels) keeps every region borderline, and

@@ -11,11 +11,24 @@ static double gap_at_t0(const scc_sdf* sdf, const scc_tri_motion* m, const doubl
     return scc_sdf_eval(sdf, scc_tri_point_at(m, b, m->t0, NULL), NULL);
 }
 
+/* The answer h of the search over [.., tb] as contacts (the primary, then the subdivision points at
+ * its TOI) and the summary. */
+static void finish(const scc_sdf* sdf, const scc_tri_motion* m, const scc_params* p, uint32_t triangle_index, scc_tri_hit h,
+                   int64_t evals, int64_t iterations, scc_contact* out, int capacity, scc_query_summary* sum);
+
 int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                        const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
                        scc_query_summary* sum)
 {
+    return scc_query_triangle_deferred(sdf, m, ta, tb, p, alloc, triangle_index, out, capacity, sum, NULL, NULL);
+}
+
+int scc_query_triangle_deferred(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                                const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
+                                scc_query_summary* sum, scc_tri_hit* raw, int* deferred)
+{
     scc_tri_hit h;
+    if (deferred) *deferred = 0;
     int64_t evals = 0, iterations = 0;
     int not_converged = 0;
     if (p->method == SCC_METHOD_DCD) {
@@ -55,6 +68,19 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
             scc_tri_hit seg;
             if (p->method == SCC_METHOD_FWGSS) {
                 scc_fwgss(sdf, m, sa, sb, &sp, &seg);
+                if (raw && segments == 1 && scc_fwgss_verified(sdf, p)) { /* the check is the caller's (scc_triangle_finish_deferred) */
+                    *raw = seg;
+                    *deferred = 1;
+                    sum->state = seg.state;
+                    sum->hit = seg.hit;
+                    sum->toi = seg.toi;
+                    sum->toi_lower = seg.toi_lower;
+                    sum->contacts_found = sum->contacts_written = 0;
+                    sum->iterations = seg.iterations;
+                    sum->evals = seg.evals;
+                    sum->triangles_tested = 1;
+                    return 1;
+                }
                 if (!scc_fwgss_verify(sdf, m, sa, sb, &sp, alloc, &seg)) return 0;
             }
             else if (p->method == SCC_METHOD_FW) scc_fw(sdf, m, sa, sb, &sp, &seg);
@@ -81,7 +107,38 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
          * segment never searched: the bracket's lower end must not claim more. */
         if (p->method == SCC_METHOD_CERTIFIED) h.toi_lower = scc_fmin(h.toi_lower, unresolved);
     }
+    finish(sdf, m, p, triangle_index, h, evals, iterations, out, capacity, sum);
+    return 1;
+}
 
+int scc_triangle_finish_deferred(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
+                                 const scc_allocator* alloc, uint32_t triangle_index, scc_tri_hit raw, scc_contact* out,
+                                 int capacity, scc_query_summary* sum)
+{
+    /* what scc_query_triangle does after its one segment's FWGSS: the check, then the answer */
+    const int64_t fw_evals = raw.evals, fw_iterations = raw.iterations;
+    int force = 0;
+    if (raw.hit && raw.toi > tb) { /* a contact after tb: what is owed is a proof of none up to tb */
+        raw.hit = 0;
+        raw.state = SCC_NO_HIT;
+        raw.toi = raw.toi_lower = tb;
+        force = 1;
+    }
+    if (!scc_fwgss_check(sdf, m, ta, tb, p, alloc, force, &raw)) return 0;
+    scc_tri_hit h = raw;
+    if (!h.hit) {
+        h.state = raw.state == SCC_NOT_CONVERGED ? SCC_NOT_CONVERGED : SCC_NO_HIT;
+        h.toi = h.toi_lower = tb;
+    }
+    finish(sdf, m, p, triangle_index, h, raw.evals, raw.iterations, out, capacity, sum);
+    sum->evals -= fw_evals; /* the caller counted the search's evaluations already */
+    sum->iterations -= fw_iterations;
+    return 1;
+}
+
+static void finish(const scc_sdf* sdf, const scc_tri_motion* m, const scc_params* p, uint32_t triangle_index, scc_tri_hit h,
+                   int64_t evals, int64_t iterations, scc_contact* out, int capacity, scc_query_summary* sum)
+{
     int n = 0;
     if (h.hit) {
         scc_contact primary;
@@ -120,5 +177,4 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
     sum->iterations = iterations;
     sum->evals = evals;
     sum->triangles_tested = 1;
-    return 1;
 }

@@ -32,6 +32,7 @@ enum {
     SCC_WS_POSED,     /* mesh query (DCD): vertices at the tested pose, tagged by trace_epoch (mesh_query.c) */
     SCC_WS_START,     /* contact sets: the start-pose query's contacts, kept while the CCD runs (contacts.c) */
     SCC_WS_VERTEX_LIST, /* contact sets: the vertices of the touching triangles, sorted (contacts.c) */
+    SCC_WS_DEFERRED,  /* mesh query: FWGSS answers whose check waits for the earliest contact (mesh_query.c) */
     SCC_WS_SLOTS
 };
 

@@ -450,6 +450,82 @@ START_TEST(test_never_culls)
 }
 END_TEST
 
+/* ---------------------------------------------------------------- below the leaf */
+
+/* A long thin triangle (40 cm by 4 mm: its leaf sphere is 20 cm in radius) and a small one 1 m
+ * aside, sliding at 18 m/s over a box of half-size 5 cm at height z, from y = -0.3, under FWGSS with
+ * its check (the case bsh.c traces below the leaf: a mesh, the check on an analytic field with
+ * kinks). At z = 0.2 the long one's sphere reaches the box but the triangle stays 15 cm clear: the
+ * regions below the leaf prove that and nothing is handed to the narrow phase (without them its leaf
+ * goes over at its sphere's time). At z = 0.04 it touches (its apex reaches the box's face y = -0.05
+ * 13.7 ms in) and its sphere does about 3 ms in: the candidate time must be a lower bound of the
+ * certified TOI and well past the sphere's. */
+static double slide_candidate(double z, double* out_cert, int64_t* out_candidates)
+{
+    const scc_vec3 v[6] = { { -0.2, 0, 0 }, { 0.2, 0, 0 }, { 0, 0.004, 0 }, { 1.0, 0, 0 }, { 1.004, 0, 0 }, { 1.0, 0.004, 0 } };
+    const uint32_t idx[6] = { 0, 1, 2, 3, 4, 5 };
+    scc_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.vertices = v;
+    mesh.indices = idx;
+    mesh.vertex_count = 6;
+    mesh.triangle_count = 2;
+    mesh.bounds = (scc_aabb){ { -0.2, 0, 0 }, { 1.004, 0.004, 0 } };
+    scc_sdf_box box;
+    scc_sdf_box_init(&box, scc_v3(0.05, 0.05, 0.05), 0.0);
+    scc_rigid body;
+    memset(&body, 0, sizeof body);
+    body.q0 = scc_quat_identity();
+    body.p0 = scc_v3(0, -0.3, z);
+    body.v = scc_v3(0, 18.0, 0);
+    scc_mesh_motion mm;
+    memset(&mm, 0, sizeof mm);
+    mm.mesh = &mesh;
+    mm.body = &body;
+    mm.t0 = 0.0;
+    mm.t1 = DT;
+    scc_bsh* bsh = scc_bsh_build(&mesh, &k_alloc);
+    ck_assert_ptr_nonnull(bsh);
+    scc_params pf = default_params(SCC_METHOD_FWGSS);
+    ck_assert(scc_fwgss_verified(&box.base, &pf));
+    double tc[2] = { INFINITY, INFINITY };
+    record rec = { tc };
+    scc_bsh_stats bst;
+    scc_workspace ws;
+    scc_ws_init(&ws, &k_alloc);
+    const scc_mesh_query_in in = { &box.base, &mm, &pf, &ws };
+    ck_assert(scc_bsh_traverse(bsh, NULL, &in, DT, record_visit, &rec, &bst));
+    ck_assert(!isfinite(tc[1])); /* the small triangle passes 95 cm aside */
+    scc_tri_motion m;
+    scc_mesh_triangle_motion(&mm, 0, &m);
+    ck_assert(bsh->nodes[0].is_leaf == 0);
+    scc_query_summary s;
+    scc_contact c[1 + SCC_MAX_SUBDIVISION_CONTACTS];
+    scc_params pc = default_params(SCC_METHOD_CERTIFIED);
+    ck_assert(scc_query_triangle(&box.base, &m, 0.0, DT, &pc, &k_alloc, 0, c, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+    *out_cert = s.hit ? s.toi : INFINITY;
+    *out_candidates = bst.candidates;
+    scc_ws_release(&ws);
+    scc_bsh_destroy(bsh, &k_alloc);
+    return tc[0];
+}
+
+START_TEST(test_below_leaf)
+{
+    double cert;
+    int64_t candidates;
+    double tc = slide_candidate(0.2, &cert, &candidates);
+    ck_assert(!isfinite(cert));
+    ck_assert_msg(candidates == 0 && !isfinite(tc), "a clear triangle handed over at %.9g", tc);
+    tc = slide_candidate(0.04, &cert, &candidates);
+    printf("bsh below the leaf: candidate %.6g s, certified TOI %.6g s\n", tc, cert);
+    ck_assert(isfinite(cert) && cert > 0.0136 && cert < 0.0138);
+    ck_assert_int_eq(candidates, 1);
+    ck_assert_msg(tc <= cert + 1e-9, "candidate %.9g after the certified TOI %.9g", tc, cert);
+    ck_assert_msg(tc > 0.5 * cert, "candidate %.9g: not past half the certified TOI %.9g", tc, cert);
+}
+END_TEST
+
 /* ---------------------------------------------------------------- ABI */
 
 START_TEST(test_abi_mesh_handle)
@@ -513,6 +589,7 @@ int main(void)
     test_add_memory_fixture(tc);
     tcase_add_test(tc, test_geometry);
     tcase_add_test(tc, test_never_culls);
+    tcase_add_test(tc, test_below_leaf);
     tcase_add_test(tc, test_abi_mesh_handle);
     suite_add_tcase(s, tc);
     return test_run_suite(s);

@@ -163,6 +163,82 @@ START_TEST(test_spike_apex_triangle)
 }
 END_TEST
 
+/* Five triangles of the 100K scene's step 2 with the spike-apex one (70699): the broad phase hands
+ * over two triangles with later contacts (at 0.0331 and 0.0279) first, whose FWGSS answers the mesh
+ * query now checks only up to the earliest contact (mesh_query.c, deferred checks). The answer must
+ * still lie in the certified bracket of the same mesh query (FWGSS alone, unchecked, answers
+ * 0.027079511, 1.5e-8 s after it), no earlier than the earliest per-triangle answer less the
+ * bracket, and the query must spend fewer evaluations than the triangles' own checked queries. */
+START_TEST(test_deferred_checks)
+{
+    static const double v[5][3][3] = {
+        { { 0.23302899999999999, 0.079539499999999999, -0.564276 }, { 0.23854449999999999, 0.044285000000000005, -0.5660639999999999 }, { 0.2241205, 0.060809500000000002, -0.56586500000000006 } },
+        { { 0.23302899999999999, 0.079539499999999999, -0.564276 }, { 0.24745300000000001, 0.063015000000000002, -0.56447499999999995 }, { 0.23854449999999999, 0.044285000000000005, -0.5660639999999999 } },
+        { { -0.25264049999999999, 0.08133, -0.57058399999999998 }, { -0.26492100000000002, 0.060382999999999999, -0.570608 }, { -0.25639000000000001, 0.074555499999999997, -0.56993099999999997 } },
+        { { -0.25264049999999999, 0.08133, -0.57058399999999998 }, { -0.2544515, 0.063916500000000001, -0.57114500000000001 }, { -0.26492100000000002, 0.060382999999999999, -0.570608 } },
+        { { -0.25639000000000001, 0.074555499999999997, -0.56993099999999997 }, { -0.26352050000000005, 0.067516499999999993, -0.56918650000000004 }, { -0.25498949999999998, 0.081688999999999998, -0.5685095 } },
+    };
+    scc_vec3 vv[15];
+    uint32_t f[15];
+    scc_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.bounds.lo = scc_v3(INFINITY, INFINITY, INFINITY);
+    mesh.bounds.hi = scc_v3(-INFINITY, -INFINITY, -INFINITY);
+    for (int t = 0; t < 5; ++t)
+        for (int k = 0; k < 3; ++k) {
+            vv[3 * t + k] = scc_v3(v[t][k][0], v[t][k][1], v[t][k][2]);
+            f[3 * t + k] = (uint32_t)(3 * t + k);
+            mesh.bounds.lo = scc_vmin(mesh.bounds.lo, vv[3 * t + k]);
+            mesh.bounds.hi = scc_vmax(mesh.bounds.hi, vv[3 * t + k]);
+        }
+    mesh.vertices = vv;
+    mesh.indices = f;
+    mesh.vertex_count = 15;
+    mesh.triangle_count = 5;
+    mesh.bsh = scc_bsh_build(&mesh, &k_alloc);
+    ck_assert_ptr_nonnull(mesh.bsh);
+    scc_sdf_spike_grid spikes;
+    scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
+    scc_rigid body;
+    memset(&body, 0, sizeof body);
+    body.t0 = 0.016666666666666666;
+    body.p0 = scc_v3(0.013213493305072261, -0.021105515453564188, 0.69002572176585786);
+    body.q0 = (scc_quat){ 0.99996076414546697, 0.0024999673033690301, 0.0016666448689126867, 0.0083332243445634335 };
+    body.c_local = scc_v3(-0.015584000000000015, -0.0019244999999999957, -0.073426499999999978);
+    body.v = scc_v3(0, 0, -2.1635);
+    body.w = scc_v3(0.3, 0.2, 1.0);
+    scc_mesh_motion mm = { &mesh, &body, NULL, NULL, NULL, body.t0, body.t0 + DT, NULL, NULL };
+    static scc_contact out[64];
+    scc_query_summary c, r;
+    scc_params pc = params_of(SDFCCD_METHOD_CERTIFIED);
+    ck_assert(scc_query_mesh(&spikes.base, &mm, &pc, &k_alloc, out, 64, &c));
+    scc_params pf = params_of(SDFCCD_METHOD_FWGSS);
+    ck_assert(scc_query_mesh(&spikes.base, &mm, &pf, &k_alloc, out, 64, &r));
+    /* the reference by brute force: each triangle alone, checked at once (scc_query_triangle) */
+    double first = INFINITY;
+    int64_t own_evals = 0;
+    int later = 0;
+    for (uint32_t t = 0; t < 5; ++t) {
+        scc_tri_motion m;
+        scc_mesh_triangle_motion(&mm, t, &m);
+        scc_query_summary s;
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+        own_evals += s.evals;
+        if (s.hit) first = fmin(first, s.toi);
+        later += s.hit && s.toi > c.toi + 1e-4; /* a contact well after the earliest */
+    }
+    printf("deferred checks: certified [%.10f, %.10f]; FWGSS %.10f (state %d, %lld evaluations, %d triangles); per triangle %.10f (%lld)\n",
+           c.toi_lower, c.toi, r.toi, (int)r.state, (long long)r.evals, (int)r.triangles_tested, first, (long long)own_evals);
+    ck_assert(c.hit && r.hit);
+    ck_assert_int_ge(later, 2); /* the scene has the later contacts it is about */
+    ck_assert_int_eq(r.state, SCC_HIT);
+    ck_assert_msg(r.toi <= c.toi && r.toi >= c.toi_lower, "FWGSS toi %.10f outside the certified bracket [%.10f, %.10f]", r.toi, c.toi_lower, c.toi);
+    ck_assert_double_le(r.toi, first + 1e-9);
+    ck_assert_int_lt(r.evals, own_evals);
+    scc_bsh_destroy((scc_bsh*)mesh.bsh, &k_alloc);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("fall");
@@ -170,6 +246,7 @@ int main(void)
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, test_armadillo_1k_on_spikes);
     tcase_add_test(tc, test_spike_apex_triangle);
+    tcase_add_test(tc, test_deferred_checks);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }
