@@ -115,12 +115,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         const btCollisionObject* co = objs[i];
         if (snapped && !co->isKinematicObject() && (size_t)i < start_poses.size() && start_poses[(size_t)i].first == co)
             return start_poses[(size_t)i].second;
-        const btRigidBody* rb = btRigidBody::upcast(co);
-        const bool kin = co->isKinematicObject() || !rb;
-        btTransform t;
-        btTransformUtil::integrateTransform(co->getWorldTransform(), -(kin ? co->getInterpolationLinearVelocity() : rb->getLinearVelocity()),
-                                            -(kin ? co->getInterpolationAngularVelocity() : rb->getAngularVelocity()), (btScalar)dt, t);
-        return t;
+        return poseBefore(co, dt);
     };
     if (!workspace && sdfccd_create_workspace(&workspace) != SDFCCD_OK) workspace = nullptr;
     sdfccd_GuardParams gp = sdfccd_default_guard_params();

@@ -40,6 +40,10 @@ struct ObjectWrapper : btCollisionObjectWrapper {
     explicit ObjectWrapper(const btCollisionObject* o) : btCollisionObjectWrapper(nullptr, o->getCollisionShape(), o, o->getWorldTransform(), -1, -1) {}
 };
 
+// The pose `dt` before the object's current one: its pose moved back by its velocities (a kinematic
+// object's, or one that is no rigid body, by its interpolation velocities), undoing Bullet's integration.
+btTransform poseBefore(const btCollisionObject* co, double dt);
+
 // The motion of a body (or compound child: `wrapper_transform` includes its offset) over a step:
 // from its start pose to its end pose with the constant velocities that connect them in Bullet's
 // motion model (origin lerp + exponential-map rotation), sdfccd's too.

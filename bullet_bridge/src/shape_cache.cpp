@@ -23,6 +23,16 @@ sdfccd_Pose toPose(const btTransform& t)
     return p;
 }
 
+btTransform poseBefore(const btCollisionObject* co, double dt)
+{
+    const btRigidBody* rb = btRigidBody::upcast(co);
+    const bool kin = co->isKinematicObject() || !rb;
+    btTransform t;
+    btTransformUtil::integrateTransform(co->getWorldTransform(), -(kin ? co->getInterpolationLinearVelocity() : rb->getLinearVelocity()),
+                                        -(kin ? co->getInterpolationAngularVelocity() : rb->getAngularVelocity()), (btScalar)dt, t);
+    return t;
+}
+
 sdfccd_RigidMotion motionOf(const btCollisionObject* co, const btTransform& wrapper_transform, double dt)
 {
     btTransform t0 = wrapper_transform, t1 = wrapper_transform;
@@ -35,10 +45,7 @@ sdfccd_RigidMotion motionOf(const btCollisionObject* co, const btTransform& wrap
     // interpolation transform is its predicted end (predictUnconstraintMotion).
     const bool kinematic = co->isKinematicObject(), moving = dt > 0 && (kinematic || !co->isStaticObject());
     if (moving && kinematic) {
-        btTransform body0;
-        btTransformUtil::integrateTransform(co->getWorldTransform(), -co->getInterpolationLinearVelocity(),
-                                            -co->getInterpolationAngularVelocity(), (btScalar)dt, body0);
-        t0 = body0 * child;
+        t0 = poseBefore(co, dt) * child;
     } else if (moving) {
         t1 = co->getInterpolationWorldTransform() * child;
     }

@@ -208,9 +208,7 @@ btTransform startPose(const btCollisionObject* co, double dt)
 {
     const btRigidBody* rb = btRigidBody::upcast(co);
     if (!rb || (rb->isStaticObject() && !rb->isKinematicObject()) || !(dt > 0)) return co->getWorldTransform(); // (mass 0: both flags)
-    btTransform x;
-    btTransformUtil::integrateTransform(co->getWorldTransform(), -rb->getLinearVelocity(), -rb->getAngularVelocity(), (btScalar)dt, x);
-    return x;
+    return poseBefore(co, dt);
 }
 
 // The contact planes of the pair (sdfccd_soft_contacts): held in Bullet's solve against a static or
