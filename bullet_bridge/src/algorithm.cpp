@@ -128,8 +128,7 @@ struct BridgeImpl::CreateFunc : public btCollisionAlgorithmCreateFunc {
         bool mesh_is_body1 = false;
         if (!bridge->orient(w0, w1, mesh_is_body1)) {
             // Not ours after all (a GImpact compound, an SdfShape without a valid handle): what
-            // the slot held before us, counted so check() can report it.
-            bridge->stats.fallbacks++;
+            // the slot held before us.
             btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(ci.m_dispatcher1);
             const int t0 = w0->getCollisionShape()->getShapeType(), t1 = w1->getCollisionShape()->getShapeType();
             if (!closest && (t0 == GIMPACT_SHAPE_PROXYTYPE || t1 == GIMPACT_SHAPE_PROXYTYPE))
@@ -180,7 +179,7 @@ bool BridgeImpl::isMeshLike(const btCollisionShape* s) const
     if (type == GIMPACT_SHAPE_PROXYTYPE)
         return static_cast<const btGImpactShapeInterface*>(s)->getGImpactShapeType() != CONST_GIMPACT_COMPOUND_SHAPE;
     if (s->isConvex()) return cfg.convex_shapes;
-    if (type == cfg.sdf_shape_type && cfg.sdf_pairs) {
+    if (type == cfg.sdf_shape_type) {
         const SdfShape* shape = dynamic_cast<const SdfShape*>(s);
         return shape && shape->isValid() && shape->hasFiniteBounds();
     }
@@ -224,7 +223,7 @@ std::vector<std::pair<int, int>> slots(const Config& cfg)
     if (cfg.handle_bt_sdf_shape && cfg.sdf_shape_type != SDF_SHAPE_PROXYTYPE) both(GIMPACT_SHAPE_PROXYTYPE, SDF_SHAPE_PROXYTYPE);
     if (cfg.convex_shapes)
         for (int t = 0; t < CONCAVE_SHAPES_START_HERE; ++t) both(t, cfg.sdf_shape_type);
-    if (cfg.sdf_pairs) both(cfg.sdf_shape_type, cfg.sdf_shape_type);
+    both(cfg.sdf_shape_type, cfg.sdf_shape_type);
     return s;
 }
 
@@ -264,16 +263,8 @@ void say(std::string* message, const char* fmt, const char* a = "", long long n 
 // ---------------------------------------------------------------------------------------------
 const char* statusString(Status s)
 {
-    switch (s) {
-    case Status::Ok: return "Ok";
-    case Status::AlreadyRegistered: return "AlreadyRegistered";
-    case Status::TooLate: return "TooLate";
-    case Status::Overwritten: return "Overwritten";
-    case Status::NotRegistered: return "NotRegistered";
-    case Status::InvalidArgument: return "InvalidArgument";
-    case Status::InvalidShape: return "InvalidShape";
-    }
-    return "?";
+    static const char* const names[] = { "Ok", "AlreadyRegistered", "TooLate", "Overwritten", "NotRegistered", "InvalidArgument", "InvalidShape" };
+    return (unsigned)s < sizeof names / sizeof names[0] ? names[(unsigned)s] : "?";
 }
 
 std::size_t collisionAlgorithmSize() { return sizeof(MeshSdfAlgorithm); }
@@ -296,8 +287,8 @@ Bridge::~Bridge()
 
 Status Bridge::registerWith(btCollisionWorld* world)
 {
-    if (!world) return Status::InvalidArgument;
-    btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(world->getDispatcher());
+    const Config& cfg = m_impl->cfg;
+    btCollisionDispatcher* d = world ? dynamic_cast<btCollisionDispatcher*>(world->getDispatcher()) : nullptr;
     if (!d) return Status::InvalidArgument;
     if (m_impl->dispatcher) return Status::AlreadyRegistered;
     {
@@ -307,27 +298,12 @@ Status Bridge::registerWith(btCollisionWorld* world)
     const btCollisionObjectArray& objs = world->getCollisionObjectArray();
     for (int i = 0; i < objs.size(); ++i) {
         const btCollisionShape* s = objs[i]->getCollisionShape();
-        if (s->getShapeType() == GIMPACT_SHAPE_PROXYTYPE || s->getShapeType() == m_impl->cfg.sdf_shape_type ||
-            m_impl->isOurSdf(s))
+        if (s->getShapeType() == GIMPACT_SHAPE_PROXYTYPE || s->getShapeType() == cfg.sdf_shape_type || m_impl->isOurSdf(s))
             return Status::TooLate;
     }
-    const Status s = registerWith(d);
-    if (s == Status::Ok) {
-        guardAttach(m_impl, world);
-        softAttach(m_impl, world);
-        m_impl->batch_world = world;
-    }
-    return s;
-}
-
-Status Bridge::registerWith(btCollisionDispatcher* d)
-{
-    const Config& cfg = m_impl->cfg;
-    if (!d) return Status::InvalidArgument;
     if (!(cfg.sdf_shape_type > CONCAVE_SHAPES_START_HERE && cfg.sdf_shape_type < CONCAVE_SHAPES_END_HERE) ||
         cfg.sdf_shape_type == GIMPACT_SHAPE_PROXYTYPE)
         return Status::InvalidArgument;
-    if (m_impl->dispatcher) return Status::AlreadyRegistered;
     {
         std::lock_guard<std::mutex> lock(g_registry_mutex);
         if (g_registered.count(d)) return Status::AlreadyRegistered;
@@ -338,17 +314,20 @@ Status Bridge::registerWith(btCollisionDispatcher* d)
     btGImpactCollisionAlgorithm::registerAlgorithm(d);
     for (const auto& s : slots(cfg)) {
         d->registerCollisionCreateFunc(s.first, s.second, m_impl->fn[0].get());
-        if (cfg.closest_points) d->registerClosestPointsCreateFunc(s.first, s.second, m_impl->fn[1].get());
+        d->registerClosestPointsCreateFunc(s.first, s.second, m_impl->fn[1].get());
     }
     softRegister(m_impl, d);
     m_impl->dispatcher = d;
+    guardAttach(m_impl, world);
+    softAttach(m_impl, world);
+    m_impl->batch_world = world;
     return verify();
 }
 
 Status Bridge::verify() const
 {
     if (!m_impl->dispatcher) return Status::NotRegistered;
-    return intact(m_impl, slots(m_impl->cfg), m_impl->cfg.closest_points) ? Status::Ok : Status::Overwritten;
+    return intact(m_impl, slots(m_impl->cfg), true) ? Status::Ok : Status::Overwritten;
 }
 
 Status Bridge::check(btCollisionWorld* world, std::string* message) const
@@ -376,21 +355,6 @@ Status Bridge::check(btCollisionWorld* world, std::string* message) const
         if (!s->isValid() || sdfccd_sdf_get_info(s->sdf(), &info) != SDFCCD_OK) {
             say(message, "collision object %lld has an SdfShape whose sdfccd handle is invalid or destroyed", "", i);
             return Status::InvalidShape;
-        }
-    }
-    // Pairs whose algorithm was created before the registration keep it.
-    btBroadphasePairArray& pairs = world->getPairCache()->getOverlappingPairArray();
-    for (int i = 0; i < pairs.size(); ++i) {
-        const btBroadphasePair& p = pairs[i];
-        if (!p.m_algorithm || !p.m_pProxy0 || !p.m_pProxy1) continue;
-        const btCollisionObject* a = static_cast<const btCollisionObject*>(p.m_pProxy0->m_clientObject);
-        const btCollisionObject* b = static_cast<const btCollisionObject*>(p.m_pProxy1->m_clientObject);
-        const ObjectWrapper wa(a), wb(b);
-        bool swapped;
-        if (m_impl->orient(&wa, &wb, swapped) && !dynamic_cast<MeshSdfAlgorithm*>(p.m_algorithm)) {
-            say(message, "a mesh-SDF pair has an algorithm created before Bridge::registerWith (register before adding "
-                         "bodies)");
-            return Status::TooLate;
         }
     }
     if (m_impl->stats.query_errors > 0)
@@ -476,17 +440,12 @@ void detail::callMisuseHandler(Status status, const char* message, const btColli
 
 namespace detail {
 
-bool isGImpactCallback(const btTriangleCallback* callback)
+void reportGImpactMisuse(const btTriangleCallback* callback, const btCollisionShape* shape, int& last_reported)
 {
     // btGImpactTriangleCallback is private to btGImpactCollisionAlgorithm.cpp: recognised by its
     // type name (RTTI is on in Debian's builds). Not recognising it only loses the report.
-    if (!callback) return false;
-    const char* name = typeid(*callback).name();
-    return name && std::strstr(name, "btGImpactTriangleCallback") != nullptr;
-}
-
-void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported)
-{
+    const char* name = callback ? typeid(*callback).name() : nullptr;
+    if (!name || !std::strstr(name, "btGImpactTriangleCallback")) return;
     // Which mistake it most likely is, from the bridges this process has registered (check(world)
     // knows the world and tells exactly).
     Status status = Status::NotRegistered;

@@ -165,10 +165,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         which.clear();
         for (const SdfObject& o : sdfs) {
             if (o.co == body || !TestAabbAgainstAabb2(lo, hi, o.lo, o.hi)) continue;
-            if (t0 == t1 && o.t0 == o.t1) { // neither moved (a sleeping body): nothing went deeper
-                stats.guard_skipped++;
-                continue;
-            }
+            if (t0 == t1 && o.t0 == o.t1) continue; // neither moved (a sleeping body): nothing went deeper
             if (parts.empty()) leaves(shape, btTransform::getIdentity(), parts);
             for (const auto& part : parts) {
                 if (part.first == o.co->getCollisionShape() || !isMeshLike(part.first)) continue;
@@ -189,7 +186,6 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         if (pairs.empty() || sdfccd_guard_body(workspace, pairs.data(), (int32_t)pairs.size(), 0, dt, &gp, &r) != SDFCCD_OK) continue;
         stats.query_errors += r.failed;
         stats.sdf_evaluations += r.sdf_evaluations;
-        stats.guard_skipped += r.certified;
         if (r.index < 0) continue;
         const sdfccd_GuardResult& best = r.first;
         const SdfObject* best_sdf = which[(size_t)r.index].first;

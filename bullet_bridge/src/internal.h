@@ -35,10 +35,6 @@ inline sdfccd_Vec3 v3(const btVector3& v)
 }
 inline btVector3 bt(const sdfccd_Vec3& v) { return btVector3((btScalar)v.x, (btScalar)v.y, (btScalar)v.z); }
 sdfccd_Pose toPose(const btTransform& t);
-// A top-level object as Bullet's dispatcher sees it (its own shape at its world transform).
-struct ObjectWrapper : btCollisionObjectWrapper {
-    explicit ObjectWrapper(const btCollisionObject* o) : btCollisionObjectWrapper(nullptr, o->getCollisionShape(), o, o->getWorldTransform(), -1, -1) {}
-};
 
 // The pose `dt` before the object's current one: its pose moved back by its velocities (a kinematic
 // object's, or one that is no rigid body, by its interpolation velocities), undoing Bullet's integration.
@@ -120,16 +116,13 @@ struct ObjectPairHash {
     size_t operator()(const ObjectPair& k) const { return std::hash<const void*>()(k.first) * 31u + std::hash<const void*>()(k.second); }
 };
 
-class MeshSdfAlgorithm;
 // The kept ids of a pair's algorithm when it is the bridge's (contact points), else NULL.
 KeptIds* keptIdsOf(btCollisionAlgorithm* algorithm);
 
-/** True when `callback` is Bullet's GImpact algorithm's triangle callback (btGImpactTriangleCallback). */
-bool isGImpactCallback(const btTriangleCallback* callback);
-/** Diagnoses Bullet's GImpact algorithm colliding with `shape` and reports it through the misuse
- * handler unless the diagnosis equals the last one reported for the shape (`last_reported`:
- * 0 = none, else the Status + 1; updated). */
-void reportGImpactMisuse(const btCollisionShape* shape, int& last_reported);
+/** When `callback` is Bullet's GImpact algorithm's (btGImpactTriangleCallback), i.e. that algorithm
+ * collides with `shape`: diagnoses why and reports it through the misuse handler unless the diagnosis
+ * equals the last one reported for the shape (`last_reported`: 0 = none, else the Status + 1; updated). */
+void reportGImpactMisuse(const btTriangleCallback* callback, const btCollisionShape* shape, int& last_reported);
 // The guarantee's action (Config::guard_tolerance): added to a dynamics world at registration,
 // removed by unregister().
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world);

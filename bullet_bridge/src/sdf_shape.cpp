@@ -65,15 +65,6 @@ SdfShape::SdfShape(sdfccd_SdfId sdf, int shape_type) : m_impl(new Impl)
     }
 }
 
-SdfShape* SdfShape::create(sdfccd_SdfId sdf, int shape_type, sdfccd_Status* status)
-{
-    sdfccd_SdfInfo info;
-    sdfccd_Status st = sdfccd_sdf_get_info(sdf, &info);
-    if (status) *status = st;
-    if (st != SDFCCD_OK) return nullptr;
-    return new SdfShape(sdf, shape_type);
-}
-
 SdfShape::~SdfShape()
 {
     m_impl->drop();
@@ -230,7 +221,7 @@ void SdfShape::processAllTriangles(btTriangleCallback* callback, const btVector3
     // A registered bridge handles every GImpact mesh against a valid SdfShape, so Bullet's GImpact
     // algorithm asking for our triangles means the bridge is not in charge of the pair (reported
     // once per shape and diagnosis).
-    if (m_impl->valid && detail::isGImpactCallback(callback)) detail::reportGImpactMisuse(this, m_impl->misuse_reported);
+    if (m_impl->valid) detail::reportGImpactMisuse(callback, this, m_impl->misuse_reported);
     if (!m_impl->triangulated) buildTriangulation();
     if (m_impl->bvh) m_impl->bvh->processAllTriangles(callback, aabbMin, aabbMax);
 }

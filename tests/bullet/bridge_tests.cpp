@@ -1425,25 +1425,22 @@ static void test_misuse()
         CHECK(bridge.check(&w.world, &msg) == Status::Overwritten, "overwritten: %s", msg.c_str());
     }
     {
-        // Too late: the pair's algorithm was created (GImpact's) before the bridge's registration.
+        // Too late: the pair's algorithm was created (GImpact's) before the registration, which is refused.
         Bridge bridge;
         World w;
         btGImpactCollisionAlgorithm::registerAlgorithm(&w.dispatcher);
         CubeOverSlab pair(w, slab);
         w.world.performDiscreteCollisionDetection();
-        CHECK(bridge.registerWith(&w.dispatcher) == Status::Ok, "register on the dispatcher");
-        CHECK(bridge.check(&w.world, &msg) == Status::TooLate, "too late: %s", msg.c_str());
+        CHECK(bridge.registerWith(&w.world) == Status::TooLate, "late registration accepted");
+        CHECK(bridge.check(&w.world, &msg) == Status::NotRegistered, "too late: %s", msg.c_str());
     }
     {
         // Invalid and destroyed handles.
         sdfccd_SdfId null_id = { 0, 0 };
-        sdfccd_Status st = SDFCCD_OK;
-        CHECK(SdfShape::create(null_id, sdfccd_bullet::kDefaultSdfShapeType, &st) == nullptr && st != SDFCCD_OK,
-              "SdfShape::create accepted a null handle");
         sdfccd_SdfId ball = { 0, 0 };
         CHECK(sdfccd_create_sphere(0.5, &ball) == SDFCCD_OK, "sphere");
-        std::unique_ptr<SdfShape> ok(SdfShape::create(ball));
-        CHECK(ok && ok->isValid(), "SdfShape::create refused a live handle");
+        std::unique_ptr<SdfShape> ok(new SdfShape(ball));
+        CHECK(ok->isValid(), "a live handle makes an invalid shape");
         SdfShape dead(null_id);
         CHECK(!dead.isValid(), "a null handle makes a valid shape");
         btTransform id;
@@ -1488,6 +1485,8 @@ static MisuseLog misuseRun(MisuseMode mode, sdfccd_SdfId slab, int* first_step, 
     setMisuseHandler(recordMisuse, &log);
     *first_step = -1;
     {
+        Bridge other; // kTooLate: a bridge registered with another world (the report cannot tell which world it is)
+        World other_world;
         Bridge bridge;
         World w;
         if (mode == kRegistered || mode == kOverwritten) CHECK(bridge.registerWith(&w.world) == Status::Ok, "register");
@@ -1496,10 +1495,10 @@ static MisuseLog misuseRun(MisuseMode mode, sdfccd_SdfId slab, int* first_step, 
         pair.body->setActivationState(DISABLE_DEACTIVATION);
         for (int i = 0; i < 5; ++i) {
             if (mode == kTooLate && i == 1) {
-                // The pair's (GImpact) algorithm exists (no contact point yet, so the dispatcher
-                // accepts the registration); registering now is too late for the pair.
-                CHECK(bridge.registerWith(&w.dispatcher) == Status::Ok, "register on the dispatcher");
-                CHECK(bridge.check(&w.world) == Status::TooLate, "check() does not see the too-late pair");
+                // The pair's (GImpact) algorithm exists: registering now is refused, while a bridge is
+                // registered with another world.
+                CHECK(bridge.registerWith(&w.world) == Status::TooLate, "late registration accepted");
+                CHECK(other.registerWith(&other_world.world) == Status::Ok, "register the other world");
             }
             int before = log.calls;
             w.step();
@@ -1512,7 +1511,7 @@ static MisuseLog misuseRun(MisuseMode mode, sdfccd_SdfId slab, int* first_step, 
             w.world.rayTest(btVector3(2, 2, 1), btVector3(2, 2, -1), ray);
             *ray_hit = ray.hasHit();
         }
-        if (mode == kTooLate) bridge.unregister();
+        if (mode == kTooLate) other.unregister();
     }
     setMisuseHandler(nullptr);
     return log;
@@ -1536,7 +1535,7 @@ static void test_misuse_handler()
     MisuseLog ow = misuseRun(kOverwritten, slab, &first);
     CHECK(ow.calls == 1 && ow.last == Status::Overwritten && first == 0, "overwritten: %d reports, last %s, first step %d", ow.calls,
           statusString(ow.last), first);
-    // Registered after the pair existed: NotRegistered before the registration, TooLate after it.
+    // Registered too late (refused) while another world has a bridge: NotRegistered, then TooLate.
     MisuseLog tl = misuseRun(kTooLate, slab, &first);
     CHECK(tl.calls == 2 && tl.last == Status::TooLate && first == 0, "too late: %d reports, last %s, first step %d", tl.calls,
           statusString(tl.last), first);

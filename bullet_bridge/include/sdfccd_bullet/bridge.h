@@ -22,7 +22,6 @@
 #include "config.h"
 #include "sdf_shape.h"
 
-class btCollisionDispatcher;
 class btCollisionShape;
 class btCollisionWorld;
 class btCollisionObject;
@@ -62,8 +61,6 @@ struct Config {
     int sdf_shape_type = kDefaultSdfShapeType;
     /** Also handle GImpact vs Bullet's btSdfCollisionShape (type 29). Default on. */
     bool handle_bt_sdf_shape = true;
-    /** Register the closest-points table too (contactTest, contactPairTest). Default on. */
-    bool closest_points = true;
     /** Features within this distance (m) of the SDF count as in contact. Default 0.01 m. */
     double contact_margin = 0.01;
     /** Contacts per pair and step in the pair's first manifold, 1..4 (cover points may add up to
@@ -76,10 +73,6 @@ struct Config {
     /** Handle convex shapes against SdfShape as triangles (a box's 12, others' btShapeHull).
      * Off: Bullet's convex-concave algorithm on the triangulation, no CCD. Default on. */
     bool convex_shapes = true;
-    /** Handle SdfShape vs SdfShape: the moving shape's triangulation (SdfShape::buildTriangulation)
-     * against the other's field. Off: such pairs have no algorithm and pass through each other
-     * (check() cannot see that; keep it on unless no two SDF bodies can meet). Default on. */
-    bool sdf_pairs = true;
     /** Threads for the contact sets of a step (1..256; default 1). With more, the first pair of a step
      * makes the sets of every pair in the world's pair cache (sdfccd_generate_contacts_batch; needs
      * registerWith(world); a callback SDF must then be thread-safe); each set is bitwise the one the
@@ -107,10 +100,8 @@ struct Stats {
     int64_t speculative_contacts = 0;  /**< Contacts written for impacts inside a step. */
     int64_t ordinary_contacts = 0;     /**< Contacts written for features in contact at step start. */
     int64_t query_errors = 0;          /**< Queries that failed or had no mesh/SDF to work with (no contacts written). */
-    int64_t fallbacks = 0;             /**< Pairs handed back to Bullet's algorithm (GImpact compounds, dead SdfShapes). */
     int64_t guard_queries = 0;         /**< Executed motions checked by the guarantee (one per body part and SDF). */
     int64_t rollbacks = 0;             /**< Bodies the guarantee put back at their time of impact. */
-    int64_t guard_skipped = 0;         /**< Checks the guarantee settled without a CCD (no motion, or certified clear). */
     int64_t face_regions = 0;          /**< Regions visited by the face search (SdfShape::setFeatureSize). */
     int64_t batched_queries = 0;       /**< Queries of contact sets taken from a step's batch (Config::batch_threads);
                                             they are counted in queries, end_pose_queries and sdf_evaluations too. */
@@ -135,19 +126,18 @@ public:
     Bridge(const Bridge&) = delete;
     Bridge& operator=(const Bridge&) = delete;
 
-    /** Registers the bridge (after GImpact's own registration, which it calls) for every pair it
-     * handles, in both tables, then verifies it. TooLate when the world already holds GImpact or
-     * SDF bodies, AlreadyRegistered when a bridge is; nothing changes then. */
+    /** Registers the bridge with the world's dispatcher (after GImpact's own registration, which it
+     * calls) for every pair it handles, in both tables, then verifies it. TooLate when the world
+     * already holds GImpact or SDF bodies or contact manifolds, AlreadyRegistered when a bridge is;
+     * nothing changes then. */
     Status registerWith(btCollisionWorld* world);
-    /** The same for a bare dispatcher ("too late" only when it already holds manifolds). */
-    Status registerWith(btCollisionDispatcher* dispatcher);
 
     /** Ok when the dispatcher still creates our algorithm, Overwritten when something replaced
      * it, NotRegistered before registerWith(). Cheap. */
     Status verify() const;
 
-    /** The first misuse found in `world` (NotRegistered, Overwritten, InvalidShape, TooLate; else
-     * Ok), with a sentence in `*message` if given. Call after adding bodies. */
+    /** The first misuse found in `world` (NotRegistered, Overwritten, InvalidShape; else Ok), with
+     * a sentence in `*message` if given. Call after adding bodies. */
     Status check(btCollisionWorld* world, std::string* message = nullptr) const;
 
     /** Restores the dispatcher's defaults (GImpact's registration too), removes the guarantee's

@@ -27,8 +27,6 @@ public:
     /** Wraps `sdf` (not owned; keep it alive while the shape lives) in the body's frame.
      * `shape_type`: a concave id no other shape uses, the bridge's Config::sdf_shape_type. */
     explicit SdfShape(sdfccd_SdfId sdf, int shape_type = kDefaultSdfShapeType);
-    /** The constructor, or NULL (and `*status`, if given) when `sdf` is not a live handle. */
-    static SdfShape* create(sdfccd_SdfId sdf, int shape_type = kDefaultSdfShapeType, sdfccd_Status* status = nullptr);
     /** False when the handle was not live at construction: an empty box, and no pairs. */
     bool isValid() const;
     ~SdfShape() override;
