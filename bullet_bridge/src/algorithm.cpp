@@ -126,10 +126,10 @@ struct BridgeImpl::CreateFunc : public btCollisionAlgorithmCreateFunc {
                                                    const btCollisionObjectWrapper* w1) override
     {
         bool mesh_is_body1 = false;
+        btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(ci.m_dispatcher1);
         if (!bridge->orient(w0, w1, mesh_is_body1)) {
             // Not ours after all (a GImpact compound, an SdfShape without a valid handle): what
             // the slot held before us.
-            btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(ci.m_dispatcher1);
             const int t0 = w0->getCollisionShape()->getShapeType(), t1 = w1->getCollisionShape()->getShapeType();
             if (!closest && (t0 == GIMPACT_SHAPE_PROXYTYPE || t1 == GIMPACT_SHAPE_PROXYTYPE))
                 return bridge->gimpact_fn.CreateCollisionAlgorithm(ci, w0, w1);
@@ -140,7 +140,6 @@ struct BridgeImpl::CreateFunc : public btCollisionAlgorithmCreateFunc {
             return f ? f->CreateCollisionAlgorithm(ci, w0, w1) : nullptr;
         }
         void* mem = nullptr;
-        btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(ci.m_dispatcher1);
         btPoolAllocator* pool = d ? d->getCollisionConfiguration()->getCollisionAlgorithmPool() : nullptr;
         if (pool && pool->getElementSize() >= (int)sizeof(MeshSdfAlgorithm))
             mem = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(MeshSdfAlgorithm));

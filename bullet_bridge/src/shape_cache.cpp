@@ -172,11 +172,8 @@ int32_t queryPointField(sdfccd_Vec3 p, double* out_value, sdfccd_Vec3* out_grad,
 // queryPoint as a sample of the field (sdfccd_sdf_compare_samples).
 int32_t queryPointSample(sdfccd_Vec3 p, double* out_value, void* shape)
 {
-    btScalar d = 0;
-    btVector3 n;
-    if (!static_cast<btSdfCollisionShape*>(shape)->queryPoint(bt(p), d, n)) return 0;
-    *out_value = (double)d;
-    return 1;
+    sdfccd_Vec3 unused;
+    return queryPointField(p, out_value, &unused, shape);
 }
 
 // The shape's box in its own frame, and its diagonal.
