@@ -46,7 +46,6 @@ struct SoftBodyStats {
     int64_t guard_nodes = 0;    /**< Nodes the guard moved back to a time of impact. */
     int64_t query_errors = 0;   /**< Queries that failed (no contact written for that face). */
     int64_t refused = 0;        /**< Pairs refused: an SdfShape with a dead handle (reported as misuse). */
-    int64_t held_nodes = 0;     /**< Nodes a held plane moved in the solve's last pass (per plane and step). */
 };
 
 /** The soft-body counters of `bridge`. */
