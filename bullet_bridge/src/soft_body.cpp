@@ -109,8 +109,6 @@ struct SoftState {
     btSoftBodySolver* inner = nullptr;
     GuardingSolver* wrapper = nullptr;
     bool guarded_this_step = false;
-    bool auto_guard = true;
-    double auto_tolerance = 5e-4;
     // Scratch of the C API calls: the body's arrays, nodes in the hold, the guard's verdicts.
     std::vector<sdfccd_Vec3> end, x, v;
     std::vector<uint8_t> pinned;
@@ -399,8 +397,9 @@ void GuardingSolver::solveConstraints(btScalar dt)
     for (int i = 0; i < softs.size(); ++i)
         if (softs[i]->isActive() && !softs[i]->isStaticObject()) solveHeld(state, softs[i]);
     for (auto& r : state->records) r.second.holds.clear(); // this step's planes
-    if (state->auto_guard && state->impl->cfg.query.method != SDFCCD_METHOD_DCD) {
-        guardWorld(state, state->world, state->auto_tolerance);
+    const Config& cfg = state->impl->cfg;
+    if (cfg.guard_tolerance > 0 && cfg.query.method != SDFCCD_METHOD_DCD) { // the guarantee's tolerance
+        guardWorld(state, state->world, cfg.guard_tolerance);
         state->guarded_this_step = true;
     }
 }
@@ -508,16 +507,6 @@ SoftBodyStats softBodyStats(const Bridge& bridge)
 {
     const detail::SoftState* st = detail::softOf(BridgeAccess::of(const_cast<Bridge&>(bridge)));
     return st ? st->stats : SoftBodyStats();
-}
-
-bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance)
-{
-    detail::SoftState* st = detail::softOf(BridgeAccess::of(bridge));
-    if (!st || !(tolerance > 0) || !std::isfinite(tolerance)) return false;
-    st->auto_guard = on;
-    st->auto_tolerance = tolerance;
-    st->guarded_this_step = false;
-    return st->wrapper != nullptr;
 }
 
 int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tolerance)

@@ -17,7 +17,8 @@
  * The guarantee, sdfccd_soft_guard(): no node or face point (rope: link point) ends a step deeper
  * than the tolerance past its time of impact; a node put back loses its velocity into the surface.
  * With Bullet's own (CPU) solver in a btSoftRigidDynamicsWorld it runs by itself after each
- * soft-body solve, in every internal step: the bridge wraps the world's solver (put back by
+ * soft-body solve, in every internal step, with the rigid bodies' tolerance Config::guard_tolerance
+ * (<= 0: off): the bridge wraps the world's solver (put back by
  * Bridge::unregister(); the world frees it otherwise). Other solvers, or a world registered as a
  * bare dispatcher: call guardSoftBodies() after each stepSimulation with at most one internal step.
  *
@@ -50,11 +51,6 @@ struct SoftBodyStats {
 
 /** The soft-body counters of `bridge`. */
 SoftBodyStats softBodyStats(const Bridge& bridge);
-
-/** Turns the automatic guard (see the file comment) on or off and sets its tolerance (m, > 0;
- * default on, 5e-4). Returns true when the automatic guard is installed in a world (false: bad
- * tolerance, bridge never registered, or no btSoftRigidDynamicsWorld with Bullet's solver). */
-bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance = 5e-4);
 
 /** The soft-body guarantee (sdfccd_soft_guard(), see the file comment) for the step just taken by
  * `world`, over every soft body the bridge collided with an SDF in it, from its nodes' start
