@@ -101,6 +101,7 @@ struct SoftState {
     std::vector<std::pair<int, int>> slots;
     btCollisionDispatcher* dispatcher = nullptr;
     SoftBodyStats stats;
+    sdfccd_SoftStats totals = { 0, 0, 0 }; // the C functions' counters (face queries, errors, evaluations)
     std::map<std::pair<const void*, const void*>, SoftRecord> records;
     std::set<const btCollisionShape*> reported;
     // The automatic guard (registerWith a btSoftRigidDynamicsWorld): the world, the solver it had when
@@ -134,12 +135,6 @@ struct SoftState {
         for (int l = 0; l < nl; ++l)
             for (int k = 0; k < 2; ++k) links[2 * (size_t)l + k] = (int32_t)(psb->m_links[l].m_n[k] - &psb->m_nodes[0]);
         return sdfccd_SoftBody{ nn, rec.start.data(), end.data(), pinned.data(), nf, faces.data(), nl, links.data(), kSinglePrecision };
-    }
-    void count(const sdfccd_SoftStats& s)
-    {
-        stats.face_queries += s.face_queries;
-        stats.query_errors += s.query_errors;
-        stats.sdf_evaluations += s.sdf_evaluations;
     }
 };
 
@@ -239,11 +234,9 @@ void SoftSdfAlgorithm::processCollision(const btCollisionObjectWrapper* w0, cons
     const sdfccd_Frame frame = frameOf(sw->getWorldTransform());
     st->planes.resize(2 * (size_t)body.node_count);
     int32_t count = 0;
-    sdfccd_SoftStats s = { 0, 0, 0 };
     if (sdfccd_soft_contacts(sdf, &frame, &body, &params, rec.node_certs.data(), rec.face_certs.data(), st->planes.data(),
-                             (int32_t)st->planes.size(), &count, &s) != SDFCCD_OK)
-        ++s.query_errors;
-    st->count(s);
+                             (int32_t)st->planes.size(), &count, &st->totals) != SDFCCD_OK)
+        ++st->totals.query_errors;
     for (int32_t k = 0; k < count; ++k) {
         const sdfccd_SoftPlane& pl = st->planes[(size_t)k];
         ++(pl.face ? st->stats.face_contacts : st->stats.node_contacts);
@@ -306,14 +299,11 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     const sdfccd_SoftBody body = st->bodyOf(psb, rec);
     const sdfccd_Frame F0 = frameOf(rec.sdf_pose), F = frameOf(rec.sdf_object->getWorldTransform());
     st->guarded.resize((size_t)nn);
-    sdfccd_SoftStats s = { 0, 0, 0 };
     int32_t moved = 0;
     const double dt = psb->m_sst.sdt > 0 ? psb->m_sst.sdt : 1.0;
-    const sdfccd_Status status = sdfccd_soft_guard(rec.sdf, &F0, &F, &body, tol, dt, &st->impl->cfg.query, rec.node_certs.data(),
-                                                   rec.face_certs.data(), st->guarded.data(), &moved, &s);
-    st->count(s);
-    if (status != SDFCCD_OK) {
-        ++st->stats.query_errors;
+    if (sdfccd_soft_guard(rec.sdf, &F0, &F, &body, tol, dt, &st->impl->cfg.query, rec.node_certs.data(), rec.face_certs.data(),
+                          st->guarded.data(), &moved, &st->totals) != SDFCCD_OK) {
+        ++st->totals.query_errors;
         return 0;
     }
     const double inv_dt = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
@@ -506,7 +496,10 @@ void softForget(BridgeImpl* impl)
 SoftBodyStats softBodyStats(const Bridge& bridge)
 {
     const detail::SoftState* st = detail::softOf(BridgeAccess::of(const_cast<Bridge&>(bridge)));
-    return st ? st->stats : SoftBodyStats();
+    if (!st) return SoftBodyStats();
+    SoftBodyStats s = st->stats;
+    s.face_queries = st->totals.face_queries, s.query_errors = st->totals.query_errors, s.sdf_evaluations = st->totals.sdf_evaluations;
+    return s;
 }
 
 int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tolerance)
