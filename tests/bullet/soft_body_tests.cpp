@@ -12,10 +12,12 @@
 #include <iterator>
 #include <memory>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/CollisionShapes/btSdfCollisionShape.h>
+#include <BulletSoftBody/btDefaultSoftBodySolver.h>
 #include <BulletSoftBody/btSoftBody.h>
 #include <BulletSoftBody/btSoftBodyHelpers.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
@@ -48,12 +50,14 @@ struct SoftWorld {
     btCollisionDispatcher dispatcher{ &config };
     btDbvtBroadphase broadphase;
     btSequentialImpulseConstraintSolver solver;
-    btSoftRigidDynamicsWorld world{ &dispatcher, &broadphase, &solver, &config };
+    btSoftRigidDynamicsWorld world;
     Bridge* bridge;
     bool guard = true;
     std::vector<std::unique_ptr<btCollisionObject>> statics;
     std::vector<btSoftBody*> softs;
-    explicit SoftWorld(Bridge* b) : bridge(b)
+    // soft_solver: the caller's soft-body solver (NULL: the world makes and owns Bullet's).
+    explicit SoftWorld(Bridge* b, btSoftBodySolver* soft_solver = nullptr)
+        : world(&dispatcher, &broadphase, &solver, &config, soft_solver), bridge(b)
     {
         world.setGravity(btVector3(0, 0, -9.81));
         world.getWorldInfo().m_gravity = btVector3(0, 0, -9.81);
@@ -840,6 +844,33 @@ static void test_soft_misuse()
         for (int s = 0; s < 5; ++s) w->world.stepSimulation((btScalar)kDt, 0, (btScalar)kDt);
         CHECK(sdfccd_bullet::softBodyStats(bridge).pair_steps > 0, "no soft-body pair");
         w.reset(); // the bridge's destructor must not touch the freed wrapper (ASan, valgrind)
+        sdfccd_destroy_sdf(plate);
+    }
+
+    // The automatic guard's wrapper in place of the world's soft-body solver, the caller's or the
+    // world's own: the guard runs in it (a 20 m/s cloth stops on a 1 cm plate), and unregister() puts
+    // back the caller's very solver, or a plain Bullet solver for the world's own.
+    for (int callers = 0; callers < 2; ++callers) {
+        sdfccd_SdfId plate;
+        CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.005 }, &plate) == SDFCCD_OK, "plate");
+        btDefaultSoftBodySolver own;
+        Bridge bridge(guardConfig());
+        SdfShape shape(plate);
+        SoftWorld w(&bridge, callers ? &own : nullptr);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&shape, id);
+        btSoftBody* cloth = w.addCloth(0.6, 0.0, 0.0, 0.5, -20.0);
+        const btSoftBodySolver* wrapped = cloth->getSoftBodySolver();
+        CHECK(wrapped && typeid(*wrapped) != typeid(btDefaultSoftBodySolver), "the soft-body solver is not wrapped (%d)", callers);
+        for (int s = 0; s < 30; ++s) w.step();
+        CHECK(minZ(cloth) > 0.004, "the cloth passed the plate (lowest node z = %.4f, %d)", minZ(cloth), callers);
+        bridge.unregister();
+        const btSoftBodySolver* back = cloth->getSoftBodySolver();
+        CHECK(back && typeid(*back) == typeid(btDefaultSoftBodySolver) && (!callers || back == &own),
+              "unregister did not put a plain solver back (%d)", callers);
+        w.bridge = nullptr;
+        for (int s = 0; s < 5; ++s) w.step(); // a plain world again
         sdfccd_destroy_sdf(plate);
     }
 
