@@ -290,7 +290,7 @@ void solveHeld(SoftState* st, btSoftBody* psb)
 
 // The guard of one pair (sdfccd_soft_guard): start positions in the SDF's frame at the start of the
 // step, end positions in its frame now. A node it moves gets Bullet's velocity for its new motion,
-// minus its part into the surface.
+// minus its part into the surface (computed there).
 int guardRecord(SoftState* st, SoftRecord& rec, double tol)
 {
     btSoftBody* psb = const_cast<btSoftBody*>(rec.soft);
@@ -301,22 +301,16 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     st->guarded.resize((size_t)nn);
     int32_t moved = 0;
     const double dt = psb->m_sst.sdt > 0 ? psb->m_sst.sdt : 1.0;
-    if (sdfccd_soft_guard(rec.sdf, &F0, &F, &body, tol, dt, &st->impl->cfg.query, rec.node_certs.data(), rec.face_certs.data(),
+    // Bullet's rule for the velocity after its position solve: (x - q) / dt, damped by kDP.
+    const double vc = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
+    if (sdfccd_soft_guard(rec.sdf, &F0, &F, &body, tol, dt, vc, &st->impl->cfg.query, rec.node_certs.data(), rec.face_certs.data(),
                           st->guarded.data(), &moved, &st->totals) != SDFCCD_OK) {
         ++st->totals.query_errors;
         return 0;
     }
-    const double inv_dt = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
     for (int i = 0; i < nn; ++i) {
         const sdfccd_SoftGuardNode& g = st->guarded[(size_t)i];
-        if (!g.moved) continue;
-        btSoftBody::Node& n = psb->m_nodes[i];
-        const sdfccd_Vec3 &w = g.position, &s0 = rec.start[(size_t)i];
-        n.m_x = bt(w);
-        n.m_v = bt(sdfccd_Vec3{ (w.x - s0.x) * inv_dt, (w.y - s0.y) * inv_dt, (w.z - s0.z) * inv_dt });
-        const btVector3 nrm = bt(g.normal);
-        const btScalar vn = n.m_v.dot(nrm);
-        if (g.stop && vn < 0) n.m_v -= nrm * vn; // no velocity into the surface
+        if (g.moved) psb->m_nodes[i].m_x = bt(g.position), psb->m_nodes[i].m_v = bt(g.velocity);
     }
     return moved;
 }

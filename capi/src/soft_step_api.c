@@ -281,8 +281,23 @@ static int cert_clears(const sdfccd_DistanceCert* dc, const scc_vec3* s, const s
     return scc_cert_bound(&c, s, e, n, L) >= need;
 }
 
+/* x as the engine computes it: one double operation on floats, rounded once, is the float operation. */
+static double eng(double x, int32_t single) { return single ? to_float(x) : x; }
+
+/* A moved node's velocity as the engine sets it: vscale * (position - start) stored, then (stop) less
+ * its part into the stored normal, term for term in the engine's precision. */
+static sdfccd_Vec3 moved_velocity(const sdfccd_SoftGuardNode* o, sdfccd_Vec3 start, double vscale, int32_t single)
+{
+    scc_vec3 v = stored(scc_scale(scc_sub(sdfccd__v(o->position), sdfccd__v(start)), vscale), single);
+    const scc_vec3 n = stored(sdfccd__v(o->normal), single);
+    const double vn = eng(eng(eng(v.x * n.x, single) + eng(v.y * n.y, single), single) + eng(v.z * n.z, single), single);
+    if (o->stop && vn < 0)
+        v = scc_v3(eng(v.x - eng(n.x * vn, single), single), eng(v.y - eng(n.y * vn, single), single), eng(v.z - eng(n.z * vn, single), single));
+    return sdfccd__pv(v);
+}
+
 static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, const sdfccd_Frame* F, const sdfccd_SoftBody* body, double tol,
-                                     double dt, const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
+                                     double dt, double vscale, const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
                                      sdfccd_DistanceCert* face_certs, sdfccd_SoftGuardNode* out, int32_t* out_moved, sdfccd_SoftStats* stats)
 {
     static const char fn[] = "sdfccd_soft_guard";
@@ -296,6 +311,7 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
     if (nf + (int64_t)nl > 0 && !face_certs) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: face_certs is NULL", fn);
     if (!(isfinite(tol) && tol > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: tolerance = %g is not finite and > 0", fn, tol);
     if (!(isfinite(dt) && dt > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: duration = %g is not finite and > 0", fn, dt);
+    if (!isfinite(vscale)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: velocity_scale = %g is not finite", fn, vscale);
     if (!sdfccd__sdf_acquire(sdf)) return SDFCCD_INVALID_HANDLE;
     const double L = lipschitz_of(sdf);
     const size_t bytes = (size_t)nn * (2 * sizeof(scc_vec3) + sizeof(double) + 2);
@@ -311,6 +327,7 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
         out[i].moved = out[i].stop = 0;
         out[i].position = body->end[i];
         out[i].normal = (sdfccd_Vec3){ 0, 0, 1 };
+        out[i].velocity = (sdfccd_Vec3){ 0, 0, 0 };
         g.E[i] = to_local(F, sdfccd__v(body->end[i]));
         g.level[i] = -tol;
         g.touched[i] = g.touched_next[i] = 0;
@@ -381,16 +398,17 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
     }
     stats->sdf_evaluations += evals;
     int32_t moved = 0;
-    for (int32_t i = 0; i < nn; ++i) moved += out[i].moved;
+    for (int32_t i = 0; i < nn; ++i)
+        if (out[i].moved) out[i].velocity = moved_velocity(&out[i], body->start[i], vscale, body->single_precision), ++moved;
     if (out_moved) *out_moved = moved;
     sdfccd__free(mem, bytes);
     return SDFCCD_OK;
 }
 
 sdfccd_Status sdfccd_soft_guard(sdfccd_SdfId sdf, const sdfccd_Frame* start_frame, const sdfccd_Frame* frame, const sdfccd_SoftBody* body,
-                                double tolerance, double duration, const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
+                                double tolerance, double duration, double velocity_scale, const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
                                 sdfccd_DistanceCert* face_certs, sdfccd_SoftGuardNode* out_nodes, int32_t* out_moved, sdfccd_SoftStats* io_stats)
 {
-    SDFCCD__HELD_CALL(soft_guard_held(sdf, start_frame, frame, body, tolerance, duration, query, node_certs, face_certs, out_nodes, out_moved,
+    SDFCCD__HELD_CALL(soft_guard_held(sdf, start_frame, frame, body, tolerance, duration, velocity_scale, query, node_certs, face_certs, out_nodes, out_moved,
                                       io_stats));
 }
