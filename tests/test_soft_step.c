@@ -251,6 +251,52 @@ START_TEST(test_guard_node_half_space)
 }
 END_TEST
 
+/* A node's contact terms with a rigid body, closed forms: against a static body the impulse matrix
+ * is I / (ima dt); against a body with inverse mass 0.5 and inverse inertia 2 I at arm r = (0, 0, 1),
+ * ima I + imb I - [r]x Iw^-1 [r]x = diag(3.5, 3.5, 1.5) (ima 1). Static friction holds while the node's
+ * sideways motion relative to the body's point under it stays within friction times its normal
+ * motion: a node carried sideways with a moving body keeps it; one sliding over a static body does not. */
+START_TEST(test_node_contact_closed_form)
+{
+    const double dt = 0.01;
+    sdfccd_SoftRigid fixed = { v3(1, 2, 3), v3(0, 0, 0), v3(0, 0, 0), 0, { { 0 } } };
+    sdfccd_SoftNodeContact c;
+    ck_assert(sdfccd_soft_node_contact(v3(1.1, 2, 4.1), v3(1.1, 2, 4), 2.0, &fixed, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) ck_assert_double_eq_tol(c.impulse[i][j], i == j ? 1 / (2.0 * dt) : 0.0, 1e-9);
+    ck_assert_double_eq_tol(c.arm.x, 0.1, 1e-12);
+    ck_assert_double_eq_tol(c.arm.z, 1.0, 1e-12);
+    ck_assert_double_eq_tol(c.mass_dt, 2.0 * dt, 1e-15);
+    ck_assert(c.friction_keep == 0.0); /* straight down */
+    ck_assert(sdfccd_soft_node_contact(v3(0.9, 2, 4.1), v3(1.1, 2, 4), 2.0, &fixed, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    ck_assert_double_eq_tol(c.friction_keep, 0.5, 1e-15); /* 0.2 sideways against 0.5 x 0.1 */
+
+    sdfccd_SoftRigid moving = { v3(0, 0, 0), v3(20, 0, 0), v3(0, 0, 0), 0.5, { { 2, 0, 0 }, { 0, 2, 0 }, { 0, 0, 2 } } };
+    ck_assert(sdfccd_soft_node_contact(v3(-0.2, 0, 1.1), v3(0, 0, 1), 1.0, &moving, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    const double diag[3] = { 1 / 3.5, 1 / 3.5, 1 / 1.5 };
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) ck_assert_double_eq_tol(c.impulse[i][j], i == j ? diag[i] / dt : 0.0, 1e-9);
+    ck_assert(c.friction_keep == 0.0); /* carried: 0.2 m sideways with the body's 20 m/s x 0.01 s */
+    moving.angular_velocity = v3(0, -20, 0); /* w x r = (-20, 0, 0): the point under the node stands still */
+    ck_assert(sdfccd_soft_node_contact(v3(-0.2, 0, 1.1), v3(0, 0, 1), 1.0, &moving, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    ck_assert_double_eq_tol(c.friction_keep, 0.5, 1e-15);
+
+    /* Single precision: floats, near the double terms. */
+    sdfccd_SoftNodeContact f;
+    ck_assert(sdfccd_soft_node_contact(v3(-0.2, 0, 1.1), v3(0.03, 0.01, 1), 1.0, &moving, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    ck_assert(sdfccd_soft_node_contact(v3(-0.2, 0, 1.1), v3(0.03, 0.01, 1), 1.0, &moving, v3(0, 0, 1), 0.5, dt, 1, &f) == SDFCCD_OK);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            ck_assert(f.impulse[i][j] == (double)(float)f.impulse[i][j]);
+            ck_assert_double_eq_tol(f.impulse[i][j], c.impulse[i][j], 1e-5 * (1 + fabs(c.impulse[i][j])));
+        }
+
+    ck_assert_int_eq(sdfccd_soft_node_contact(v3(0, 0, 0), v3(0, 0, 0), 1.0, NULL, v3(0, 0, 1), 0.5, dt, 0, &c), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_node_contact(v3(0, 0, 0), v3(0, 0, 0), 1.0, &fixed, v3(0, 0, 1), 0.5, 0.0, 0, &c), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_node_contact(v3(0, 0, 0), v3(0, 0, 0), 0.0, &fixed, v3(0, 0, 1), 0.5, dt, 0, &c), SDFCCD_INVALID_ARGUMENT);
+}
+END_TEST
+
 /* Single precision: the guard's velocity is what a float engine computes (floats, near the double one),
  * and never into the surface by more than float rounding. */
 START_TEST(test_guard_velocity_single)
@@ -401,6 +447,7 @@ int main(void)
     tcase_add_test(tc, test_hold_single_precision);
     tcase_add_test(tc, test_guard_node_half_space);
     tcase_add_test(tc, test_guard_velocity_single);
+    tcase_add_test(tc, test_node_contact_closed_form);
     tcase_add_test(tc, test_guard_face_and_link_through_ball);
     tcase_add_test(tc, test_soft_step_bad_input);
     suite_add_tcase(s, tc);

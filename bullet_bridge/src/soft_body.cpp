@@ -148,29 +148,22 @@ SoftState* softOf(const BridgeImpl* impl)
     return it == g_soft.end() ? nullptr : it->second.get();
 }
 
-// Bullet's soft-rigid contact terms for a node against the SDF body (how btSoftBody's own
-// collision handler fills RContact: impulse matrix, anchor, ima dt, friction, hardness).
+// A node's RContact against the SDF body: the terms of Bullet's own collision handler (impulse
+// matrix, anchor, ima dt, friction) from sdfccd_soft_node_contact(), hardness kKHR or kCHR.
 void addContact(btSoftBody* psb, btSoftBody::Node& n, const btCollisionObject* co, const btVector3& nrm, double offset)
 {
-    const double dt = psb->m_sst.sdt;
     const btRigidBody* rb = btRigidBody::upcast(co);
-    const btScalar ima = n.m_im;
-    const btScalar imb = rb ? rb->getInvMass() : btScalar(0);
-    if (!(ima + imb > 0)) return;
-    const btTransform& wtr = co->getWorldTransform();
-    const btVector3 ra = n.m_x - wtr.getOrigin();
-    const btVector3 va = rb ? rb->getVelocityInLocalPoint(ra) * btScalar(dt) : btVector3(0, 0, 0);
-    const btVector3 vr = (n.m_x - n.m_q) - va;
-    const btScalar dn = vr.dot(nrm);
-    const btVector3 fv = vr - nrm * dn;
-    const btScalar fc = psb->m_cfg.kDF * co->getFriction();
-    // Impulse matrix: (1/dt) (ima I + imb I - [ra]x Iw^-1 [ra]x)^-1.
-    const btMatrix3x3 iwi = rb ? rb->getInvInertiaTensorWorld() : btMatrix3x3(0, 0, 0, 0, 0, 0, 0, 0, 0);
-    const btMatrix3x3 cr(0, -ra.z(), ra.y(), ra.z(), 0, -ra.x(), -ra.y(), ra.x(), 0);
-    btMatrix3x3 k = cr * iwi * cr;
-    btMatrix3x3 m;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) m[i][j] = (i == j ? ima + imb : btScalar(0)) - k[i][j];
+    sdfccd_SoftRigid body = { v3(co->getWorldTransform().getOrigin()), { 0, 0, 0 }, { 0, 0, 0 }, 0, { { 0 } } };
+    if (rb) {
+        body.linear_velocity = v3(rb->getLinearVelocity()), body.angular_velocity = v3(rb->getAngularVelocity());
+        body.inverse_mass = rb->getInvMass();
+        const btMatrix3x3& iwi = rb->getInvInertiaTensorWorld();
+        for (int i = 0; i < 9; ++i) body.inverse_inertia[i / 3][i % 3] = iwi[i / 3][i % 3];
+    }
+    sdfccd_SoftNodeContact t;
+    if (sdfccd_soft_node_contact(v3(n.m_q), v3(n.m_x), n.m_im, &body, v3(nrm), psb->m_cfg.kDF * co->getFriction(), psb->m_sst.sdt,
+                                 kSinglePrecision, &t) != SDFCCD_OK)
+        return;
     btSoftBody::RContact c;
     c.m_cti.m_colObj = co;
     c.m_cti.m_normal = nrm;
@@ -179,10 +172,10 @@ void addContact(btSoftBody* psb, btSoftBody::Node& n, const btCollisionObject* c
     c.m_node = &n;
     c.t1.setZero();
     c.t2.setZero();
-    c.m_c0 = m.inverse() * btScalar(1 / dt);
-    c.m_c1 = ra;
-    c.m_c2 = ima * btScalar(dt);
-    c.m_c3 = fv.length2() < (dn * fc * dn * fc) ? btScalar(0) : 1 - fc;
+    for (int i = 0; i < 3; ++i) c.m_c0[i] = bt(sdfccd_Vec3{ t.impulse[i][0], t.impulse[i][1], t.impulse[i][2] });
+    c.m_c1 = bt(t.arm);
+    c.m_c2 = (btScalar)t.mass_dt;
+    c.m_c3 = (btScalar)t.friction_keep;
     c.m_c4 = co->isStaticOrKinematicObject() ? psb->m_cfg.kKHR : psb->m_cfg.kCHR;
     psb->m_rcontacts.push_back(c);
     if (rb) const_cast<btRigidBody*>(rb)->activate();

@@ -103,6 +103,34 @@ SDFCCD_API sdfccd_Status sdfccd_soft_hold(const sdfccd_Frame* start_frame, const
                                           double* pushes, double velocity_scale, int32_t last, int32_t single_precision,
                                           int32_t* out_held);
 
+/** A rigid body a node touches, as sdfccd_soft_node_contact() sees it (world frame). */
+typedef struct sdfccd_SoftRigid {
+    sdfccd_Vec3 origin;           /**< Its centre of mass (m). */
+    sdfccd_Vec3 linear_velocity;  /**< Of the centre of mass (m/s). */
+    sdfccd_Vec3 angular_velocity; /**< (rad/s). */
+    double inverse_mass;          /**< 1/kg; 0 for a static or kinematic body. */
+    double inverse_inertia[3][3]; /**< Inverse inertia tensor (world); zeros for a static or kinematic body. */
+} sdfccd_SoftRigid;
+
+/** The terms of a node's contact with a rigid body in a position-based soft-body solver, as
+ * Bullet's own soft-rigid collision handler computes them (btSoftBody::RContact m_c0 to m_c3). */
+typedef struct sdfccd_SoftNodeContact {
+    double impulse[3][3]; /**< (1/dt) (ima I + imb I - [r]x Iw^-1 [r]x)^-1: the impulse that cancels a unit relative displacement. */
+    sdfccd_Vec3 arm;      /**< r: the node's end position minus the body's origin (m). */
+    double mass_dt;       /**< The node's inverse mass times dt. */
+    double friction_keep; /**< 0 when static friction holds (the node's sideways motion relative to the body's point at most friction times its normal motion), else 1 - friction. */
+} sdfccd_SoftNodeContact;
+
+/** The contact terms of a node (inverse mass `inverse_mass`, moving from `start` to `end` over a
+ * step of `duration` s) with `body` along the unit contact normal `normal` (world), with the
+ * combined friction coefficient `friction`. With `single_precision` non-zero every operation is
+ * rounded as a float engine rounds it (its inputs being floats), so that such an engine gets its
+ * own numbers. Errors (nothing written): INVALID_ARGUMENT for a NULL pointer, a duration not
+ * finite and > 0, or a node and a body without inverse mass. */
+SDFCCD_API sdfccd_Status sdfccd_soft_node_contact(sdfccd_Vec3 start, sdfccd_Vec3 end, double inverse_mass, const sdfccd_SoftRigid* body,
+                                                  sdfccd_Vec3 normal, double friction, double duration, int32_t single_precision,
+                                                  sdfccd_SoftNodeContact* out);
+
 /** What sdfccd_soft_guard() decided for one node. */
 typedef struct sdfccd_SoftGuardNode {
     int32_t moved;        /**< 1: the node goes to `position` with `velocity`. */
