@@ -220,7 +220,7 @@ START_TEST(test_guard_node_half_space)
         int32_t moved = -1;
         sdfccd_SoftStats stats = { 0, 0, 0 };
         const sdfccd_QueryParams qp = sdfccd_default_query_params();
-        ck_assert_msg(sdfccd_soft_guard(plane, &F, &F, &body, tol, 0.01, &qp, certs, NULL, out, &moved, &stats) == SDFCCD_OK, "%s",
+        ck_assert_msg(sdfccd_soft_guard(plane, &F, &F, &body, tol, 0.01, 100.0, &qp, certs, NULL, out, &moved, &stats) == SDFCCD_OK, "%s",
                       sdfccd_last_error());
         ck_assert_int_eq(moved, 2);
         const sdfccd_Vec3 back = to_world(&F, v3(0.1 * (0.1 + 0.5 * tol) / 0.2, 0, -0.5 * tol)), up = to_world(&F, v3(0, 0, 1)),
@@ -233,6 +233,13 @@ START_TEST(test_guard_node_half_space)
         ck_assert_double_eq_tol(out[0].normal.x, up.x - o.x, 1e-12);
         ck_assert_double_eq_tol(out[0].normal.y, up.y - o.y, 1e-12);
         ck_assert_double_eq_tol(out[0].normal.z, up.z - o.z, 1e-12);
+        /* Its velocity: 100 x (back - start), less its part into +z: (5.0125, 0, 0) in the SDF's frame. */
+        const sdfccd_Vec3 ex = to_world(&F, v3(1, 0, 0));
+        const double vx = 100 * 0.1 * (0.1 + 0.5 * tol) / 0.2;
+        ck_assert_double_eq_tol(out[0].velocity.x, vx * (ex.x - o.x), 1e-4);
+        ck_assert_double_eq_tol(out[0].velocity.y, vx * (ex.y - o.y), 1e-4);
+        ck_assert_double_eq_tol(out[0].velocity.z, vx * (ex.z - o.z), 1e-4);
+        ck_assert(out[1].velocity.x == 0 && out[1].velocity.y == 0 && out[1].velocity.z == 0);
         ck_assert_int_eq(out[1].moved, 0);
         ck_assert_int_eq(out[2].moved, 1);
         const sdfccd_Vec3 d = v3(out[2].position.x - o.x, out[2].position.y - o.y, out[2].position.z - o.z);
@@ -240,6 +247,78 @@ START_TEST(test_guard_node_half_space)
         ck_assert(z2 >= -0.01 - 0.1 * tol - 1e-9);
         ck_assert(z2 < -0.01 + 1e-9); /* and not lifted above its start */
     }
+    ck_assert(sdfccd_destroy_sdf(plane) == SDFCCD_OK);
+}
+END_TEST
+
+/* A node's contact terms with a rigid body, closed forms: against a static body the impulse matrix
+ * is I / (ima dt); against a body with inverse mass 0.5 and inverse inertia 2 I at arm r = (0, 0, 1),
+ * ima I + imb I - [r]x Iw^-1 [r]x = diag(3.5, 3.5, 1.5) (ima 1). Static friction holds while the node's
+ * sideways motion relative to the body's point under it stays within friction times its normal
+ * motion: a node carried sideways with a moving body keeps it; one sliding over a static body does not. */
+START_TEST(test_node_contact_closed_form)
+{
+    const double dt = 0.01;
+    sdfccd_SoftRigid fixed = { v3(1, 2, 3), v3(0, 0, 0), v3(0, 0, 0), 0, { { 0 } } };
+    sdfccd_SoftNodeContact c;
+    ck_assert(sdfccd_soft_node_contact(v3(1.1, 2, 4.1), v3(1.1, 2, 4), 2.0, &fixed, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) ck_assert_double_eq_tol(c.impulse[i][j], i == j ? 1 / (2.0 * dt) : 0.0, 1e-9);
+    ck_assert_double_eq_tol(c.arm.x, 0.1, 1e-12);
+    ck_assert_double_eq_tol(c.arm.z, 1.0, 1e-12);
+    ck_assert_double_eq_tol(c.mass_dt, 2.0 * dt, 1e-15);
+    ck_assert(c.friction_keep == 0.0); /* straight down */
+    ck_assert(sdfccd_soft_node_contact(v3(0.9, 2, 4.1), v3(1.1, 2, 4), 2.0, &fixed, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    ck_assert_double_eq_tol(c.friction_keep, 0.5, 1e-15); /* 0.2 sideways against 0.5 x 0.1 */
+
+    sdfccd_SoftRigid moving = { v3(0, 0, 0), v3(20, 0, 0), v3(0, 0, 0), 0.5, { { 2, 0, 0 }, { 0, 2, 0 }, { 0, 0, 2 } } };
+    ck_assert(sdfccd_soft_node_contact(v3(-0.2, 0, 1.1), v3(0, 0, 1), 1.0, &moving, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    const double diag[3] = { 1 / 3.5, 1 / 3.5, 1 / 1.5 };
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) ck_assert_double_eq_tol(c.impulse[i][j], i == j ? diag[i] / dt : 0.0, 1e-9);
+    ck_assert(c.friction_keep == 0.0); /* carried: 0.2 m sideways with the body's 20 m/s x 0.01 s */
+    moving.angular_velocity = v3(0, -20, 0); /* w x r = (-20, 0, 0): the point under the node stands still */
+    ck_assert(sdfccd_soft_node_contact(v3(-0.2, 0, 1.1), v3(0, 0, 1), 1.0, &moving, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    ck_assert_double_eq_tol(c.friction_keep, 0.5, 1e-15);
+
+    /* Single precision: floats, near the double terms. */
+    sdfccd_SoftNodeContact f;
+    ck_assert(sdfccd_soft_node_contact(v3(-0.2, 0, 1.1), v3(0.03, 0.01, 1), 1.0, &moving, v3(0, 0, 1), 0.5, dt, 0, &c) == SDFCCD_OK);
+    ck_assert(sdfccd_soft_node_contact(v3(-0.2, 0, 1.1), v3(0.03, 0.01, 1), 1.0, &moving, v3(0, 0, 1), 0.5, dt, 1, &f) == SDFCCD_OK);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            ck_assert(f.impulse[i][j] == (double)(float)f.impulse[i][j]);
+            ck_assert_double_eq_tol(f.impulse[i][j], c.impulse[i][j], 1e-5 * (1 + fabs(c.impulse[i][j])));
+        }
+
+    ck_assert_int_eq(sdfccd_soft_node_contact(v3(0, 0, 0), v3(0, 0, 0), 1.0, NULL, v3(0, 0, 1), 0.5, dt, 0, &c), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_node_contact(v3(0, 0, 0), v3(0, 0, 0), 1.0, &fixed, v3(0, 0, 1), 0.5, 0.0, 0, &c), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_node_contact(v3(0, 0, 0), v3(0, 0, 0), 0.0, &fixed, v3(0, 0, 1), 0.5, dt, 0, &c), SDFCCD_INVALID_ARGUMENT);
+}
+END_TEST
+
+/* Single precision: the guard's velocity is what a float engine computes (floats, near the double one),
+ * and never into the surface by more than float rounding. */
+START_TEST(test_guard_velocity_single)
+{
+    const sdfccd_SdfId plane = half_space_z();
+    const sdfccd_Frame F = turned_frame();
+    const sdfccd_Vec3 start = to_world(&F, v3(0.3, 0.1, 0.1)), end = to_world(&F, v3(0.4, 0.2, -0.1));
+    sdfccd_SoftGuardNode out[2];
+    for (int single = 0; single < 2; ++single) {
+        const sdfccd_SoftBody body = { 1, &start, &end, NULL, 0, NULL, 0, NULL, single };
+        sdfccd_DistanceCert cert = sdfccd_empty_distance_cert();
+        sdfccd_SoftStats stats = { 0, 0, 0 };
+        const sdfccd_QueryParams qp = sdfccd_default_query_params();
+        ck_assert(sdfccd_soft_guard(plane, &F, &F, &body, 5e-4, 0.01, 99.0, &qp, &cert, NULL, &out[single], NULL, &stats) == SDFCCD_OK);
+        ck_assert_int_eq(out[single].moved, 1);
+    }
+    const sdfccd_Vec3 v = out[1].velocity, n = out[1].normal;
+    ck_assert(v.x == (double)(float)v.x && v.y == (double)(float)v.y && v.z == (double)(float)v.z);
+    ck_assert_double_eq_tol(v.x, out[0].velocity.x, 1e-5);
+    ck_assert_double_eq_tol(v.y, out[0].velocity.y, 1e-5);
+    ck_assert_double_eq_tol(v.z, out[0].velocity.z, 1e-5);
+    ck_assert(v.x * n.x + v.y * n.y + v.z * n.z > -1e-6);
     ck_assert(sdfccd_destroy_sdf(plane) == SDFCCD_OK);
 }
 END_TEST
@@ -268,7 +347,7 @@ START_TEST(test_guard_face_and_link_through_ball)
         sdfccd_SoftGuardNode out[3];
         int32_t moved = 0;
         sdfccd_SoftStats stats = { 0, 0, 0 };
-        ck_assert_msg(sdfccd_soft_guard(ball, &F, &F, &body, tol, 0.01, &qp, nc, fc, out, &moved, &stats) == SDFCCD_OK, "%s",
+        ck_assert_msg(sdfccd_soft_guard(ball, &F, &F, &body, tol, 0.01, 100.0, &qp, nc, fc, out, &moved, &stats) == SDFCCD_OK, "%s",
                       sdfccd_last_error());
         ck_assert_int_eq(moved, rope ? 2 : 3);
         for (int k = 0; k < (rope ? 2 : 3); ++k) {
@@ -310,7 +389,7 @@ START_TEST(test_guard_face_and_link_through_ball)
     sdfccd_SoftGuardNode out5[5];
     int32_t moved5 = -1;
     sdfccd_SoftStats st5 = { 0, 0, 0 };
-    ck_assert(sdfccd_soft_guard(ball, &F, &F, &mixed, tol, 0.01, &qp, nc5, fc5, out5, &moved5, &st5) == SDFCCD_OK);
+    ck_assert(sdfccd_soft_guard(ball, &F, &F, &mixed, tol, 0.01, 100.0, &qp, nc5, fc5, out5, &moved5, &st5) == SDFCCD_OK);
     ck_assert_int_eq(moved5, 0);
     ck_assert(sdfccd_destroy_sdf(ball) == SDFCCD_OK);
 }
@@ -338,10 +417,11 @@ START_TEST(test_soft_step_bad_input)
     ck_assert_int_eq(count, 77);
     const sdfccd_QueryParams qp = sdfccd_default_query_params();
     sdfccd_SoftGuardNode out[2];
-    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 0.0, 0.01, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
-    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 5e-4, NAN, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
-    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &bad, 5e-4, 0.01, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
-    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 5e-4, 0.01, NULL, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 0.0, 0.01, 100.0, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 5e-4, NAN, 100.0, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 5e-4, 0.01, NAN, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &bad, 5e-4, 0.01, 100.0, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 5e-4, 0.01, 100.0, NULL, c, c, out, NULL, &st), SDFCCD_INVALID_ARGUMENT);
     const sdfccd_SoftPlane far = { 5, 0, v3(0, 0, 1), 0, v3(0, 0, 1), 0, 0 };
     sdfccd_Vec3 x[2] = { s[0], s[1] }, v[2] = { s[0], s[1] };
     const double m[2] = { 1, 1 };
@@ -351,7 +431,7 @@ START_TEST(test_soft_step_bad_input)
     ck_assert(strlen(sdfccd_last_error()) > 0);
     ck_assert(sdfccd_destroy_sdf(plane) == SDFCCD_OK);
     ck_assert_int_eq(sdfccd_soft_contacts(plane, &F, &body, &p, c, c, planes, 4, &count, &st), SDFCCD_INVALID_HANDLE);
-    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 5e-4, 0.01, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_HANDLE);
+    ck_assert_int_eq(sdfccd_soft_guard(plane, &F, &F, &body, 5e-4, 0.01, 100.0, &qp, c, c, out, NULL, &st), SDFCCD_INVALID_HANDLE);
     ck_assert_int_eq(count, 77);
 }
 END_TEST
@@ -366,6 +446,8 @@ int main(void)
     tcase_add_test(tc, test_hold_closed_form);
     tcase_add_test(tc, test_hold_single_precision);
     tcase_add_test(tc, test_guard_node_half_space);
+    tcase_add_test(tc, test_guard_velocity_single);
+    tcase_add_test(tc, test_node_contact_closed_form);
     tcase_add_test(tc, test_guard_face_and_link_through_ball);
     tcase_add_test(tc, test_soft_step_bad_input);
     suite_add_tcase(s, tc);

@@ -9,9 +9,10 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <typeinfo>
 
+#include <BulletSoftBody/btDefaultSoftBodySolver.h>
 #include <BulletSoftBody/btSoftBody.h>
-#include <BulletSoftBody/btSoftBodySolvers.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 #include <sdfccd/soft.h>
 
@@ -19,9 +20,6 @@
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 namespace detail {
-
-void callMisuseHandler(Status status, const char* message, const btCollisionShape* shape);
-
 namespace {
 
 const int32_t kSinglePrecision = sizeof(btScalar) == 4 ? 1 : 0;
@@ -48,24 +46,13 @@ struct SoftRecord {
     std::vector<sdfccd_DistanceCert> node_certs, face_certs;
     std::vector<sdfccd_SoftPlane> holds;
     double friction = 0;
-    void setSdf(sdfccd_SdfId id) // another field: the certificates say nothing about it
-    {
-        if (id.index1 != sdf.index1 || id.generation != sdf.generation) node_certs.clear(), face_certs.clear();
-        sdf = id;
-    }
     void begin(const btSoftBody* psb, const btCollisionObject* co, sdfccd_SdfId id, const btTransform& pose)
     {
-        soft = psb;
-        sdf_object = co;
-        setSdf(id);
-        sdf_pose = pose;
+        if (id.index1 != sdf.index1 || id.generation != sdf.generation) // another field: the certificates say nothing about it
+            node_certs.clear(), face_certs.clear();
+        soft = psb, sdf_object = co, sdf = id, sdf_pose = pose;
         start.resize((size_t)psb->m_nodes.size());
         for (int k = 0; k < psb->m_nodes.size(); ++k) start[(size_t)k] = v3(psb->m_nodes[k].m_q);
-    }
-    void sizeCerts(int nodes, int faces)
-    {
-        if (node_certs.size() != (size_t)nodes) node_certs.assign((size_t)nodes, sdfccd_empty_distance_cert());
-        if (face_certs.size() != (size_t)faces) face_certs.assign((size_t)faces, sdfccd_empty_distance_cert());
     }
 };
 
@@ -99,24 +86,31 @@ struct SoftCreateFunc : btCollisionAlgorithmCreateFunc {
     }
 };
 
+// Bullet's CPU solver (a copy of the world's btDefaultSoftBodySolver) with the contact planes held in
+// its solve and the guard after it, in every internal step. The world owns it.
+struct GuardingSolver : btDefaultSoftBodySolver {
+    GuardingSolver(const btDefaultSoftBodySolver& inner, SoftState* st) : btDefaultSoftBodySolver(inner), state(st) {}
+    ~GuardingSolver() override;
+    void solveConstraints(btScalar dt) override;
+    SoftState* state; // NULL once the bridge is gone: a plain solver
+};
+
 struct SoftState {
     BridgeImpl* impl = nullptr;
     SoftCreateFunc fn[2]; // (soft, sdf) and (sdf, soft)
     std::vector<std::pair<int, int>> slots;
     btCollisionDispatcher* dispatcher = nullptr;
     SoftBodyStats stats;
+    sdfccd_SoftStats totals = { 0, 0, 0 }; // the C functions' counters (face queries, errors, evaluations)
     std::map<std::pair<const void*, const void*>, SoftRecord> records;
     std::set<const btCollisionShape*> reported;
-    // The automatic guard (registerWith a btSoftRigidDynamicsWorld): the world, its solver as it was,
-    // and whether the world owned it.
+    // The automatic guard (registerWith a btSoftRigidDynamicsWorld): the world, the solver it had when
+    // the caller owns that one (NULL: the world did, and it is freed), and the wrapper put in its place.
     btSoftRigidDynamicsWorld* world = nullptr;
     btSoftBodySolver* inner = nullptr;
-    class GuardingSolver* wrapper = nullptr;
-    bool world_owned_inner = false;
+    GuardingSolver* wrapper = nullptr;
     bool guarded_this_step = false;
-    bool auto_guard = true;
-    double auto_tolerance = 5e-4;
-    // Scratch of the C API calls: the body's arrays, planes, nodes in the hold, the guard's verdicts.
+    // Scratch of the C API calls: the body's arrays, nodes in the hold, the guard's verdicts.
     std::vector<sdfccd_Vec3> end, x, v;
     std::vector<uint8_t> pinned;
     std::vector<int32_t> faces, links;
@@ -124,27 +118,23 @@ struct SoftState {
     std::vector<sdfccd_SoftPlane> planes;
     std::vector<sdfccd_SoftGuardNode> guarded;
 
-    // The body as the C API sees it: start positions `start`, end positions its nodes' m_x now.
-    sdfccd_SoftBody bodyOf(const btSoftBody* psb, const std::vector<sdfccd_Vec3>& start)
+    // The body as the C API sees it: start positions rec.start, end positions its nodes' m_x now;
+    // rec's certificates sized to it.
+    sdfccd_SoftBody bodyOf(const btSoftBody* psb, SoftRecord& rec)
     {
-        const int nn = psb->m_nodes.size();
+        const int nn = psb->m_nodes.size(), nf = psb->m_faces.size(), nl = psb->m_links.size();
+        if (rec.node_certs.size() != (size_t)nn) rec.node_certs.assign((size_t)nn, sdfccd_empty_distance_cert());
+        if (rec.face_certs.size() != (size_t)(nf + nl)) rec.face_certs.assign((size_t)(nf + nl), sdfccd_empty_distance_cert());
         end.resize((size_t)nn);
         pinned.resize((size_t)nn);
         for (int i = 0; i < nn; ++i) end[(size_t)i] = v3(psb->m_nodes[i].m_x), pinned[(size_t)i] = psb->m_nodes[i].m_battach ? 1 : 0;
-        faces.resize(3 * (size_t)psb->m_faces.size());
-        for (int f = 0; f < psb->m_faces.size(); ++f)
+        faces.resize(3 * (size_t)nf);
+        for (int f = 0; f < nf; ++f)
             for (int k = 0; k < 3; ++k) faces[3 * (size_t)f + k] = (int32_t)(psb->m_faces[f].m_n[k] - &psb->m_nodes[0]);
-        links.resize(2 * (size_t)psb->m_links.size());
-        for (int l = 0; l < psb->m_links.size(); ++l)
+        links.resize(2 * (size_t)nl);
+        for (int l = 0; l < nl; ++l)
             for (int k = 0; k < 2; ++k) links[2 * (size_t)l + k] = (int32_t)(psb->m_links[l].m_n[k] - &psb->m_nodes[0]);
-        return sdfccd_SoftBody{ nn, start.data(), end.data(), pinned.data(), psb->m_faces.size(), faces.data(), psb->m_links.size(),
-                                links.data(), kSinglePrecision };
-    }
-    void count(const sdfccd_SoftStats& s)
-    {
-        stats.face_queries += s.face_queries;
-        stats.query_errors += s.query_errors;
-        stats.sdf_evaluations += s.sdf_evaluations;
+        return sdfccd_SoftBody{ nn, rec.start.data(), end.data(), pinned.data(), nf, faces.data(), nl, links.data(), kSinglePrecision };
     }
 };
 
@@ -158,33 +148,22 @@ SoftState* softOf(const BridgeImpl* impl)
     return it == g_soft.end() ? nullptr : it->second.get();
 }
 
-// Bullet's soft-rigid contact terms for a node against the SDF body (how btSoftBody's own
-// collision handler fills RContact: impulse matrix, anchor, ima dt, friction, hardness).
+// A node's RContact against the SDF body: the terms of Bullet's own collision handler (impulse
+// matrix, anchor, ima dt, friction) from sdfccd_soft_node_contact(), hardness kKHR or kCHR.
 void addContact(btSoftBody* psb, btSoftBody::Node& n, const btCollisionObject* co, const btVector3& nrm, double offset)
 {
-    const double dt = psb->m_sst.sdt;
     const btRigidBody* rb = btRigidBody::upcast(co);
-    const btScalar ima = n.m_im;
-    const btScalar imb = rb ? rb->getInvMass() : btScalar(0);
-    if (!(ima + imb > 0)) return;
-    const btTransform& wtr = co->getWorldTransform();
-    const btVector3 ra = n.m_x - wtr.getOrigin();
-    const btVector3 va = rb ? rb->getVelocityInLocalPoint(ra) * btScalar(dt) : btVector3(0, 0, 0);
-    const btVector3 vr = (n.m_x - n.m_q) - va;
-    const btScalar dn = vr.dot(nrm);
-    const btVector3 fv = vr - nrm * dn;
-    const btScalar fc = psb->m_cfg.kDF * co->getFriction();
-    // Impulse matrix: (1/dt) (ima I + imb I - [ra]x Iw^-1 [ra]x)^-1.
-    btMatrix3x3 iwi;
-    if (rb)
-        iwi = rb->getInvInertiaTensorWorld();
-    else
-        iwi.setValue(0, 0, 0, 0, 0, 0, 0, 0, 0);
-    const btMatrix3x3 cr(0, -ra.z(), ra.y(), ra.z(), 0, -ra.x(), -ra.y(), ra.x(), 0);
-    btMatrix3x3 k = cr * iwi * cr;
-    btMatrix3x3 m;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) m[i][j] = (i == j ? ima + imb : btScalar(0)) - k[i][j];
+    sdfccd_SoftRigid body = { v3(co->getWorldTransform().getOrigin()), { 0, 0, 0 }, { 0, 0, 0 }, 0, { { 0 } } };
+    if (rb) {
+        body.linear_velocity = v3(rb->getLinearVelocity()), body.angular_velocity = v3(rb->getAngularVelocity());
+        body.inverse_mass = rb->getInvMass();
+        const btMatrix3x3& iwi = rb->getInvInertiaTensorWorld();
+        for (int i = 0; i < 9; ++i) body.inverse_inertia[i / 3][i % 3] = iwi[i / 3][i % 3];
+    }
+    sdfccd_SoftNodeContact t;
+    if (sdfccd_soft_node_contact(v3(n.m_q), v3(n.m_x), n.m_im, &body, v3(nrm), psb->m_cfg.kDF * co->getFriction(), psb->m_sst.sdt,
+                                 kSinglePrecision, &t) != SDFCCD_OK)
+        return;
     btSoftBody::RContact c;
     c.m_cti.m_colObj = co;
     c.m_cti.m_normal = nrm;
@@ -193,10 +172,10 @@ void addContact(btSoftBody* psb, btSoftBody::Node& n, const btCollisionObject* c
     c.m_node = &n;
     c.t1.setZero();
     c.t2.setZero();
-    c.m_c0 = m.inverse() * btScalar(1 / dt);
-    c.m_c1 = ra;
-    c.m_c2 = ima * btScalar(dt);
-    c.m_c3 = fv.length2() < (dn * fc * dn * fc) ? btScalar(0) : 1 - fc;
+    for (int i = 0; i < 3; ++i) c.m_c0[i] = bt(sdfccd_Vec3{ t.impulse[i][0], t.impulse[i][1], t.impulse[i][2] });
+    c.m_c1 = bt(t.arm);
+    c.m_c2 = (btScalar)t.mass_dt;
+    c.m_c3 = (btScalar)t.friction_keep;
     c.m_c4 = co->isStaticOrKinematicObject() ? psb->m_cfg.kKHR : psb->m_cfg.kCHR;
     psb->m_rcontacts.push_back(c);
     if (rb) const_cast<btRigidBody*>(rb)->activate();
@@ -213,8 +192,13 @@ btTransform startPose(const btCollisionObject* co, double dt)
 
 // The contact planes of the pair (sdfccd_soft_contacts): held in Bullet's solve against a static or
 // kinematic SDF body when the bridge wraps the solver, RContacts otherwise.
-void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
+void SoftSdfAlgorithm::processCollision(const btCollisionObjectWrapper* w0, const btCollisionObjectWrapper* w1,
+                                        const btDispatcherInfo&, btManifoldResult*)
 {
+    const btCollisionObjectWrapper* sw = m_swapped ? w0 : w1;
+    btSoftBody* psb = const_cast<btSoftBody*>(btSoftBody::upcast((m_swapped ? w1 : w0)->getCollisionObject()));
+    SoftState* st = m_state;
+    if (!psb || !st) return;
     BridgeImpl* impl = st->impl;
     const btCollisionObject* co = sw->getCollisionObject();
     const btCollisionShape* shape = sw->getCollisionShape();
@@ -233,23 +217,19 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     SoftRecord& rec = st->records[std::make_pair((const void*)psb, (const void*)co)];
     rec.begin(psb, co, sdf, co->isKinematicObject() ? startPose(co, psb->m_sst.sdt) : sw->getWorldTransform());
     rec.fresh = true;
-    const int nn = psb->m_nodes.size();
-    rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
     const bool hold = impl->cfg.query.method != SDFCCD_METHOD_DCD && co->isStaticOrKinematicObject() && st->wrapper;
     rec.friction = (double)(psb->m_cfg.kDF * co->getFriction());
     rec.holds.clear();
     // Bullet's soft bodies keep their collision shape's margin from rigid surfaces.
     const sdfccd_SoftContactParams params = { impl->cfg.query, std::max(0.0, (double)psb->getCollisionShape()->getMargin()),
                                               impl->cfg.contact_margin, psb->m_sst.sdt };
-    const sdfccd_SoftBody body = st->bodyOf(psb, rec.start);
+    const sdfccd_SoftBody body = st->bodyOf(psb, rec);
     const sdfccd_Frame frame = frameOf(sw->getWorldTransform());
-    st->planes.resize(2 * (size_t)nn);
+    st->planes.resize(2 * (size_t)body.node_count);
     int32_t count = 0;
-    sdfccd_SoftStats s = { 0, 0, 0 };
     if (sdfccd_soft_contacts(sdf, &frame, &body, &params, rec.node_certs.data(), rec.face_certs.data(), st->planes.data(),
-                             (int32_t)st->planes.size(), &count, &s) != SDFCCD_OK)
-        ++s.query_errors;
-    st->count(s);
+                             (int32_t)st->planes.size(), &count, &st->totals) != SDFCCD_OK)
+        ++st->totals.query_errors;
     for (int32_t k = 0; k < count; ++k) {
         const sdfccd_SoftPlane& pl = st->planes[(size_t)k];
         ++(pl.face ? st->stats.face_contacts : st->stats.node_contacts);
@@ -260,129 +240,73 @@ void collide(SoftState* st, btSoftBody* psb, const btCollisionObjectWrapper* sw)
     }
 }
 
-void SoftSdfAlgorithm::processCollision(const btCollisionObjectWrapper* w0, const btCollisionObjectWrapper* w1,
-                                        const btDispatcherInfo&, btManifoldResult*)
+// Bullet's soft-body position solve (btSoftBody::solveConstraints) with the contact planes held
+// (sdfccd_soft_hold, every pair of the body in turn on the same nodes) after each of its piterations
+// passes: one call per pass with piterations = 1 is the same solve (links and anchors are prepared
+// from m_q, velocities set from m_x - m_q at the end of each call) when the body has no velocity or
+// drift passes and no clusters; otherwise the planes are held once, after the solve.
+void solveHeld(SoftState* st, btSoftBody* psb)
 {
-    const btCollisionObjectWrapper* softw = m_swapped ? w1 : w0;
-    const btCollisionObjectWrapper* sdfw = m_swapped ? w0 : w1;
-    btSoftBody* psb = const_cast<btSoftBody*>(btSoftBody::upcast(softw->getCollisionObject()));
-    if (!psb || !m_state) return;
-    collide(m_state, psb, sdfw);
-}
-
-// One pass of holding the soft body's nodes on their planes (sdfccd_soft_hold), every pair of it
-// in turn on the same nodes. push: per plane, over the passes.
-void holdIteration(SoftState* st, btSoftBody* psb, std::vector<double>& push, bool last)
-{
+    std::vector<SoftRecord*> recs;
+    size_t count = 0;
+    for (auto& r : st->records)
+        if (r.second.soft == psb && r.second.fresh && !r.second.holds.empty()) recs.push_back(&r.second), count += r.second.holds.size();
+    const int passes = psb->m_cfg.piterations;
+    const bool split = passes > 1 && psb->m_cfg.viterations <= 0 && psb->m_cfg.diterations <= 0 && psb->m_clusters.size() == 0;
+    if (count > 0 && split) psb->m_cfg.piterations = 1;
+    std::vector<double> push(count, 0.0); // per plane, over the passes
+    // Bullet's rule for the velocity after its position solve: (x - q) / dt, damped by kDP.
+    const double vc = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
     const size_t nn = (size_t)psb->m_nodes.size();
     st->x.resize(nn), st->v.resize(nn), st->inverse_mass.resize(nn);
-    for (auto& r : st->records)
-        if (r.second.soft == psb && r.second.fresh)
-            for (const sdfccd_SoftPlane& h : r.second.holds) {
+    for (int k = 0; k < (count > 0 && split ? passes : 1); ++k) {
+        psb->solveConstraints();
+        for (SoftRecord* rec : recs)
+            for (const sdfccd_SoftPlane& h : rec->holds) {
                 const btSoftBody::Node& n = psb->m_nodes[h.node];
                 st->x[(size_t)h.node] = v3(n.m_x), st->v[(size_t)h.node] = v3(n.m_v), st->inverse_mass[(size_t)h.node] = n.m_im;
             }
-    // Bullet's rule for the velocity after its position solve: (x - q) / dt, damped by kDP.
-    const double vc = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
-    size_t hi = 0;
-    for (auto& r : st->records) {
-        SoftRecord& rec = r.second;
-        if (rec.soft != psb || !rec.fresh) continue;
-        const sdfccd_Frame F0 = frameOf(rec.sdf_pose), F = frameOf(rec.sdf_object->getWorldTransform());
-        int32_t held = 0;
-        sdfccd_soft_hold(&F0, &F, rec.start.data(), st->x.data(), st->v.data(), st->inverse_mass.data(), (int32_t)nn, rec.holds.data(),
-                         (int32_t)rec.holds.size(), rec.friction, push.data() + hi, vc, last, kSinglePrecision, &held);
-        st->stats.held_nodes += held;
-        hi += rec.holds.size();
-        for (const sdfccd_SoftPlane& h : rec.holds) {
-            btSoftBody::Node& n = psb->m_nodes[h.node];
-            n.m_x = bt(st->x[(size_t)h.node]), n.m_v = bt(st->v[(size_t)h.node]);
+        size_t hi = 0;
+        for (SoftRecord* rec : recs) {
+            const sdfccd_Frame F0 = frameOf(rec->sdf_pose), F = frameOf(rec->sdf_object->getWorldTransform());
+            sdfccd_soft_hold(&F0, &F, rec->start.data(), st->x.data(), st->v.data(), st->inverse_mass.data(), (int32_t)nn,
+                             rec->holds.data(), (int32_t)rec->holds.size(), rec->friction, push.data() + hi, vc,
+                             !split || k + 1 == passes, kSinglePrecision, nullptr);
+            hi += rec->holds.size();
         }
-    }
-}
-
-// Bullet's soft-body position solve (btSoftBody::solveConstraints) with the contact planes held
-// after each of its piterations passes: one call per pass with piterations = 1 is the same solve
-// (links and anchors are prepared from m_q, velocities set from m_x - m_q at the end of each call)
-// when the body has no velocity or drift passes and no clusters; otherwise the planes are held once,
-// after the solve.
-void solveHeld(SoftState* st, btSoftBody* psb)
-{
-    size_t count = 0;
-    for (auto& r : st->records)
-        if (r.second.soft == psb && r.second.fresh) count += r.second.holds.size();
-    if (count == 0) {
-        psb->solveConstraints();
-        return;
-    }
-    std::vector<double> push(count, 0.0);
-    const int passes = psb->m_cfg.piterations;
-    if (passes <= 1 || psb->m_cfg.viterations > 0 || psb->m_cfg.diterations > 0 || psb->m_clusters.size() > 0) {
-        psb->solveConstraints();
-        holdIteration(st, psb, push, true);
-        return;
-    }
-    psb->m_cfg.piterations = 1;
-    for (int k = 0; k < passes; ++k) {
-        psb->solveConstraints();
-        holdIteration(st, psb, push, k + 1 == passes);
+        for (SoftRecord* rec : recs)
+            for (const sdfccd_SoftPlane& h : rec->holds)
+                psb->m_nodes[h.node].m_x = bt(st->x[(size_t)h.node]), psb->m_nodes[h.node].m_v = bt(st->v[(size_t)h.node]);
     }
     psb->m_cfg.piterations = passes;
 }
 
 // The guard of one pair (sdfccd_soft_guard): start positions in the SDF's frame at the start of the
 // step, end positions in its frame now. A node it moves gets Bullet's velocity for its new motion,
-// minus its part into the surface.
+// minus its part into the surface (computed there).
 int guardRecord(SoftState* st, SoftRecord& rec, double tol)
 {
     btSoftBody* psb = const_cast<btSoftBody*>(rec.soft);
     const int nn = psb->m_nodes.size();
     if ((size_t)nn != rec.start.size()) return 0;
-    rec.sizeCerts(nn, psb->m_faces.size() + psb->m_links.size());
-    const sdfccd_SoftBody body = st->bodyOf(psb, rec.start);
+    const sdfccd_SoftBody body = st->bodyOf(psb, rec);
     const sdfccd_Frame F0 = frameOf(rec.sdf_pose), F = frameOf(rec.sdf_object->getWorldTransform());
     st->guarded.resize((size_t)nn);
-    sdfccd_SoftStats s = { 0, 0, 0 };
     int32_t moved = 0;
     const double dt = psb->m_sst.sdt > 0 ? psb->m_sst.sdt : 1.0;
-    const sdfccd_Status status = sdfccd_soft_guard(rec.sdf, &F0, &F, &body, tol, dt, &st->impl->cfg.query, rec.node_certs.data(),
-                                                   rec.face_certs.data(), st->guarded.data(), &moved, &s);
-    st->count(s);
-    if (status != SDFCCD_OK) {
-        ++st->stats.query_errors;
+    // Bullet's rule for the velocity after its position solve: (x - q) / dt, damped by kDP.
+    const double vc = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
+    if (sdfccd_soft_guard(rec.sdf, &F0, &F, &body, tol, dt, vc, &st->impl->cfg.query, rec.node_certs.data(), rec.face_certs.data(),
+                          st->guarded.data(), &moved, &st->totals) != SDFCCD_OK) {
+        ++st->totals.query_errors;
         return 0;
     }
-    const double inv_dt = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
     for (int i = 0; i < nn; ++i) {
         const sdfccd_SoftGuardNode& g = st->guarded[(size_t)i];
-        if (!g.moved) continue;
-        btSoftBody::Node& n = psb->m_nodes[i];
-        const sdfccd_Vec3 &w = g.position, &s0 = rec.start[(size_t)i];
-        n.m_x = bt(w);
-        n.m_v = bt(sdfccd_Vec3{ (w.x - s0.x) * inv_dt, (w.y - s0.y) * inv_dt, (w.z - s0.z) * inv_dt });
-        const btVector3 nrm = bt(g.normal);
-        const btScalar vn = n.m_v.dot(nrm);
-        if (g.stop && vn < 0) n.m_v -= nrm * vn; // no velocity into the surface
+        if (g.moved) psb->m_nodes[i].m_x = bt(g.position), psb->m_nodes[i].m_v = bt(g.velocity);
     }
     return moved;
 }
-
-// The world's soft-body solver, private in btSoftRigidDynamicsWorld, reached through an explicit
-// instantiation (where access is not checked), so that the guard runs right after the soft-body solve.
-template <typename Tag, typename Tag::type M>
-struct Reach {
-    friend typename Tag::type reach(Tag) { return M; }
-};
-struct SolverField {
-    typedef btSoftBodySolver* btSoftRigidDynamicsWorld::*type;
-    friend type reach(SolverField);
-};
-struct OwnsField {
-    typedef bool btSoftRigidDynamicsWorld::*type;
-    friend type reach(OwnsField);
-};
-template struct Reach<SolverField, &btSoftRigidDynamicsWorld::m_softBodySolver>;
-template struct Reach<OwnsField, &btSoftRigidDynamicsWorld::m_ownsSolver>;
 
 int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
 {
@@ -438,88 +362,74 @@ int guardWorld(SoftState* st, btSoftRigidDynamicsWorld* world, double tolerance)
     return moved;
 }
 
-// Bullet's solver, with the guard after each solve (the world owns this wrapper; the wrapper owns the
-// solver it wraps when the world did).
-class GuardingSolver : public btSoftBodySolver
+GuardingSolver::~GuardingSolver()
 {
-public:
-    GuardingSolver(btSoftBodySolver* inner, bool owns, SoftState* st, btSoftRigidDynamicsWorld* world)
-        : m_inner(inner), m_owns(owns), m_state(st), m_world(world)
-    {
-        m_timeScale = inner->getTimeScale();
-        m_numberOfPositionIterations = inner->getNumberOfPositionIterations();
-        m_numberOfVelocityIterations = inner->getNumberOfVelocityIterations();
-    }
-    ~GuardingSolver() override
-    {
-        if (m_state && m_state->wrapper == this) m_state->wrapper = nullptr; // the world is going away
-        if (m_owns) {
-            m_inner->~btSoftBodySolver();
-            btAlignedFree(m_inner);
-        }
-    }
-    SolverTypes getSolverType() const override { return m_inner->getSolverType(); }
-    bool checkInitialized() override { return m_inner->checkInitialized(); }
-    void optimize(btAlignedObjectArray<btSoftBody*>& bodies, bool force) override { m_inner->optimize(bodies, force); }
-    void copyBackToSoftBodies(bool move) override { m_inner->copyBackToSoftBodies(move); }
-    void predictMotion(btScalar dt) override { m_inner->predictMotion(dt); }
-    void solveConstraints(btScalar dt) override
-    {
-        if (m_state && m_state->dispatcher) { // Bullet's solver's loop, with the contact planes held
-            btSoftBodyArray& softs = m_world->getSoftBodyArray();
-            for (int i = 0; i < softs.size(); ++i)
-                if (softs[i]->isActive() && !softs[i]->isStaticObject()) solveHeld(m_state, softs[i]);
-            for (auto& r : m_state->records) r.second.holds.clear(); // this step's planes
-        } else {
-            m_inner->solveConstraints(dt);
-        }
-        if (m_state && m_state->dispatcher && m_state->auto_guard && m_state->impl->cfg.query.method != SDFCCD_METHOD_DCD) {
-            guardWorld(m_state, m_world, m_state->auto_tolerance);
-            m_state->guarded_this_step = true;
-        }
-    }
-    void updateSoftBodies() override { m_inner->updateSoftBodies(); }
-    void processCollision(btSoftBody* b, const btCollisionObjectWrapper* w) override { m_inner->processCollision(b, w); }
-    void processCollision(btSoftBody* a, btSoftBody* b) override { m_inner->processCollision(a, b); }
-    void setNumberOfPositionIterations(int n) override { m_inner->setNumberOfPositionIterations(n); }
-    int getNumberOfPositionIterations() override { return m_inner->getNumberOfPositionIterations(); }
-    void setNumberOfVelocityIterations(int n) override { m_inner->setNumberOfVelocityIterations(n); }
-    int getNumberOfVelocityIterations() override { return m_inner->getNumberOfVelocityIterations(); }
+    if (state && state->wrapper == this) state->wrapper = nullptr; // the world is going away
+}
 
-    btSoftBodySolver* m_inner;
-    bool m_owns;
-    SoftState* m_state;
-    btSoftRigidDynamicsWorld* m_world;
+void GuardingSolver::solveConstraints(btScalar dt)
+{
+    if (!state || !state->dispatcher) return btDefaultSoftBodySolver::solveConstraints(dt);
+    btSoftBodyArray& softs = state->world->getSoftBodyArray(); // Bullet's solver's loop, with the contact planes held
+    for (int i = 0; i < softs.size(); ++i)
+        if (softs[i]->isActive() && !softs[i]->isStaticObject()) solveHeld(state, softs[i]);
+    for (auto& r : state->records) r.second.holds.clear(); // this step's planes
+    const Config& cfg = state->impl->cfg;
+    if (cfg.guard_tolerance > 0 && cfg.query.method != SDFCCD_METHOD_DCD) { // the guarantee's tolerance
+        guardWorld(state, state->world, cfg.guard_tolerance);
+        state->guarded_this_step = true;
+    }
+}
+
+// The world's soft-body solver, private in btSoftRigidDynamicsWorld, reached through an explicit
+// instantiation (where access is not checked), so that the guard runs right after the soft-body solve.
+template <typename Tag, typename Tag::type M>
+struct Reach {
+    friend typename Tag::type reach(Tag) { return M; }
 };
+struct SolverField {
+    typedef btSoftBodySolver* btSoftRigidDynamicsWorld::*type;
+    friend type reach(SolverField);
+};
+struct OwnsField {
+    typedef bool btSoftRigidDynamicsWorld::*type;
+    friend type reach(OwnsField);
+};
+template struct Reach<SolverField, &btSoftRigidDynamicsWorld::m_softBodySolver>;
+template struct Reach<OwnsField, &btSoftRigidDynamicsWorld::m_ownsSolver>;
+
+// Puts `solver` in the world's private slot (the world frees it when `owns`) and in its soft bodies.
+void installSolver(btSoftRigidDynamicsWorld* world, btSoftBodySolver* solver, bool owns)
+{
+    world->*reach(SolverField()) = solver;
+    world->*reach(OwnsField()) = owns;
+    btSoftBodyArray& softs = world->getSoftBodyArray();
+    for (int i = 0; i < softs.size(); ++i) softs[i]->setSoftBodySolver(solver);
+}
+
+// Both orders of each (soft body, SDF) slot to `a` (soft first) and `b`, or to the configuration's own.
+void setSlots(SoftState* st, btCollisionAlgorithmCreateFunc* a, btCollisionAlgorithmCreateFunc* b)
+{
+    btCollisionConfiguration* cc = st->dispatcher->getCollisionConfiguration();
+    for (const auto& s : st->slots) {
+        st->dispatcher->registerCollisionCreateFunc(s.first, s.second, a ? a : cc->getCollisionAlgorithmCreateFunc(s.first, s.second));
+        st->dispatcher->registerCollisionCreateFunc(s.second, s.first, b ? b : cc->getCollisionAlgorithmCreateFunc(s.second, s.first));
+    }
+}
 
 } // namespace
 
 void softRegister(BridgeImpl* impl, btCollisionDispatcher* d)
 {
     std::unique_ptr<SoftState> st(new SoftState);
-    st->impl = impl;
-    st->dispatcher = d;
-    st->fn[0].state = st.get();
-    st->fn[1].state = st.get();
+    st->impl = impl, st->dispatcher = d;
+    st->fn[0].state = st->fn[1].state = st.get();
     st->fn[1].m_swapped = true;
     st->slots.push_back(std::make_pair((int)SOFTBODY_SHAPE_PROXYTYPE, impl->cfg.sdf_shape_type));
     if (impl->cfg.handle_bt_sdf_shape) st->slots.push_back(std::make_pair((int)SOFTBODY_SHAPE_PROXYTYPE, (int)SDF_SHAPE_PROXYTYPE));
-    for (const auto& s : st->slots) {
-        d->registerCollisionCreateFunc(s.first, s.second, &st->fn[0]);
-        d->registerCollisionCreateFunc(s.second, s.first, &st->fn[1]);
-    }
+    setSlots(st.get(), &st->fn[0], &st->fn[1]);
     std::lock_guard<std::mutex> lock(g_soft_mutex);
     g_soft[impl] = std::move(st);
-}
-
-
-// Puts `solver` in the world's private slot (the world frees it when `owns`) and in its soft bodies.
-static void installSolver(btSoftRigidDynamicsWorld* world, btSoftBodySolver* solver, bool owns)
-{
-    world->*reach(SolverField()) = solver;
-    world->*reach(OwnsField()) = owns;
-    btSoftBodyArray& softs = world->getSoftBodyArray();
-    for (int i = 0; i < softs.size(); ++i) softs[i]->setSoftBodySolver(solver);
 }
 
 void softAttach(BridgeImpl* impl, btCollisionWorld* cw)
@@ -528,24 +438,26 @@ void softAttach(BridgeImpl* impl, btCollisionWorld* cw)
     SoftState* st = softOf(impl);
     if (!world || !st || st->wrapper) return;
     btSoftBodySolver* inner = world->*reach(SolverField());
-    if (!inner || inner->getSolverType() != btSoftBodySolver::DEFAULT_SOLVER) return; // only Bullet's CPU solver
-    st->world = world, st->inner = inner, st->world_owned_inner = world->*reach(OwnsField());
-    st->wrapper = new (btAlignedAlloc(sizeof(GuardingSolver), 16)) GuardingSolver(inner, st->world_owned_inner, st, world);
-    installSolver(world, st->wrapper, true); // the world frees the wrapper (and the wrapper its solver when the world owned it)
+    if (!inner || typeid(*inner) != typeid(btDefaultSoftBodySolver)) return; // only Bullet's CPU solver
+    st->world = world;
+    st->wrapper = new (btAlignedAlloc(sizeof(GuardingSolver), 16)) GuardingSolver(*static_cast<btDefaultSoftBodySolver*>(inner), st);
+    st->inner = world->*reach(OwnsField()) ? nullptr : inner;
+    if (!st->inner) inner->~btSoftBodySolver(), btAlignedFree(inner); // the world's own: the wrapper is its copy
+    installSolver(world, st->wrapper, true); // the world frees the wrapper
 }
 
-// Puts the world's own solver back (the world must still exist: see Bridge's lifetime note).
+// Puts a plain solver back (the caller's, else a copy of the wrapper the world owns; the world must
+// still exist: see Bridge's lifetime note).
 void softDetach(SoftState* st)
 {
-    if (!st->wrapper || !st->world) return;
-    if (st->world->*reach(SolverField()) == st->wrapper) {
-        installSolver(st->world, st->inner, st->world_owned_inner);
+    if (st->wrapper && st->world && st->world->*reach(SolverField()) == st->wrapper) {
         GuardingSolver* g = st->wrapper;
-        g->m_owns = false, g->m_state = nullptr;
+        installSolver(st->world, st->inner ? st->inner : new (btAlignedAlloc(sizeof(btDefaultSoftBodySolver), 16)) btDefaultSoftBodySolver(*g),
+                      !st->inner);
         g->~GuardingSolver();
         btAlignedFree(g);
     }
-    st->wrapper = nullptr, st->world = nullptr;
+    st->wrapper = nullptr, st->world = nullptr, st->inner = nullptr;
 }
 
 void softUnregister(BridgeImpl* impl)
@@ -553,11 +465,7 @@ void softUnregister(BridgeImpl* impl)
     SoftState* st = softOf(impl);
     if (!st || !st->dispatcher) return;
     softDetach(st);
-    btCollisionConfiguration* cc = st->dispatcher->getCollisionConfiguration();
-    for (const auto& s : st->slots) {
-        st->dispatcher->registerCollisionCreateFunc(s.first, s.second, cc->getCollisionAlgorithmCreateFunc(s.first, s.second));
-        st->dispatcher->registerCollisionCreateFunc(s.second, s.first, cc->getCollisionAlgorithmCreateFunc(s.second, s.first));
-    }
+    setSlots(st, nullptr, nullptr);
     st->dispatcher = nullptr;
     st->records.clear();
 }
@@ -565,7 +473,7 @@ void softUnregister(BridgeImpl* impl)
 void softForget(BridgeImpl* impl)
 {
     SoftState* st = softOf(impl);
-    if (st && st->wrapper) st->wrapper->m_state = nullptr; // the world still holds it: make it a plain solver
+    if (st && st->wrapper) st->wrapper->state = nullptr; // the world still holds it: make it a plain solver
     std::lock_guard<std::mutex> lock(g_soft_mutex);
     g_soft.erase(impl);
 }
@@ -575,17 +483,10 @@ void softForget(BridgeImpl* impl)
 SoftBodyStats softBodyStats(const Bridge& bridge)
 {
     const detail::SoftState* st = detail::softOf(BridgeAccess::of(const_cast<Bridge&>(bridge)));
-    return st ? st->stats : SoftBodyStats();
-}
-
-bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance)
-{
-    detail::SoftState* st = detail::softOf(BridgeAccess::of(bridge));
-    if (!st || !(tolerance > 0) || !std::isfinite(tolerance)) return false;
-    st->auto_guard = on;
-    st->auto_tolerance = tolerance;
-    st->guarded_this_step = false;
-    return st->wrapper != nullptr;
+    if (!st) return SoftBodyStats();
+    SoftBodyStats s = st->stats;
+    s.face_queries = st->totals.face_queries, s.query_errors = st->totals.query_errors, s.sdf_evaluations = st->totals.sdf_evaluations;
+    return s;
 }
 
 int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tolerance)

@@ -42,6 +42,8 @@ static double to_float(double x)
     return f;
 }
 static scc_vec3 stored(scc_vec3 v, int32_t single) { return single ? scc_v3(to_float(v.x), to_float(v.y), to_float(v.z)) : v; }
+/* x as the engine computes it: one double operation on floats, rounded once, is the float operation. */
+static double eng(double x, int32_t single) { return single ? to_float(x) : x; }
 
 /* The bridge's Lipschitz bound: the SDF's own, never below 1. */
 static double lipschitz_of(sdfccd_SdfId sdf)
@@ -246,6 +248,59 @@ sdfccd_Status sdfccd_soft_hold(const sdfccd_Frame* F0, const sdfccd_Frame* F, co
     return SDFCCD_OK;
 }
 
+/* ---- a node's contact with a rigid body ---- */
+
+/* Bullet's soft-rigid contact terms (btSoftBody's collision handler), operation for operation in
+ * its order (btVector3, btMatrix3x3: products summed left to right, the inverse by the cofactors of
+ * the first row), each rounded as the engine rounds (R). */
+#define R(x) eng((x), sp)
+static double cofac(const double m[3][3], int r1, int c1, int r2, int c2, int32_t sp) { return R(R(m[r1][c1] * m[r2][c2]) - R(m[r1][c2] * m[r2][c1])); }
+static void mat_mul(const double a[3][3], const double b[3][3], double out[3][3], int32_t sp)
+{
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) out[i][j] = R(R(R(b[0][j] * a[i][0]) + R(b[1][j] * a[i][1])) + R(b[2][j] * a[i][2]));
+}
+static double dot_r(scc_vec3 a, scc_vec3 b, int32_t sp) { return R(R(R(a.x * b.x) + R(a.y * b.y)) + R(a.z * b.z)); }
+
+sdfccd_Status sdfccd_soft_node_contact(sdfccd_Vec3 start, sdfccd_Vec3 end, double inverse_mass, const sdfccd_SoftRigid* body,
+                                       sdfccd_Vec3 normal, double friction, double duration, int32_t sp, sdfccd_SoftNodeContact* out)
+{
+    static const char fn[] = "sdfccd_soft_node_contact";
+    if (!body || !out) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: a NULL pointer", fn);
+    if (!(duration > 0) || !isfinite(duration)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: duration %g not finite and > 0", fn, duration);
+    const double ima = inverse_mass, imb = body->inverse_mass, dt = duration, fc = friction;
+    if (!(R(ima + imb) > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: node and body both without inverse mass", fn);
+    const scc_vec3 x = sdfccd__v(end), q = sdfccd__v(start), o = sdfccd__v(body->origin), w = sdfccd__v(body->angular_velocity);
+    const scc_vec3 lv = sdfccd__v(body->linear_velocity), n = sdfccd__v(normal);
+    const scc_vec3 r = scc_v3(R(x.x - o.x), R(x.y - o.y), R(x.z - o.z));
+    /* The node's motion relative to the body's point under it; static friction when its sideways
+     * part is below friction times its normal part. */
+    const scc_vec3 wr = scc_v3(R(R(w.y * r.z) - R(w.z * r.y)), R(R(w.z * r.x) - R(w.x * r.z)), R(R(w.x * r.y) - R(w.y * r.x)));
+    const scc_vec3 va = scc_v3(R(R(lv.x + wr.x) * dt), R(R(lv.y + wr.y) * dt), R(R(lv.z + wr.z) * dt));
+    const scc_vec3 vr = scc_v3(R(R(x.x - q.x) - va.x), R(R(x.y - q.y) - va.y), R(R(x.z - q.z) - va.z));
+    const double dn = dot_r(vr, n, sp);
+    const scc_vec3 fv = scc_v3(R(vr.x - R(n.x * dn)), R(vr.y - R(n.y * dn)), R(vr.z - R(n.z * dn)));
+    out->friction_keep = dot_r(fv, fv, sp) < R(R(R(dn * fc) * dn) * fc) ? 0.0 : R(1 - fc);
+    /* The effective inverse mass at the node, ima I + imb I - [r]x Iw^-1 [r]x, inverted, per dt. */
+    const double cr[3][3] = { { 0, -r.z, r.y }, { r.z, 0, -r.x }, { -r.y, r.x, 0 } };
+    double t[3][3], k[3][3], m[3][3];
+    mat_mul(cr, body->inverse_inertia, t, sp);
+    mat_mul(t, cr, k, sp);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) m[i][j] = R((i == j ? R(ima + imb) : 0.0) - k[i][j]);
+    const double c0 = cofac(m, 1, 1, 2, 2, sp), c1 = cofac(m, 1, 2, 2, 0, sp), c2 = cofac(m, 1, 0, 2, 1, sp);
+    const double s = R(1.0 / R(R(R(m[0][0] * c0) + R(m[0][1] * c1)) + R(m[0][2] * c2))), per_dt = R(1 / dt);
+    const double inv[3][3] = { { c0, cofac(m, 0, 2, 2, 1, sp), cofac(m, 0, 1, 1, 2, sp) },
+                               { c1, cofac(m, 0, 0, 2, 2, sp), cofac(m, 0, 2, 1, 0, sp) },
+                               { c2, cofac(m, 0, 1, 2, 0, sp), cofac(m, 0, 0, 1, 1, sp) } };
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) out->impulse[i][j] = R(R(inv[i][j] * s) * per_dt);
+    out->arm = sdfccd__pv(r);
+    out->mass_dt = R(ima * dt);
+    return SDFCCD_OK;
+}
+#undef R
+
 /* ---- the guard ---- */
 
 typedef struct guard_state {
@@ -281,8 +336,20 @@ static int cert_clears(const sdfccd_DistanceCert* dc, const scc_vec3* s, const s
     return scc_cert_bound(&c, s, e, n, L) >= need;
 }
 
+/* A moved node's velocity as the engine sets it: vscale * (position - start) stored, then (stop) less
+ * its part into the stored normal, term for term in the engine's precision. */
+static sdfccd_Vec3 moved_velocity(const sdfccd_SoftGuardNode* o, sdfccd_Vec3 start, double vscale, int32_t single)
+{
+    scc_vec3 v = stored(scc_scale(scc_sub(sdfccd__v(o->position), sdfccd__v(start)), vscale), single);
+    const scc_vec3 n = stored(sdfccd__v(o->normal), single);
+    const double vn = eng(eng(eng(v.x * n.x, single) + eng(v.y * n.y, single), single) + eng(v.z * n.z, single), single);
+    if (o->stop && vn < 0)
+        v = scc_v3(eng(v.x - eng(n.x * vn, single), single), eng(v.y - eng(n.y * vn, single), single), eng(v.z - eng(n.z * vn, single), single));
+    return sdfccd__pv(v);
+}
+
 static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, const sdfccd_Frame* F, const sdfccd_SoftBody* body, double tol,
-                                     double dt, const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
+                                     double dt, double vscale, const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
                                      sdfccd_DistanceCert* face_certs, sdfccd_SoftGuardNode* out, int32_t* out_moved, sdfccd_SoftStats* stats)
 {
     static const char fn[] = "sdfccd_soft_guard";
@@ -296,6 +363,7 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
     if (nf + (int64_t)nl > 0 && !face_certs) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: face_certs is NULL", fn);
     if (!(isfinite(tol) && tol > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: tolerance = %g is not finite and > 0", fn, tol);
     if (!(isfinite(dt) && dt > 0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: duration = %g is not finite and > 0", fn, dt);
+    if (!isfinite(vscale)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: velocity_scale = %g is not finite", fn, vscale);
     if (!sdfccd__sdf_acquire(sdf)) return SDFCCD_INVALID_HANDLE;
     const double L = lipschitz_of(sdf);
     const size_t bytes = (size_t)nn * (2 * sizeof(scc_vec3) + sizeof(double) + 2);
@@ -311,6 +379,7 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
         out[i].moved = out[i].stop = 0;
         out[i].position = body->end[i];
         out[i].normal = (sdfccd_Vec3){ 0, 0, 1 };
+        out[i].velocity = (sdfccd_Vec3){ 0, 0, 0 };
         g.E[i] = to_local(F, sdfccd__v(body->end[i]));
         g.level[i] = -tol;
         g.touched[i] = g.touched_next[i] = 0;
@@ -381,16 +450,17 @@ static sdfccd_Status soft_guard_held(sdfccd_SdfId sdf, const sdfccd_Frame* F0, c
     }
     stats->sdf_evaluations += evals;
     int32_t moved = 0;
-    for (int32_t i = 0; i < nn; ++i) moved += out[i].moved;
+    for (int32_t i = 0; i < nn; ++i)
+        if (out[i].moved) out[i].velocity = moved_velocity(&out[i], body->start[i], vscale, body->single_precision), ++moved;
     if (out_moved) *out_moved = moved;
     sdfccd__free(mem, bytes);
     return SDFCCD_OK;
 }
 
 sdfccd_Status sdfccd_soft_guard(sdfccd_SdfId sdf, const sdfccd_Frame* start_frame, const sdfccd_Frame* frame, const sdfccd_SoftBody* body,
-                                double tolerance, double duration, const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
+                                double tolerance, double duration, double velocity_scale, const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
                                 sdfccd_DistanceCert* face_certs, sdfccd_SoftGuardNode* out_nodes, int32_t* out_moved, sdfccd_SoftStats* io_stats)
 {
-    SDFCCD__HELD_CALL(soft_guard_held(sdf, start_frame, frame, body, tolerance, duration, query, node_certs, face_certs, out_nodes, out_moved,
+    SDFCCD__HELD_CALL(soft_guard_held(sdf, start_frame, frame, body, tolerance, duration, velocity_scale, query, node_certs, face_certs, out_nodes, out_moved,
                                       io_stats));
 }

@@ -12,10 +12,12 @@
 #include <iterator>
 #include <memory>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/CollisionShapes/btSdfCollisionShape.h>
+#include <BulletSoftBody/btDefaultSoftBodySolver.h>
 #include <BulletSoftBody/btSoftBody.h>
 #include <BulletSoftBody/btSoftBodyHelpers.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
@@ -33,28 +35,36 @@ using sdfccd_bullet::Status;
 
 static const double kDt = 1.0 / 60.0;
 
+// The default configuration, or with the guarantee off (contacts only, to show what the guard adds;
+// SDFCCD_SOFT_NO_GUARD=1 for every test).
+static sdfccd_bullet::Config guardConfig(bool guard = std::getenv("SDFCCD_SOFT_NO_GUARD") == nullptr)
+{
+    sdfccd_bullet::Config c;
+    if (!guard) c.guard_tolerance = 0;
+    return c;
+}
+
 // A soft-rigid world, z up, with or without the bridge (registered before any body is added).
 struct SoftWorld {
     btSoftBodyRigidBodyCollisionConfiguration config;
     btCollisionDispatcher dispatcher{ &config };
     btDbvtBroadphase broadphase;
     btSequentialImpulseConstraintSolver solver;
-    btSoftRigidDynamicsWorld world{ &dispatcher, &broadphase, &solver, &config };
+    btSoftRigidDynamicsWorld world;
     Bridge* bridge;
     bool guard = true;
     std::vector<std::unique_ptr<btCollisionObject>> statics;
     std::vector<btSoftBody*> softs;
-    explicit SoftWorld(Bridge* b) : bridge(b)
+    // soft_solver: the caller's soft-body solver (NULL: the world makes and owns Bullet's).
+    explicit SoftWorld(Bridge* b, btSoftBodySolver* soft_solver = nullptr)
+        : world(&dispatcher, &broadphase, &solver, &config, soft_solver), bridge(b)
     {
         world.setGravity(btVector3(0, 0, -9.81));
         world.getWorldInfo().m_gravity = btVector3(0, 0, -9.81);
         if (bridge) {
             const Status s = bridge->registerWith(&world);
             CHECK(s == Status::Ok, "registerWith: %s", sdfccd_bullet::statusString(s));
-            if (std::getenv("SDFCCD_SOFT_NO_GUARD")) { // contacts only (to show what the guard adds)
-                guard = false;
-                sdfccd_bullet::setSoftBodyGuard(*bridge, false);
-            }
+            guard = bridge->config().guard_tolerance > 0;
         }
     }
     ~SoftWorld()
@@ -183,7 +193,7 @@ static void test_cloth_on_torus()
     double final_min_z = 0;
     const int steps = std::getenv("SDFCCD_SOFT_STEPS") ? std::atoi(std::getenv("SDFCCD_SOFT_STEPS")) : 240;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(torus);
         SoftWorld w(&bridge);
         btTransform id;
@@ -243,7 +253,7 @@ static double slideOnSlope(double deg, double* pen)
     double moved = 0;
     *pen = 0;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(slab);
         SoftWorld w(&bridge);
         btTransform pose;
@@ -290,11 +300,9 @@ static void runFastPlate(bool guard, double* worst, double* final_min_z)
     CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.005 }, &plate) == SDFCCD_OK, "plate");
     *worst = 0;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig(guard));
         SdfShape shape(plate);
-        SoftWorld w(&bridge);
-        w.guard = guard;
-        CHECK(sdfccd_bullet::setSoftBodyGuard(bridge, guard), "the automatic guard is not installed");
+        SoftWorld w(&bridge); // with the guard, each step() also checks that the automatic guard ran
         btTransform id;
         id.setIdentity();
         w.addStatic(&shape, id);
@@ -338,15 +346,13 @@ static void test_cloth_on_spikes()
     double worst = 0, worst_nodes = 0;
     int face_steps = 0;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(spikes);
         shape.setLocalBounds(btVector3(-1, -1, -0.1f), btVector3(1, 1, 0.11f));
         SoftWorld w(&bridge);
         btTransform id;
         id.setIdentity();
         w.addStatic(&shape, id);
-        w.guard = std::getenv("SDFCCD_SOFT_NO_GUARD") == nullptr;
-        sdfccd_bullet::setSoftBodyGuard(bridge, w.guard);
         btSoftBody* cloth = w.addCloth(0.6, 0.013, 0.021, 0.25, -2.0);
         for (int s = 0; s < 90; ++s) {
             w.step();
@@ -377,7 +383,7 @@ static void test_ball_on_torus()
     double worst = 0, mean_z = 0;
     int faces = 0;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(torus);
         SoftWorld w(&bridge);
         btTransform id;
@@ -441,7 +447,7 @@ static void test_ball_on_bunny()
     double worst = 0, lowest = 1e30;
     int64_t contacts = 0;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(grid);
         SoftWorld w(&bridge);
         w.addStatic(&shape, pose);
@@ -470,7 +476,7 @@ static void test_rope_through_ring()
     CHECK(sdfccd_create_torus(0.25, 0.04, &torus) == SDFCCD_OK, "torus");
     double worst = 0, worst_links = 0;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(torus);
         SoftWorld w(&bridge);
         btTransform pose;
@@ -523,7 +529,7 @@ static void test_moving_sdf()
     CHECK(sdfccd_create_box(sdfccd_Vec3{ 0.6, 0.6, 0.005 }, &plate) == SDFCCD_OK, "plate");
     double worst = 0, lowest_gap = 1e30;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(plate);
         SoftWorld w(&bridge);
         KinematicPath path;
@@ -560,7 +566,7 @@ static void test_dynamic_sdf()
     double worst = 0, nodes_worst = 0, lowest = 1e30, up_vz = -1e30;
     int worst_step = -1, bad_steps = 0;
     {
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(ball);
         SoftWorld w(&bridge);
         btSoftBody* cloth = w.addCloth(0.6, 0.0, 0.0, 0.0, 0.0);
@@ -634,7 +640,7 @@ static void test_btsdf_tray()
     for (int with = 0; with < 2; ++with) {
         btSdfCollisionShape cdf;
         CHECK(cdf.initializeSDF(bytes.data(), (int)bytes.size()), "initializeSDF");
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SoftWorld w(with ? &bridge : nullptr);
         btTransform id;
         id.setIdentity();
@@ -655,7 +661,7 @@ static void test_btsdf_tray()
         btSdfCollisionShape cdf;
         SdfShape shape(grid);
         CHECK(cdf.initializeSDF(bytes.data(), (int)bytes.size()), "initializeSDF");
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         if (k == 0) CHECK(bridge.setBtSdfData(&cdf, bytes.data(), bytes.size()) == Status::Ok, "setBtSdfData");
         SoftWorld w(&bridge);
         btTransform id;
@@ -776,7 +782,7 @@ static void test_soft_misuse()
     {
         sdfccd_SdfId plate;
         CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &plate) == SDFCCD_OK, "plate");
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(plate);
         SoftWorld w(&bridge);
         btTransform id;
@@ -798,7 +804,7 @@ static void test_soft_misuse()
     {
         sdfccd_SdfId plate;
         CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &plate) == SDFCCD_OK, "plate");
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(plate);
         SoftWorld w(&bridge);
         btTransform id;
@@ -827,7 +833,7 @@ static void test_soft_misuse()
     {
         sdfccd_SdfId plate;
         CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &plate) == SDFCCD_OK, "plate");
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         SdfShape shape(plate);
         std::unique_ptr<SoftWorld> w(new SoftWorld(&bridge));
         w->bridge = nullptr; // its destructor must not unregister
@@ -837,8 +843,34 @@ static void test_soft_misuse()
         w->addCloth(0.4, 0, 0, 0.1, -1.0);
         for (int s = 0; s < 5; ++s) w->world.stepSimulation((btScalar)kDt, 0, (btScalar)kDt);
         CHECK(sdfccd_bullet::softBodyStats(bridge).pair_steps > 0, "no soft-body pair");
-        w.reset();
-        CHECK(!sdfccd_bullet::setSoftBodyGuard(bridge, true), "the guard still counts as installed in a destroyed world");
+        w.reset(); // the bridge's destructor must not touch the freed wrapper (ASan, valgrind)
+        sdfccd_destroy_sdf(plate);
+    }
+
+    // The automatic guard's wrapper in place of the world's soft-body solver, the caller's or the
+    // world's own: the guard runs in it (a 20 m/s cloth stops on a 1 cm plate), and unregister() puts
+    // back the caller's very solver, or a plain Bullet solver for the world's own.
+    for (int callers = 0; callers < 2; ++callers) {
+        sdfccd_SdfId plate;
+        CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.005 }, &plate) == SDFCCD_OK, "plate");
+        btDefaultSoftBodySolver own;
+        Bridge bridge(guardConfig());
+        SdfShape shape(plate);
+        SoftWorld w(&bridge, callers ? &own : nullptr);
+        btTransform id;
+        id.setIdentity();
+        w.addStatic(&shape, id);
+        btSoftBody* cloth = w.addCloth(0.6, 0.0, 0.0, 0.5, -20.0);
+        const btSoftBodySolver* wrapped = cloth->getSoftBodySolver();
+        CHECK(wrapped && typeid(*wrapped) != typeid(btDefaultSoftBodySolver), "the soft-body solver is not wrapped (%d)", callers);
+        for (int s = 0; s < 30; ++s) w.step();
+        CHECK(minZ(cloth) > 0.004, "the cloth passed the plate (lowest node z = %.4f, %d)", minZ(cloth), callers);
+        bridge.unregister();
+        const btSoftBodySolver* back = cloth->getSoftBodySolver();
+        CHECK(back && typeid(*back) == typeid(btDefaultSoftBodySolver) && (!callers || back == &own),
+              "unregister did not put a plain solver back (%d)", callers);
+        w.bridge = nullptr;
+        for (int s = 0; s < 5; ++s) w.step(); // a plain world again
         sdfccd_destroy_sdf(plate);
     }
 
@@ -887,7 +919,7 @@ static void bench(const char* only)
         sdfccd_SdfId slab;
         CHECK(sdfccd_create_box(sdfccd_Vec3{ 1.0, 1.0, 0.05 }, &slab) == SDFCCD_OK, "slab");
         {
-            Bridge bridge;
+            Bridge bridge(guardConfig());
             SdfShape shape(slab);
             btBoxShape box(btVector3(1, 1, 0.05f));
             SoftWorld w(with ? &bridge : nullptr);
@@ -1056,7 +1088,7 @@ static void reportRow(const ReportScene& rs, Collider c)
         StockShape stock;
         SdfShape shape(sdf);
         if (std::string(rs.name) == "cloth_on_spikes") shape.setLocalBounds(btVector3(-1, -1, -0.1f), btVector3(1, 1, 0.11f));
-        Bridge bridge;
+        Bridge bridge(guardConfig());
         btCollisionShape* coll = c == Collider::Bridge ? (btCollisionShape*)&shape : stock.make(c, sdf, box, rs.mesh_res);
         if (!coll) {
             CHECK(false, "%s: the stock shape could not be built", rs.name);

@@ -17,9 +17,10 @@
  * The guarantee, sdfccd_soft_guard(): no node or face point (rope: link point) ends a step deeper
  * than the tolerance past its time of impact; a node put back loses its velocity into the surface.
  * With Bullet's own (CPU) solver in a btSoftRigidDynamicsWorld it runs by itself after each
- * soft-body solve, in every internal step: the bridge wraps the world's solver (put back by
- * Bridge::unregister(); the world frees it otherwise). Other solvers, or a world registered as a
- * bare dispatcher: call guardSoftBodies() after each stepSimulation with at most one internal step.
+ * soft-body solve, in every internal step, with the rigid bodies' tolerance Config::guard_tolerance
+ * (<= 0: off): the bridge wraps the world's solver (put back by
+ * Bridge::unregister(); the world frees it otherwise). With other solvers, call
+ * guardSoftBodies() after each stepSimulation with at most one internal step.
  *
  * Not covered: btDeformableMultiBodyDynamicsWorld, whose solver takes node and face contacts of
  * its own kind and ignores the RContacts the bridge writes, and does not use the soft-rigid world's
@@ -46,16 +47,10 @@ struct SoftBodyStats {
     int64_t guard_nodes = 0;    /**< Nodes the guard moved back to a time of impact. */
     int64_t query_errors = 0;   /**< Queries that failed (no contact written for that face). */
     int64_t refused = 0;        /**< Pairs refused: an SdfShape with a dead handle (reported as misuse). */
-    int64_t held_nodes = 0;     /**< Nodes a held plane moved in the solve's last pass (per plane and step). */
 };
 
 /** The soft-body counters of `bridge`. */
 SoftBodyStats softBodyStats(const Bridge& bridge);
-
-/** Turns the automatic guard (see the file comment) on or off and sets its tolerance (m, > 0;
- * default on, 5e-4). Returns true when the automatic guard is installed in a world (false: bad
- * tolerance, bridge never registered, or no btSoftRigidDynamicsWorld with Bullet's solver). */
-bool setSoftBodyGuard(Bridge& bridge, bool on, double tolerance = 5e-4);
 
 /** The soft-body guarantee (sdfccd_soft_guard(), see the file comment) for the step just taken by
  * `world`, over every soft body the bridge collided with an SDF in it, from its nodes' start

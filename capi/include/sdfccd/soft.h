@@ -103,12 +103,41 @@ SDFCCD_API sdfccd_Status sdfccd_soft_hold(const sdfccd_Frame* start_frame, const
                                           double* pushes, double velocity_scale, int32_t last, int32_t single_precision,
                                           int32_t* out_held);
 
+/** A rigid body a node touches, as sdfccd_soft_node_contact() sees it (world frame). */
+typedef struct sdfccd_SoftRigid {
+    sdfccd_Vec3 origin;           /**< Its centre of mass (m). */
+    sdfccd_Vec3 linear_velocity;  /**< Of the centre of mass (m/s). */
+    sdfccd_Vec3 angular_velocity; /**< (rad/s). */
+    double inverse_mass;          /**< 1/kg; 0 for a static or kinematic body. */
+    double inverse_inertia[3][3]; /**< Inverse inertia tensor (world); zeros for a static or kinematic body. */
+} sdfccd_SoftRigid;
+
+/** The terms of a node's contact with a rigid body in a position-based soft-body solver, as
+ * Bullet's own soft-rigid collision handler computes them (btSoftBody::RContact m_c0 to m_c3). */
+typedef struct sdfccd_SoftNodeContact {
+    double impulse[3][3]; /**< (1/dt) (ima I + imb I - [r]x Iw^-1 [r]x)^-1: the impulse that cancels a unit relative displacement. */
+    sdfccd_Vec3 arm;      /**< r: the node's end position minus the body's origin (m). */
+    double mass_dt;       /**< The node's inverse mass times dt. */
+    double friction_keep; /**< 0 when static friction holds (the node's sideways motion relative to the body's point at most friction times its normal motion), else 1 - friction. */
+} sdfccd_SoftNodeContact;
+
+/** The contact terms of a node (inverse mass `inverse_mass`, moving from `start` to `end` over a
+ * step of `duration` s) with `body` along the unit contact normal `normal` (world), with the
+ * combined friction coefficient `friction`. With `single_precision` non-zero every operation is
+ * rounded as a float engine rounds it (its inputs being floats), so that such an engine gets its
+ * own numbers. Errors (nothing written): INVALID_ARGUMENT for a NULL pointer, a duration not
+ * finite and > 0, or a node and a body without inverse mass. */
+SDFCCD_API sdfccd_Status sdfccd_soft_node_contact(sdfccd_Vec3 start, sdfccd_Vec3 end, double inverse_mass, const sdfccd_SoftRigid* body,
+                                                  sdfccd_Vec3 normal, double friction, double duration, int32_t single_precision,
+                                                  sdfccd_SoftNodeContact* out);
+
 /** What sdfccd_soft_guard() decided for one node. */
 typedef struct sdfccd_SoftGuardNode {
-    int32_t moved;        /**< 1: the node goes to `position`; its velocity becomes (position - start) / dt as the engine sets it. */
-    int32_t stop;         /**< 1: then it loses its velocity into `normal`. */
+    int32_t moved;        /**< 1: the node goes to `position` with `velocity`. */
+    int32_t stop;         /**< 1: it lost its velocity into `normal`. */
     sdfccd_Vec3 position; /**< Its new end position (world; before single-precision rounding). */
-    sdfccd_Vec3 normal;   /**< Unit normal (world) to stop the velocity along. */
+    sdfccd_Vec3 normal;   /**< Unit normal (world) the velocity was stopped along. */
+    sdfccd_Vec3 velocity; /**< Its new velocity (world; 0 when not moved): velocity_scale * (position - start), less its part into `normal` when stop; computed as a float engine does when the body is single_precision. */
 } sdfccd_SoftGuardNode;
 
 /** The no-tunnelling guard of a soft body's step against `sdf`: the SDF's frame at the start of
@@ -121,13 +150,16 @@ typedef struct sdfccd_SoftGuardNode {
  *
  * `node_certs` (node_count) and `face_certs` (face_count + link_count) are the caller's
  * certificates. `out_nodes` (node_count) gets what happens to each node. `*out_moved` (may be NULL)
- * gets the number of nodes moved. `duration` is the step (s, > 0). Failed checks are counted in
+ * gets the number of nodes moved. `duration` is the step (s, > 0). A moved node's velocity is
+ * velocity_scale * (its displacement over the step), as the engine sets it after its position solve
+ * (1 / duration, or a damped rule such as Bullet's (1 - kDP) / dt). Failed checks are counted in
  * `io_stats` and skipped.
  *
  * Errors (nothing written): INVALID_HANDLE; INVALID_ARGUMENT for a NULL pointer, a count < 0, a
- * node index out of range, tolerance or duration not finite and > 0; OUT_OF_MEMORY. */
+ * node index out of range, tolerance or duration not finite and > 0, velocity_scale not finite;
+ * OUT_OF_MEMORY. */
 SDFCCD_API sdfccd_Status sdfccd_soft_guard(sdfccd_SdfId sdf, const sdfccd_Frame* start_frame, const sdfccd_Frame* frame,
-                                           const sdfccd_SoftBody* body, double tolerance, double duration,
+                                           const sdfccd_SoftBody* body, double tolerance, double duration, double velocity_scale,
                                            const sdfccd_QueryParams* query, sdfccd_DistanceCert* node_certs,
                                            sdfccd_DistanceCert* face_certs, sdfccd_SoftGuardNode* out_nodes, int32_t* out_moved,
                                            sdfccd_SoftStats* io_stats);
