@@ -82,6 +82,57 @@ START_TEST(test_huge_spin_rejected)
 }
 END_TEST
 
+/* SDF evaluations are the unit of cost the library reports: every call of a user's field is one counted
+ * evaluation (nothing computed ahead and thrown away), for a query that hits, one that grazes past, and at
+ * every evaluation budget. */
+static double counted_sphere(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
+{
+    ++*(int64_t*)user;
+    const double l = sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+    if (g) *g = l > 0.0 ? (sdfccd_Vec3){ p.x / l, p.y / l, p.z / l } : (sdfccd_Vec3){ 0.0, 0.0, 1.0 };
+    return l - 1.0;
+}
+
+START_TEST(test_field_calls_are_counted)
+{
+    int64_t calls = 0;
+    sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
+    d.eval = counted_sphere;
+    d.user = &calls;
+    d.bounds = (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } };
+    d.smooth = 1;
+    sdfccd_SdfId s;
+    ck_assert_int_eq(sdfccd_create_callback_sdf(&d, &s), SDFCCD_OK);
+    /* z = 1.0005 slides 0.5 mm over the top (the traces' steps shrink there); z = 0.5 hits */
+    const double heights[2] = { 1.0005, 0.5 };
+    for (int k = 0; k < 2; ++k) {
+        const double z = heights[k];
+        const sdfccd_Vec3 tri[3] = { { 2, 0, z }, { 2.5, 0, z }, { 2, 0.5, z } };
+        sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+        m.linear_velocity.x = -4.0;
+        m.local_center = (sdfccd_Vec3){ 2.17, 0.17, z }; /* spin about the triangle's centroid */
+        m.angular_velocity.z = 3.0;
+        for (int method = 0; method < SDFCCD_METHOD_COUNT; ++method) {
+            sdfccd_QueryParams p = sdfccd_default_query_params();
+            p.method = (sdfccd_Method)method;
+            sdfccd_QueryResult r;
+            calls = 0;
+            ck_assert_int_eq(sdfccd_query_triangle(s, NULL, tri, &m, 0, 1, &p, NULL, 0, &r), SDFCCD_OK);
+            if (method == SDFCCD_METHOD_FWGSS || method == SDFCCD_METHOD_CERTIFIED) ck_assert_int_eq(r.hit, k);
+            ck_assert_int_gt(calls, 0);
+            ck_assert_int_eq(calls, r.sdf_evaluations);
+            for (int64_t budget = 1; budget <= 40; budget += 3) {
+                calls = 0;
+                p.max_sdf_evaluations = budget;
+                ck_assert_int_eq(sdfccd_query_triangle(s, NULL, tri, &m, 0, 1, &p, NULL, 0, &r), SDFCCD_OK);
+                ck_assert_int_eq(calls, r.sdf_evaluations);
+            }
+        }
+    }
+    sdfccd_destroy_sdf(s);
+}
+END_TEST
+
 /* The budget is shared by the interval's segments: a rotation split into 1e6 segments (each of
  * which used to get the full per-call caps) stops at the budget with NOT_CONVERGED, for every
  * method; the same query with a large budget spends more, so the cap is what stopped it. */
@@ -747,6 +798,7 @@ int main(void)
     test_add_memory_fixture(tc);
     tcase_add_test(tc, test_huge_spin_rejected);
     tcase_add_test(tc, test_budget_shared_by_segments);
+    tcase_add_test(tc, test_field_calls_are_counted);
     tcase_add_test(tc, test_budget_shared_by_triangles);
     tcase_add_test(tc, test_overflowing_query_inputs_rejected);
     tcase_add_test(tc, test_query_argument_names);
