@@ -374,6 +374,12 @@ static void sub_triangle(uint32_t sub, double u[3], double v[3])
     }
 }
 
+/* The point with weights (u, v, 1 - u - v) of the triangle x[0..2]. */
+static scc_vec3 bary_point(const scc_vec3 x[3], double u, double v)
+{
+    return scc_add(scc_add(scc_scale(x[0], u), scc_scale(x[1], v)), scc_scale(x[2], 1.0 - u - v));
+}
+
 /* One step of region `it` (of the triangle of leaf it.node) from its time: 1 when it advanced
  * (it->key moved on) or was split (children written to kids[0..3], *n_kids = 4); 0 when it
  * stalls (in contact, or at the depth limit). */
@@ -387,14 +393,20 @@ static int region_step(trav* tr, item* it, item kids[4], int* n_kids)
     if (!(speed > 0.0)) return 0;
     double u[3], v[3];
     sub_triangle(it->sub, u, v);
-    scc_tri_state st;
-    scc_tri_state_at(&m, it->key, &st);
     const double cu = (u[0] + u[1] + u[2]) / 3.0, cv = (v[0] + v[1] + v[2]) / 3.0;
-    const scc_vec3 c = scc_add(scc_add(scc_scale(st.x[0], cu), scc_scale(st.x[1], cv)), scc_scale(st.x[2], 1.0 - cu - cv));
+    scc_vec3 c;
     double rad = 0.0;
-    for (int i = 0; i < 3; ++i) {
-        const scc_vec3 x = scc_add(scc_add(scc_scale(st.x[0], u[i]), scc_scale(st.x[1], v[i])), scc_scale(st.x[2], 1.0 - u[i] - v[i]));
-        rad = fmax(rad, scc_dist(x, c));
+    if (m.kind == SCC_TRI_RIGID) {
+        /* a rigid motion keeps distances: the radius from the body-frame corners, only the centroid posed */
+        const double bc[3] = { cu, cv, 1.0 - cu - cv };
+        c = scc_tri_point_at(&m, bc, it->key, NULL);
+        const scc_vec3 lc = bary_point(m.local, cu, cv);
+        for (int i = 0; i < 3; ++i) rad = fmax(rad, scc_dist(bary_point(m.local, u[i], v[i]), lc));
+    } else {
+        scc_tri_state st;
+        scc_tri_state_at(&m, it->key, &st);
+        c = bary_point(st.x, cu, cv);
+        for (int i = 0; i < 3; ++i) rad = fmax(rad, scc_dist(bary_point(st.x, u[i], v[i]), c));
     }
     rad += 1e-9 * (1.0 + rad); /* the corners' rounding */
     const double gap = field(tr, c) - tr->in->p->margin;

@@ -115,6 +115,12 @@ int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, dou
  * from a contact after tb: the check then proves [ta, tb] clear or finds a contact there). */
 int scc_fwgss_check(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                     const scc_allocator* alloc, int force, scc_tri_hit* io);
+/* The certified search over [ta, tb] within `budget` evaluations, for a short clear proof: no hit
+ * with state SCC_NO_HIT proves [ta, tb] free of contact; a stop at the budget (SCC_NOT_CONVERGED)
+ * still proves none before out->toi_lower, and a hit is a witness at out->toi. Returns 0 on
+ * allocation failure. */
+int scc_certified_clear(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, const scc_allocator* alloc,
+                        int64_t budget, scc_tri_hit* out);
 /* Whether scc_fwgss_verify checks FWGSS on this field: fields with gradient jumps (analytic kinked
  * fields, grids, user fields) with fwgss_kink_guard and fwgss_verify on. On grids the search bounds
  * phi per cell by a first-order Taylor form (certified.c), not by the cells' Lipschitz bounds, and

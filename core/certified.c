@@ -625,6 +625,23 @@ static int verify_search(const scc_sdf* sdf, const scc_tri_motion* m, double ta,
     return 1;
 }
 
+/* The clear proof before FWGSS (ours, issue 20 item 6; mesh_query.c): the unseeded search over
+ * [ta, tb] within `budget` evaluations. Its first-order bounds prove a triangle that passes a
+ * kinked convex piece without touching it clear in tens of evaluations, where FWGSS's descents
+ * spend hundreds before their own check proves the same. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline))
+#endif
+int scc_certified_clear(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, const scc_allocator* alloc,
+                        int64_t budget, scc_tri_hit* out)
+{
+    const double none[3] = { 1, 0, 0 };
+    stack_store store;
+    store.next = alloc;
+    const scc_allocator hooks = { stack_alloc, stack_free, &store };
+    return certified_search(sdf, m, ta, tb, p, &hooks, INFINITY, none, 0.0, budget, NULL, out);
+}
+
 /* Whether a grid may be sharp where the triangle goes over [ta, tb] (ours): the largest bound on
  * |grad phi| of the cells its swept box touches exceeds SCC_VERIFY_GRID_MIN_LIPSCHITZ. A grid
  * samples the distance to its surface (|grad| = 1); its cubic cells overshoot where the sampled

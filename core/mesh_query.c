@@ -15,6 +15,13 @@
 
 #include <string.h>
 
+/* Evaluations of the certified clear proof tried on a triangle before FWGSS (test_triangle). */
+#define SCC_PRECHECK_EVALS 32
+/* Proofs that may fail before the first clears (then two more per triangle cleared): where they fail
+ * the triangles are large against their clearance (1K scaling scene: 19 of 19 failed, 6.6 % more
+ * evaluations when every triangle tried). */
+#define SCC_PRECHECK_MISSES 5
+
 typedef struct contact_buf {
     scc_contact* a;
     size_t n, cap;
@@ -147,6 +154,8 @@ typedef struct mesh_ctx {
     scc_quat pose_q;             /* that pose (scc_rigid_pose_at at mm->t1) */
     scc_vec3 pose_p;
     int defer;                   /* FWGSS's checks wait until the earliest contact is known (scc_query_mesh_probed) */
+    int precheck;                /* the certified clear proof runs before FWGSS (test_triangle) */
+    int pre_cleared, pre_failed; /* its outcomes so far */
     deferred_tri* deferred;      /* the triangles searched so, in the order searched */
     size_t n_deferred, cap_deferred;
     double provisional;          /* the earliest of their FWGSS contacts (a witness: the TOI is no later) */
@@ -178,6 +187,30 @@ static int take_answer(mesh_ctx* c, scc_query_summary* s, const scc_contact* loc
         buf_prune(&c->buf, c->best + window);
     }
     return 1;
+}
+
+/* The certified search's short clear proof before FWGSS (ours, issue 20 item 6): on a kinked
+ * analytic field its first-order bounds clear a triangle that passes a convex piece without touching
+ * it in tens of evaluations, where FWGSS's descents spend hundreds before their deferred check proves
+ * the same (100K scaling scene: 9 of 13 triangles cleared in 1-23 evaluations each). Returns 1 when
+ * the triangle is done (cleared on [ta, tb], or the budget ran out), 0 when FWGSS goes on, -1 on
+ * allocation failure; tp->max_evals loses what the proof spent. */
+static int precheck(mesh_ctx* c, const scc_tri_motion* m, double ta, double tb, scc_params* tp)
+{
+    scc_tri_hit h;
+    const int64_t budget = tp->max_evals < SCC_PRECHECK_EVALS ? tp->max_evals : SCC_PRECHECK_EVALS;
+    if (!scc_certified_clear(c->in.sdf, m, ta, tb, tp, c->in.ws->alloc, budget, &h)) return -1;
+    c->sum->evals += h.evals;
+    tp->max_evals -= h.evals;
+    if (!h.hit && h.state == SCC_NO_HIT) { /* the same answer as a search that found nothing on [ta, tb] */
+        c->sum->triangles_tested += 1;
+        c->lower = fmin(c->lower, tb);
+        c->pre_cleared += 1;
+        return 1;
+    }
+    c->pre_failed += 1;
+    if (tp->max_evals <= 0) c->budget_exhausted = 1; /* its contacts stay unproven */
+    return c->budget_exhausted;
 }
 
 /* Narrow phase of triangle t on [ta, min(t1, best + window)], where ta is t0 or the broad phase's
@@ -219,6 +252,12 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
     scc_query_summary s;
     if (c->probe) c->probe(c->probe_user, t, 1);
     if (!(ta < tb)) ta = mm->t0;
+    /* while the proofs pay: at most SCC_PRECHECK_MISSES more failed than twice the cleared */
+    const int pre = c->precheck && c->pre_failed < SCC_PRECHECK_MISSES + 2 * c->pre_cleared ? precheck(c, &m, ta, tb, &tp) : 0;
+    if (pre != 0) {
+        if (c->probe) c->probe(c->probe_user, t, 0);
+        return pre > 0;
+    }
     int deferred = 0;
     scc_tri_hit raw;
     int ok = scc_query_triangle_deferred(c->in.sdf, &m, ta, tb, p, c->in.ws->alloc, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s,
@@ -401,6 +440,8 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     c.traces = NULL;
     /* Deferred checks: a mesh (one triangle has nothing to wait for) under FWGSS on a checked field */
     c.defer = p->method == SCC_METHOD_FWGSS && mm->mesh->triangle_count > 1 && scc_fwgss_verified(sdf, p);
+    c.precheck = c.defer && sdf->kind != SCC_SDF_GRID;
+    c.pre_cleared = c.pre_failed = 0;
     c.deferred = ws->slot[SCC_WS_DEFERRED].p;
     c.n_deferred = 0;
     c.cap_deferred = ws->slot[SCC_WS_DEFERRED].bytes / sizeof(deferred_tri);

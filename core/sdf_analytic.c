@@ -217,13 +217,29 @@ static int spike_grid_convex_in(const scc_sdf* self, const scc_aabb* box)
     const scc_vec3 c = scc_scale(scc_add(box->lo, box->hi), 0.5);
     const double h = 0.5 * scc_dist(box->lo, box->hi);
     if (!(h < 0.25 * s->spacing) || !scc_vfinite(c)) return 0;
-    double best = c.z, second = 1.5 * s->spacing - s->base_radius; /* the ground; the far cones' bound */
+    const double far = 1.5 * s->spacing - s->base_radius;
+    double best = c.z, second = far; /* the ground; the far cones' bound */
     int ci, cj;
     spike_cell(s, c, &ci, &cj);
-    for (int j = cj - 1; j <= cj + 1; ++j) {
-        if (j < 0 || j >= s->count_y) continue;
-        for (int i = ci - 1; i <= ci + 1; ++i) {
-            if (i < 0 || i >= s->count_x) continue;
+    /* A cone's distance is at least max(rho - R, z - H) (its bounding cylinder), so a cone whose bound
+     * exceeds best + 2h + the rounding margin can be neither the nearest piece nor make the test fail:
+     * its exact distance is skipped (the answer is the same). The own cell's cone goes first. */
+    double lb[9];
+    int n = 0;
+    for (int j = cj - 1; j <= cj + 1; ++j)
+        for (int i = ci - 1; i <= ci + 1; ++i, ++n) {
+            lb[n] = INFINITY;
+            if (j < 0 || j >= s->count_y || i < 0 || i >= s->count_x) continue;
+            const double rho = scc_hypot2(c.x - (s->x0 + i * s->spacing), c.y - (s->y0 + j * s->spacing));
+            lb[n] = fmax(rho - s->base_radius, c.z - s->height);
+        }
+    for (int pass = 0; pass < 2; ++pass)
+        for (int k = 0; k < 9; ++k) {
+            if ((pass == 0) != (k == 4) || !(lb[k] < INFINITY)) continue;
+            /* |second| <= max(|best|, far), so this bounds the rounding margin below whatever second ends up */
+            const double eps_max = 1e-12 * (2.0 * fabs(best) + fabs(far) + s->spacing + s->height);
+            if (lb[k] > best + 2.0 * h + eps_max) continue;
+            const int i = ci - 1 + k % 3, j = cj - 1 + k / 3;
             double grho, gz;
             const double d = cone_distance2(scc_hypot2(c.x - (s->x0 + i * s->spacing), c.y - (s->y0 + j * s->spacing)), c.z, s->base_radius,
                                             s->height, &grho, &gz);
@@ -234,7 +250,6 @@ static int spike_grid_convex_in(const scc_sdf* self, const scc_aabb* box)
                 second = fmin(second, d);
             }
         }
-    }
     /* the margin covers the rounding of the distances (relative 1e-12 of the sizes involved) */
     const double eps = 1e-12 * (fabs(best) + fabs(second) + s->spacing + s->height);
     return best + 2.0 * h + eps < second;

@@ -239,6 +239,74 @@ START_TEST(test_deferred_checks)
 }
 END_TEST
 
+/* The clear proof before FWGSS (mesh_query.c, precheck): six triangles of the 100K scene's step 2
+ * that pass spikes without touching them before the scene's earliest contact (0.0270795 s) plus the
+ * window. Certified queries of each triangle say so; the FWGSS mesh query over that interval (no
+ * broad phase: every triangle on [t0, t1]) must answer no hit and cost exactly the triangles'
+ * certified clear proofs (scc_certified_clear within the pre-check's 32 evaluations, each closing), so
+ * no descent and no check runs, and fewer than the triangles' own checked FWGSS queries. */
+START_TEST(test_precheck_clears)
+{
+    static const double v[6][3][3] = {
+        { { -0.1530245, 0.072401, -0.567027 }, { -0.1576415, 0.0642195, -0.567656 }, { -0.173972, 0.046571, -0.567053 } },
+        { { -0.25639, 0.0745555, -0.569931 }, { -0.264921, 0.060383, -0.570608 }, { -0.2635205, 0.0675165, -0.5691865 } },
+        { { -0.1530245, 0.072401, -0.567027 }, { -0.173972, 0.046571, -0.567053 }, { -0.1734645, 0.069004, -0.5660545 } },
+        { { -0.1530245, 0.072401, -0.567027 }, { -0.1734645, 0.069004, -0.5660545 }, { -0.152517, 0.094834, -0.5660285 } },
+        { { 0.240782, -0.030266, -0.5640415 }, { 0.251951, -0.050491, -0.562868 }, { 0.237412, -0.0303775, -0.5609695 } },
+        { { -0.149437, 0.1659965, -0.5659525 }, { -0.16344, 0.1623955, -0.5677365 }, { -0.154311, 0.1746, -0.567768 } },
+    };
+    scc_vec3 vv[18];
+    uint32_t f[18];
+    scc_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.bounds.lo = scc_v3(INFINITY, INFINITY, INFINITY);
+    mesh.bounds.hi = scc_v3(-INFINITY, -INFINITY, -INFINITY);
+    for (int t = 0; t < 6; ++t)
+        for (int k = 0; k < 3; ++k) {
+            vv[3 * t + k] = scc_v3(v[t][k][0], v[t][k][1], v[t][k][2]);
+            f[3 * t + k] = (uint32_t)(3 * t + k);
+            mesh.bounds.lo = scc_vmin(mesh.bounds.lo, vv[3 * t + k]);
+            mesh.bounds.hi = scc_vmax(mesh.bounds.hi, vv[3 * t + k]);
+        }
+    mesh.vertices = vv;
+    mesh.indices = f;
+    mesh.vertex_count = 18;
+    mesh.triangle_count = 6;
+    scc_sdf_spike_grid spikes;
+    scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
+    scc_rigid body = spike_scene_body();
+    scc_mesh_motion mm = { &mesh, &body, NULL, NULL, NULL, 0.026, 0.02708951, NULL, NULL };
+    static scc_contact out[64];
+    scc_params pc = params_of(SDFCCD_METHOD_CERTIFIED);
+    scc_params pf = params_of(SDFCCD_METHOD_FWGSS);
+    pf.broad_phase = 0;
+    int64_t proofs = 0, own = 0;
+    for (uint32_t t = 0; t < mesh.triangle_count; ++t) {
+        scc_tri_motion m;
+        scc_mesh_triangle_motion(&mm, t, &m);
+        scc_query_summary s;
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &k_alloc, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+        ck_assert_msg(!s.hit && s.state == SCC_NO_HIT, "triangle %u touches (certified)", t);
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+        ck_assert(!s.hit);
+        own += s.evals;
+        scc_tri_hit h;
+        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 32, &h));
+        ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "triangle %u: no clear proof in 32 evaluations", t);
+        proofs += h.evals;
+    }
+    scc_query_summary r;
+    ck_assert(scc_query_mesh(&spikes.base, &mm, &pf, &k_alloc, out, 64, &r));
+    printf("precheck: FWGSS mesh query %lld evaluations, clear proofs %lld, triangles alone (FWGSS + check) %lld\n", (long long)r.evals,
+           (long long)proofs, (long long)own);
+    ck_assert(!r.hit);
+    ck_assert_int_eq(r.state, SCC_NO_HIT);
+    ck_assert(r.toi_lower == mm.t1);
+    ck_assert_int_eq(r.evals, proofs);
+    ck_assert_int_lt(r.evals, own);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("fall");
@@ -247,6 +315,7 @@ int main(void)
     tcase_add_test(tc, test_armadillo_1k_on_spikes);
     tcase_add_test(tc, test_spike_apex_triangle);
     tcase_add_test(tc, test_deferred_checks);
+    tcase_add_test(tc, test_precheck_clears);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -737,7 +737,7 @@ START_TEST(test_step_spun_through_wall)
 END_TEST
 
 /* Moving away: CLEAR at the end pose; not moving at all: CLEAR at no cost (certified); sliding 1 cm
- * above a ground: CLEAR by the certificate alone, with far fewer evaluations than the CCD's check. */
+ * above a ground: CLEAR by the certificate alone, and by the CCD's check (whose pre-check is cheaper). */
 START_TEST(test_step_clear_and_certified)
 {
     box_mesh rod = make_box(ROD_R, ROD_A, ROD_A, 10, 1, 1);
@@ -774,7 +774,10 @@ START_TEST(test_step_clear_and_certified)
     ck_assert_int_eq(full.state, SDFCCD_GUARD_CLEAR);
     REPORT("%s: sliding: certificate %lld evaluations, CCD check %lld\n", __func__, (long long)r.sdf_evaluations,
            (long long)full.sdf_evaluations);
-    ck_assert_int_lt(r.sdf_evaluations, full.sdf_evaluations);
+    /* The CCD's mesh query now clears this slide's triangles by the certified search's short proof
+     * before FWGSS (mesh_query.c, precheck): 251 evaluations where FWGSS and its checks spent 4,181,
+     * so it undercuts the certificate's 305. */
+    ck_assert_int_lt(full.sdf_evaluations, r.sdf_evaluations);
     sdfccd_destroy_workspace(ws);
     ck_assert_int_eq(sdfccd_destroy_sdf(wall), SDFCCD_OK);
     free_box(&rod);
