@@ -321,6 +321,30 @@ void scc_guard_response(scc_vec3 point, scc_vec3 normal, int pinned, int repeate
     if (kt > 0.0) apply_impulse(body, scc_scale(t, -fmin(mu * j, ul / kt)), point);
 }
 
+void scc_friction_hold(const scc_held_contact* c, size_t count, scc_vec3* held, scc_body_state* body)
+{
+    for (size_t i = 0; i < count; ++i) held[i] = scc_v3(0, 0, 0);
+    for (int pass = 0; pass < SCC_HOLD_PASSES; ++pass)
+        for (size_t i = 0; i < count; ++i) {
+            const scc_vec3 n = c[i].normal;
+            scc_vec3 u = scc_sub(point_velocity(body, c[i].point), c[i].surface_velocity);
+            u = scc_madd(u, n, -scc_dot(u, n));
+            const double ul = scc_len(u);
+            if (!(ul > 0.0)) continue;
+            const scc_vec3 t = scc_scale(u, 1.0 / ul);
+            const double kt = inv_effective_mass(body, c[i].point, t);
+            if (!(kt > 0.0)) continue;
+            /* The friction the point needs to stop sliding, the solver's included, cut to the cone. */
+            const scc_vec3 applied = scc_madd(c[i].applied, n, -scc_dot(c[i].applied, n));
+            scc_vec3 total = scc_madd(scc_add(applied, held[i]), t, -ul / kt);
+            const double tl = scc_len(total);
+            if (tl > c[i].cap) total = scc_scale(total, c[i].cap / tl);
+            const scc_vec3 next = scc_sub(total, applied);
+            apply_impulse(body, scc_sub(next, held[i]), c[i].point);
+            held[i] = next;
+        }
+}
+
 void scc_swept_aabb(const scc_aabb* a, const scc_aabb* b, scc_vec3 o0, scc_vec3 o1, double reach, double angle, scc_aabb* out)
 {
     scc_aabb r = { scc_vmin(a->lo, b->lo), scc_vmax(a->hi, b->hi) };

@@ -84,4 +84,22 @@ typedef struct scc_body_state {
 void scc_guard_response(scc_vec3 point, scc_vec3 normal, int pinned, int repeated, const scc_body_state* sdf_body, double mu,
                         scc_body_state* body);
 
+/* One contact of a body after an engine's solve (world frame): where the impulses act, the unit
+ * normal from the SDF to the body, the SDF's velocity there, the friction impulse the solver applied
+ * to the body there, and the cone's radius cap = mu times the solver's normal impulse. */
+typedef struct scc_held_contact {
+    scc_vec3 point, normal, surface_velocity, applied;
+    double cap;
+} scc_held_contact;
+
+/* Gauss-Seidel passes of scc_friction_hold over the contacts. */
+#define SCC_HOLD_PASSES 16
+
+/* Static friction an engine's solve left out (Bullet's one friction direction per point leaves the
+ * other free): passes over the contacts each add the tangential impulse that stops the point sliding
+ * relative to the SDF, with the solver's friction and the added one together kept within the
+ * point's Coulomb cone (|applied + held| <= cap). `held` (count) receives each point's added
+ * impulse; `body`'s velocities are updated. */
+void scc_friction_hold(const scc_held_contact* c, size_t count, scc_vec3* held, scc_body_state* body);
+
 #endif
