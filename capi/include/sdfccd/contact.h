@@ -599,18 +599,22 @@ typedef struct sdfccd_HeldContact {
     double friction;              /**< Coulomb coefficient (>= 0). */
 } sdfccd_HeldContact;
 
-/** Static friction that an engine's solve left out. A solver that gives each contact point one
- * friction direction (Bullet's default: along the point's sliding velocity) leaves the other tangent
- * direction free, so a body that should stick can creep. This adds, at each contact, the tangential
- * impulse that stops the point sliding relative to the SDF (`surface_velocity`), such that the
- * solver's friction impulse and the added one together stay within the point's Coulomb cone
- * (|friction_impulse + added| <= friction * normal_impulse): a sticking body stops, a sliding one
- * keeps the friction the cone allows. Sixteen Gauss-Seidel passes over the points in order
- * (deterministic; more than 64 points are held 64 at a time, in order). `body` (its velocities after the solve; the SDF counts as infinitely heavy) gets
- * the new velocities; `impulses` (`count` entries, may be NULL) receives the added impulse per point.
- * Errors (::SDFCCD_INVALID_ARGUMENT, nothing written): NULL `body`, NULL `contacts` with `count` > 0,
- * `count` < 0, non-finite values, a zero normal, a negative normal impulse, friction or inverse mass. */
-SDFCCD_API sdfccd_Status sdfccd_friction_hold(const sdfccd_HeldContact* contacts, int32_t count, sdfccd_BodyState* body,
+/** Static friction that an engine's solve left out, for a body at rest on an SDF. A solver that
+ * gives each contact point one friction direction (Bullet's default: along the point's sliding
+ * velocity) leaves the other tangent direction free, so a body that should stick can creep. When
+ * every loaded contact point (normal_impulse > 0) moves slower than `rest_speed` (m/s) relative to
+ * the SDF (the engine's resting-contact speed; an impact or a fast slide is left to the solver),
+ * this adds at each contact the tangential impulse that stops the point sliding relative to the SDF
+ * (`surface_velocity`), such that the solver's friction impulse and the added one together stay
+ * within the point's Coulomb cone (|friction_impulse + added| <= friction * normal_impulse): a
+ * sticking body stops, a sliding one keeps the friction the cone allows. Sixteen Gauss-Seidel passes
+ * over the points in order (deterministic; more than 64 points are held 64 at a time, in order).
+ * `body` (its velocities after the solve; the SDF counts as infinitely heavy) gets the new
+ * velocities; `impulses` (`count` entries, may be NULL) receives the added impulse per point (zero
+ * when the body is not at rest). Errors (::SDFCCD_INVALID_ARGUMENT, nothing written): NULL `body`,
+ * NULL `contacts` with `count` > 0, `count` < 0, non-finite values, a zero normal, a negative normal
+ * impulse, friction, inverse mass or `rest_speed`. */
+SDFCCD_API sdfccd_Status sdfccd_friction_hold(const sdfccd_HeldContact* contacts, int32_t count, double rest_speed, sdfccd_BodyState* body,
                                               sdfccd_Vec3* impulses);
 
 #ifdef __cplusplus
