@@ -279,7 +279,11 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         return;
     }
     writeManifolds(manifolds, manifold_count, r ? r->points.data() : nullptr, s.count, s.reduced, margin, mw, sw, work, stats);
-    if (guard_world && s.count > 0) held_manifolds.insert(held_manifolds.end(), manifolds, manifolds + manifold_count);
+    if (guard_world && s.count > 0) {
+        // For the friction hold after the step (holdFriction clears them; a world only queried, never stepped, drops them).
+        if (dispatcher && held_manifolds.size() > 4 * (size_t)dispatcher->getNumManifolds() + 64) held_manifolds.clear();
+        held_manifolds.insert(held_manifolds.end(), manifolds, manifolds + manifold_count);
+    }
     if (kept) {
         kept->count = std::min(s.reduced, (int32_t)MANIFOLD_CACHE_SIZE);
         for (int i = 0; i < kept->count; ++i) kept->ids[i] = r->points[(size_t)i].id;
