@@ -321,10 +321,11 @@ void BridgeImpl::holdFriction(btCollisionWorld* world, double dt)
             for (int i = 0; i < pm->getNumContacts(); ++i) {
                 const btManifoldPoint& p = pm->getContactPoint(i);
                 if (!(p.m_appliedImpulse > 0)) continue;
+                const btVector3 at = p.m_positionWorldOnA;
                 sdfccd_HeldContact c;
-                c.point = v3(p.m_positionWorldOnA);
+                c.point = v3(at);
                 c.normal = v3(p.m_normalWorldOnB);
-                c.surface_velocity = v3(sb ? sb->getVelocityInLocalPoint(p.m_positionWorldOnA - sb->getCenterOfMassPosition()) : btVector3(0, 0, 0));
+                c.surface_velocity = v3(sb ? sb->getVelocityInLocalPoint(at - sb->getCenterOfMassPosition()) : btVector3(0, 0, 0));
                 c.friction_impulse = v3(p.m_lateralFrictionDir1 * p.m_appliedImpulseLateral1 +
                                         (two ? p.m_lateralFrictionDir2 * p.m_appliedImpulseLateral2 : btVector3(0, 0, 0)));
                 c.normal_impulse = (double)p.m_appliedImpulse;
@@ -341,7 +342,8 @@ void BridgeImpl::holdFriction(btCollisionWorld* world, double dt)
         bs.angular_velocity = v3(body->getAngularVelocity());
         bs.inverse_mass = (double)body->getInvMass();
         for (int k = 0; k < 9; ++k) bs.inverse_inertia[k] = (double)body->getInvInertiaTensorWorld()[k / 3][k % 3];
-        if (cs.empty() || sdfccd_friction_hold(cs.data(), (int32_t)cs.size(), (double)si.m_restitutionVelocityThreshold, &bs, nullptr) != SDFCCD_OK) continue;
+        const double rest = (double)si.m_restitutionVelocityThreshold;
+        if (cs.empty() || sdfccd_friction_hold(cs.data(), (int32_t)cs.size(), rest, &bs, nullptr) != SDFCCD_OK) continue;
         if (bt(bs.linear_velocity) == v && bt(bs.angular_velocity) == w) continue;
         body->setLinearVelocity(bt(bs.linear_velocity));
         body->setAngularVelocity(bt(bs.angular_velocity));
