@@ -321,6 +321,47 @@ void scc_guard_response(scc_vec3 point, scc_vec3 normal, int pinned, int repeate
     if (kt > 0.0) apply_impulse(body, scc_scale(t, -fmin(mu * j, ul / kt)), point);
 }
 
+void scc_friction_hold(const scc_held_contact* c, size_t count, scc_vec3* held, scc_body_state* body)
+{
+    /* held[i] is the point's added impulse, tangential and normal; a point may approach the surface no
+     * faster than it did after the solve (and not at all if it did not), so the added turn of the body
+     * never sinks another point. */
+    double floor_vn[SCC_HOLD_MAX];
+    for (size_t i = 0; i < count; ++i) {
+        held[i] = scc_v3(0, 0, 0);
+        floor_vn[i] = fmin(0.0, scc_dot(scc_sub(point_velocity(body, c[i].point), c[i].surface_velocity), c[i].normal));
+    }
+    for (int pass = 0; pass < SCC_HOLD_PASSES; ++pass)
+        for (size_t i = 0; i < count; ++i) {
+            const scc_vec3 n = c[i].normal;
+            scc_vec3 u = scc_sub(point_velocity(body, c[i].point), c[i].surface_velocity);
+            const double kn = inv_effective_mass(body, c[i].point, n);
+            double jn = scc_dot(held[i], n); /* the added normal impulse, >= 0 */
+            const double push = kn > 0.0 ? fmax(-jn, (floor_vn[i] - scc_dot(u, n)) / kn) : 0.0;
+            if (push != 0.0) {
+                apply_impulse(body, scc_scale(n, push), c[i].point);
+                held[i] = scc_madd(held[i], n, push);
+                jn += push;
+                u = scc_sub(point_velocity(body, c[i].point), c[i].surface_velocity);
+            }
+            u = scc_madd(u, n, -scc_dot(u, n));
+            const double ul = scc_len(u);
+            if (!(ul > 0.0)) continue;
+            const scc_vec3 t = scc_scale(u, 1.0 / ul);
+            const double kt = inv_effective_mass(body, c[i].point, t);
+            if (!(kt > 0.0)) continue;
+            /* The friction the point needs to stop sliding, the solver's included, cut to the cone. */
+            const scc_vec3 applied = scc_madd(c[i].applied, n, -scc_dot(c[i].applied, n));
+            const scc_vec3 old_t = scc_madd(held[i], n, -jn);
+            scc_vec3 total = scc_madd(scc_add(applied, old_t), t, -ul / kt);
+            const double tl = scc_len(total), cap = c[i].mu * (c[i].normal_impulse + jn);
+            if (tl > cap) total = scc_scale(total, cap / tl);
+            const scc_vec3 next = scc_sub(total, applied);
+            apply_impulse(body, scc_sub(next, old_t), c[i].point);
+            held[i] = scc_madd(next, n, jn);
+        }
+}
+
 void scc_swept_aabb(const scc_aabb* a, const scc_aabb* b, scc_vec3 o0, scc_vec3 o1, double reach, double angle, scc_aabb* out)
 {
     scc_aabb r = { scc_vmin(a->lo, b->lo), scc_vmax(a->hi, b->hi) };

@@ -84,4 +84,24 @@ typedef struct scc_body_state {
 void scc_guard_response(scc_vec3 point, scc_vec3 normal, int pinned, int repeated, const scc_body_state* sdf_body, double mu,
                         scc_body_state* body);
 
+/* One contact of a body after an engine's solve (world frame): where the impulses act, the unit
+ * normal from the SDF to the body, the SDF's velocity there, the friction impulse the solver applied
+ * to the body there, the solver's normal impulse and the Coulomb coefficient. */
+typedef struct scc_held_contact {
+    scc_vec3 point, normal, surface_velocity, applied;
+    double normal_impulse, mu;
+} scc_held_contact;
+
+/* Gauss-Seidel passes of scc_friction_hold over the contacts, and the most contacts of one call. */
+#define SCC_HOLD_PASSES 16
+#define SCC_HOLD_MAX 64
+
+/* Static friction an engine's solve left out (Bullet's one friction direction per point leaves the
+ * other free): passes over the contacts (at most SCC_HOLD_MAX) each add the tangential impulse that
+ * stops the point sliding relative to the SDF, with the solver's friction and the added one together
+ * kept within the point's Coulomb cone (mu times the solver's normal impulse and any added one), and
+ * a normal impulse (>= 0) wherever the added turn would make a point approach the surface faster than
+ * after the solve. `held` (count) receives each point's added impulse; `body`'s velocities are updated. */
+void scc_friction_hold(const scc_held_contact* c, size_t count, scc_vec3* held, scc_body_state* body);
+
 #endif

@@ -1665,6 +1665,180 @@ START_TEST(test_generate_bad_input)
 }
 END_TEST
 
+/* ---- sdfccd_friction_hold: the static friction a one-direction solver leaves out ---- */
+
+static const double REST = 2.0; /* rest_speed (m/s) above every slip below but the one of test_hold_rest_speed */
+
+static sdfccd_BodyState hold_body(double inv_mass, double inv_inertia, sdfccd_Vec3 v, sdfccd_Vec3 w)
+{
+    sdfccd_BodyState b;
+    memset(&b, 0, sizeof b);
+    b.inverse_mass = inv_mass;
+    b.inverse_inertia[0] = b.inverse_inertia[4] = b.inverse_inertia[8] = inv_inertia;
+    b.linear_velocity = v;
+    b.angular_velocity = w;
+    return b;
+}
+
+static sdfccd_HeldContact held_contact(double x, double y, double z, double normal_impulse, double friction)
+{
+    sdfccd_HeldContact c;
+    memset(&c, 0, sizeof c);
+    c.point = (sdfccd_Vec3){ x, y, z };
+    c.normal = (sdfccd_Vec3){ 0, 0, 1 };
+    c.normal_impulse = normal_impulse;
+    c.friction = friction;
+    return c;
+}
+
+/* The tangential (x, y) velocity of the body's material point at p. */
+static double tangential_speed(const sdfccd_BodyState* b, sdfccd_Vec3 p, sdfccd_Vec3 surface)
+{
+    const sdfccd_Vec3 r = { p.x - b->center.x, p.y - b->center.y, p.z - b->center.z }, w = b->angular_velocity;
+    const double vx = b->linear_velocity.x + w.y * r.z - w.z * r.y - surface.x, vy = b->linear_velocity.y + w.z * r.x - w.x * r.z - surface.y;
+    return hypot(vx, vy);
+}
+
+/* The normal (z) velocity of the body's material point at p. */
+static double normal_speed(const sdfccd_BodyState* b, sdfccd_Vec3 p)
+{
+    const sdfccd_Vec3 w = b->angular_velocity;
+    return b->linear_velocity.z + w.x * (p.y - b->center.y) - w.y * (p.x - b->center.x);
+}
+
+START_TEST(test_hold_sticks_closed_form)
+{
+    /* A sliding point mass (no rotation) inside its cone: the impulse that stops it, -v/inv_mass in
+     * the plane, and nothing along the normal. */
+    sdfccd_BodyState b = hold_body(0.5, 0.0, (sdfccd_Vec3){ 0.3, -0.4, -0.2 }, (sdfccd_Vec3){ 0, 0, 0 });
+    sdfccd_HeldContact c = held_contact(0.1, 0.2, 0.0, 10.0, 0.5); /* cap 5 > |0.5 m/s| / 0.5 = 1 */
+    sdfccd_Vec3 j;
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, &j), SDFCCD_OK);
+    ck_assert(fabs(b.linear_velocity.x) < 1e-15 && fabs(b.linear_velocity.y) < 1e-15);
+    ck_assert(b.linear_velocity.z == -0.2);
+    ck_assert(fabs(j.x + 0.6) < 1e-15 && fabs(j.y - 0.8) < 1e-15 && j.z == 0.0);
+    /* A moving surface (a conveyor at 1 m/s in y) carries a sticking body along. */
+    b = hold_body(1.0, 0.0, (sdfccd_Vec3){ 0, 0, 0 }, (sdfccd_Vec3){ 0, 0, 0 });
+    c.surface_velocity = (sdfccd_Vec3){ 0, 1, 0 };
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, NULL), SDFCCD_OK);
+    ck_assert(fabs(b.linear_velocity.x) < 1e-15 && fabs(b.linear_velocity.y - 1.0) < 1e-15);
+    /* No load, no hold: the velocities stay bit for bit. */
+    b = hold_body(1.0, 0.0, (sdfccd_Vec3){ 0.3, -0.4, 0 }, (sdfccd_Vec3){ 0, 0, 0 });
+    c = held_contact(0, 0, 0, 0.0, 0.5);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, &j), SDFCCD_OK);
+    ck_assert(b.linear_velocity.x == 0.3 && b.linear_velocity.y == -0.4 && j.x == 0.0 && j.y == 0.0);
+}
+END_TEST
+
+START_TEST(test_hold_cone_closed_form)
+{
+    /* Outside the cone the point keeps sliding: |impulse| = mu N opposite the slip. v = (0.3, -0.4),
+     * cap 0.25 with inverse mass 1: v loses 0.25 along (0.6, -0.8). */
+    sdfccd_BodyState b = hold_body(1.0, 0.0, (sdfccd_Vec3){ 0.3, -0.4, 0 }, (sdfccd_Vec3){ 0, 0, 0 });
+    sdfccd_HeldContact c = held_contact(0, 0, 0, 0.5, 0.5);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, NULL), SDFCCD_OK);
+    ck_assert(fabs(b.linear_velocity.x - 0.15) < 1e-15 && fabs(b.linear_velocity.y + 0.2) < 1e-15);
+    /* The solver's own friction counts against the cone. It pushed 0.2 along -x (its one direction)
+     * and left the body sliding at 1 m/s in y: stopping that needs (-0.2, -1) in total, |.| = 1.0198
+     * > cap 0.5, so the total is cut to 0.5 (-0.2, -1)/1.0198 and the hold adds that minus (-0.2, 0). */
+    b = hold_body(1.0, 0.0, (sdfccd_Vec3){ 0, 1, 0 }, (sdfccd_Vec3){ 0, 0, 0 });
+    c = held_contact(0, 0, 0, 1.0, 0.5);
+    c.friction_impulse = (sdfccd_Vec3){ -0.2, 0, 0.7 }; /* its part along the normal is ignored */
+    sdfccd_Vec3 j;
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, &j), SDFCCD_OK);
+    const double len = sqrt(0.04 + 1.0), tx = -0.2 * 0.5 / len, ty = -1.0 * 0.5 / len;
+    ck_assert(fabs(j.x - (tx + 0.2)) < 1e-12 && fabs(j.y - ty) < 1e-12);
+    ck_assert(fabs(b.linear_velocity.x - (tx + 0.2)) < 1e-12 && fabs(b.linear_velocity.y - (1.0 + ty)) < 1e-12);
+    ck_assert(hypot(-0.2 + j.x, j.y) <= 0.5 + 1e-12);
+    /* A solver that already used the whole cone along the slip leaves nothing to add. */
+    b = hold_body(1.0, 0.0, (sdfccd_Vec3){ 0, 1, 0 }, (sdfccd_Vec3){ 0, 0, 0 });
+    c.friction_impulse = (sdfccd_Vec3){ 0, -0.5, 0 };
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, &j), SDFCCD_OK);
+    ck_assert(fabs(j.x) < 1e-15 && fabs(j.y) < 1e-15 && b.linear_velocity.y == 1.0);
+}
+END_TEST
+
+START_TEST(test_hold_box_on_four_corners)
+{
+    /* A unit cube (1 kg, inverse inertia 6) on its four bottom corners, creeping and turning about
+     * the normal as Bullet's one friction row per corner leaves it: with the corners inside their
+     * cones (2.5 N s each, mu 0.5) every corner stops sliding, within 1e-9 of its start slip. */
+    sdfccd_BodyState b = hold_body(1.0, 6.0, (sdfccd_Vec3){ 0.004, -0.003, 0 }, (sdfccd_Vec3){ 0.001, 0.002, 0.02 });
+    b.center = (sdfccd_Vec3){ 0, 0, 0.5 };
+    sdfccd_HeldContact c[4] = { held_contact(-0.5, -0.5, 0, 2.5, 0.5), held_contact(0.5, -0.5, 0, 2.5, 0.5),
+                                held_contact(0.5, 0.5, 0, 2.5, 0.5), held_contact(-0.5, 0.5, 0, 2.5, 0.5) };
+    double before = 0, after = 0, vn0[4];
+    for (int i = 0; i < 4; ++i) {
+        before = fmax(before, tangential_speed(&b, c[i].point, c[i].surface_velocity));
+        vn0[i] = normal_speed(&b, c[i].point);
+    }
+    sdfccd_Vec3 j[4];
+    ck_assert_int_eq(sdfccd_friction_hold(c, 4, REST, &b, j), SDFCCD_OK);
+    for (int i = 0; i < 4; ++i) {
+        after = fmax(after, tangential_speed(&b, c[i].point, c[i].surface_velocity));
+        /* Within the cone of the solver's and any added normal impulse (>= 0); the hold's turn sinks no
+         * corner faster than after the solve (the ones that rose may not approach at all). */
+        ck_assert(j[i].z >= 0.0 && hypot(j[i].x, j[i].y) <= 0.5 * (2.5 + j[i].z) + 1e-12);
+        ck_assert(normal_speed(&b, c[i].point) >= fmin(vn0[i], 0.0) - 1e-12);
+    }
+    REPORT("hold: box corners slip %.3g -> %.3g m/s\n", before, after);
+    ck_assert(before > 0.01 && after <= 1e-9 * before);
+    /* Deterministic: the same input, the same bits. */
+    sdfccd_BodyState b2 = hold_body(1.0, 6.0, (sdfccd_Vec3){ 0.004, -0.003, 0 }, (sdfccd_Vec3){ 0.001, 0.002, 0.02 });
+    b2.center = b.center;
+    ck_assert_int_eq(sdfccd_friction_hold(c, 4, REST, &b2, NULL), SDFCCD_OK);
+    ck_assert(memcmp(&b, &b2, sizeof b) == 0);
+}
+END_TEST
+
+START_TEST(test_hold_rest_speed)
+{
+    /* A point sliding at 0.5 m/s is held below a 0.6 m/s rest speed, and left to the solver at
+     * 0.5 m/s (not slower than it): velocities bit for bit, impulses zero. A point without load does
+     * not count. */
+    sdfccd_HeldContact c[2] = { held_contact(0, 0, 0, 10.0, 0.5), held_contact(0, 0, 0, 0.0, 0.5) };
+    c[1].surface_velocity = (sdfccd_Vec3){ 5, 0, 0 };
+    sdfccd_BodyState b = hold_body(1.0, 0.0, (sdfccd_Vec3){ 0.3, -0.4, 0 }, (sdfccd_Vec3){ 0, 0, 0 });
+    sdfccd_Vec3 j[2] = { { 9, 9, 9 }, { 9, 9, 9 } };
+    ck_assert_int_eq(sdfccd_friction_hold(c, 2, 0.6, &b, j), SDFCCD_OK);
+    ck_assert(fabs(b.linear_velocity.x) < 1e-15 && fabs(b.linear_velocity.y) < 1e-15 && fabs(j[0].x + 0.3) < 1e-15);
+    b = hold_body(1.0, 0.0, (sdfccd_Vec3){ 0.3, -0.4, 0 }, (sdfccd_Vec3){ 0, 0, 0 });
+    ck_assert_int_eq(sdfccd_friction_hold(c, 2, 0.5, &b, j), SDFCCD_OK);
+    ck_assert(b.linear_velocity.x == 0.3 && b.linear_velocity.y == -0.4);
+    ck_assert(j[0].x == 0.0 && j[0].y == 0.0 && j[1].x == 0.0 && j[1].y == 0.0);
+}
+END_TEST
+
+START_TEST(test_hold_bad_input)
+{
+    sdfccd_BodyState b = hold_body(1.0, 1.0, (sdfccd_Vec3){ 1, 2, 3 }, (sdfccd_Vec3){ 4, 5, 6 });
+    const sdfccd_BodyState keep = b;
+    sdfccd_HeldContact c = held_contact(0, 0, 0, 1.0, 0.5);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, NULL, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_friction_hold(NULL, 1, REST, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, -1, REST, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    c.normal = (sdfccd_Vec3){ 0, 0, 0 };
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(strstr(sdfccd_last_error(), "sdfccd_friction_hold") != NULL);
+    c = held_contact(0, 0, 0, -1.0, 0.5);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    c = held_contact(0, 0, 0, 1.0, -0.5);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    c = held_contact(0, 0, 0, 1.0, 0.5);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, -1.0, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, NAN, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    c = held_contact(0, 0, NAN, 1.0, 0.5);
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    c = held_contact(0, 0, 0, 1.0, 0.5);
+    b.inverse_mass = -1;
+    ck_assert_int_eq(sdfccd_friction_hold(&c, 1, REST, &b, NULL), SDFCCD_INVALID_ARGUMENT);
+    b.inverse_mass = 1;
+    ck_assert(memcmp(&b, &keep, sizeof b) == 0);
+    ck_assert_int_eq(sdfccd_friction_hold(NULL, 0, REST, &b, NULL), SDFCCD_OK); /* nothing to hold */
+    ck_assert(memcmp(&b, &keep, sizeof b) == 0);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("contacts");
@@ -1718,5 +1892,13 @@ int main(void)
     test_add_memory_fixture(tq);
     tcase_add_test(tq, test_mesh_query_reduces_contacts);
     suite_add_tcase(s, tq);
+    TCase* th = tcase_create("friction hold");
+    test_add_memory_fixture(th);
+    tcase_add_test(th, test_hold_sticks_closed_form);
+    tcase_add_test(th, test_hold_cone_closed_form);
+    tcase_add_test(th, test_hold_box_on_four_corners);
+    tcase_add_test(th, test_hold_rest_speed);
+    tcase_add_test(th, test_hold_bad_input);
+    suite_add_tcase(s, th);
     return test_run_suite(s);
 }

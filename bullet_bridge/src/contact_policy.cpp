@@ -279,9 +279,81 @@ void BridgeImpl::process(const btCollisionObjectWrapper* mw, const btCollisionOb
         return;
     }
     writeManifolds(manifolds, manifold_count, r ? r->points.data() : nullptr, s.count, s.reduced, margin, mw, sw, work, stats);
+    if (guard_world && s.count > 0) {
+        // For the friction hold after the step (holdFriction clears them; a world only queried, never stepped, drops them).
+        if (dispatcher && held_manifolds.size() > 4 * (size_t)dispatcher->getNumManifolds() + 64) held_manifolds.clear();
+        held_manifolds.insert(held_manifolds.end(), manifolds, manifolds + manifold_count);
+    }
     if (kept) {
         kept->count = std::min(s.reduced, (int32_t)MANIFOLD_CACHE_SIZE);
         for (int i = 0; i < kept->count; ++i) kept->ids[i] = r->points[(size_t)i].id;
+    }
+}
+
+void BridgeImpl::holdFriction(btCollisionWorld* world, double dt)
+{
+    if (!guard_world) return;
+    // The step's manifolds still in the dispatcher (their points carry the solver's impulses), by body.
+    std::vector<std::pair<const btCollisionObject*, const btPersistentManifold*>> live;
+    btDispatcher* d = world->getDispatcher();
+    std::sort(held_manifolds.begin(), held_manifolds.end());
+    for (int m = 0; m < d->getNumManifolds(); ++m) {
+        const btPersistentManifold* pm = d->getManifoldByIndexInternal(m);
+        if (pm->getNumContacts() > 0 && std::binary_search(held_manifolds.begin(), held_manifolds.end(), pm))
+            live.push_back(std::make_pair(pm->getBody0(), pm));
+    }
+    held_manifolds.clear();
+    std::stable_sort(live.begin(), live.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    // Bullet's second friction direction when the world has one, and its resting-contact speed (no
+    // restitution below it): a body whose contact points all move slower is at rest.
+    const btContactSolverInfo& si = guard_world->getSolverInfo();
+    const bool two = (si.m_solverMode & SOLVER_USE_2_FRICTION_DIRECTIONS) != 0;
+    std::vector<sdfccd_HeldContact> cs;
+    for (size_t lo = 0, hi; lo < live.size(); lo = hi) {
+        for (hi = lo; hi < live.size() && live[hi].first == live[lo].first; ++hi) {}
+        btRigidBody* body = btRigidBody::upcast(const_cast<btCollisionObject*>(live[lo].first));
+        if (!body || body->isStaticOrKinematicObject() || !body->isActive()) continue;
+        cs.clear();
+        for (size_t k = lo; k < hi; ++k) {
+            const btPersistentManifold* pm = live[k].second;
+            const btRigidBody* sb = btRigidBody::upcast(pm->getBody1());
+            if (sb && sb->getInvMass() > 0) continue; // a dynamic SDF body: the friction between two bodies is Bullet's
+            for (int i = 0; i < pm->getNumContacts(); ++i) {
+                const btManifoldPoint& p = pm->getContactPoint(i);
+                if (!(p.m_appliedImpulse > 0)) continue;
+                const btVector3 at = p.m_positionWorldOnA;
+                sdfccd_HeldContact c;
+                c.point = v3(at);
+                c.normal = v3(p.m_normalWorldOnB);
+                c.surface_velocity = v3(sb ? sb->getVelocityInLocalPoint(at - sb->getCenterOfMassPosition()) : btVector3(0, 0, 0));
+                c.friction_impulse = v3(p.m_lateralFrictionDir1 * p.m_appliedImpulseLateral1 +
+                                        (two ? p.m_lateralFrictionDir2 * p.m_appliedImpulseLateral2 : btVector3(0, 0, 0)));
+                c.normal_impulse = (double)p.m_appliedImpulse;
+                c.friction = (double)p.m_combinedFriction;
+                cs.push_back(c);
+            }
+        }
+        // The lever arms from the centre the solver used (the start pose's, before the integration).
+        const btVector3 v = body->getLinearVelocity(), w = body->getAngularVelocity();
+        btTransform t1 = body->getWorldTransform(), turn_old, turn_new;
+        sdfccd_BodyState bs;
+        bs.center = v3(t1.getOrigin() - v * (btScalar)dt);
+        bs.linear_velocity = v3(body->getLinearVelocity());
+        bs.angular_velocity = v3(body->getAngularVelocity());
+        bs.inverse_mass = (double)body->getInvMass();
+        for (int k = 0; k < 9; ++k) bs.inverse_inertia[k] = (double)body->getInvInertiaTensorWorld()[k / 3][k % 3];
+        const double rest = (double)si.m_restitutionVelocityThreshold;
+        if (cs.empty() || sdfccd_friction_hold(cs.data(), (int32_t)cs.size(), rest, &bs, nullptr) != SDFCCD_OK) continue;
+        if (bt(bs.linear_velocity) == v && bt(bs.angular_velocity) == w) continue;
+        body->setLinearVelocity(bt(bs.linear_velocity));
+        body->setAngularVelocity(bt(bs.angular_velocity));
+        // Bullet's integration of the step redone with the new velocities: x1 + dv dt, and the turn of
+        // w over dt replaced by that of the new w.
+        btTransformUtil::integrateTransform(btTransform::getIdentity(), btVector3(0, 0, 0), w, (btScalar)dt, turn_old);
+        btTransformUtil::integrateTransform(btTransform::getIdentity(), btVector3(0, 0, 0), body->getAngularVelocity(), (btScalar)dt, turn_new);
+        t1.setOrigin(t1.getOrigin() + (body->getLinearVelocity() - v) * (btScalar)dt);
+        t1.setRotation((turn_new.getRotation() * turn_old.getRotation().inverse() * t1.getRotation()).normalized());
+        body->proceedToTransform(t1);
     }
 }
 

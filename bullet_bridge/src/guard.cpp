@@ -117,6 +117,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
             return start_poses[(size_t)i].second;
         return poseBefore(co, dt);
     };
+    holdFriction(world, dt);
     if (!workspace && sdfccd_create_workspace(&workspace) != SDFCCD_OK) workspace = nullptr;
     sdfccd_GuardParams gp = sdfccd_default_guard_params();
     gp.tolerance = cfg.guard_tolerance;

@@ -172,6 +172,10 @@ public:
     void guardStep(btCollisionWorld* world, double dt);
     // The step's start poses, once per step (the first narrow-phase call).
     void snapshotStartPoses(const btCollisionWorld* world);
+    // contact_policy.cpp: static friction on the step's manifolds (held_manifolds) that Bullet's one
+    // friction direction per point left out.
+    void holdFriction(btCollisionWorld* world, double dt);
+    std::vector<const btPersistentManifold*> held_manifolds;
 
     Config cfg;
     Stats stats;

@@ -532,11 +532,11 @@ sdfccd_Status sdfccd_guard_step_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, co
 }
 
 /* A body state (checked) in the core's form. */
-static sdfccd_Status body_state(const sdfccd_BodyState* in, const char* what, scc_body_state* out)
+static sdfccd_Status body_state(const sdfccd_BodyState* in, const char* fn, const char* what, scc_body_state* out)
 {
     sdfccd_Status st;
     char w[96];
-    snprintf(w, sizeof w, "sdfccd_guard_response: %s", what);
+    snprintf(w, sizeof w, "%s: %s", fn, what);
     if ((st = sdfccd__check_ptr(in, w)) || (st = sdfccd__check_vec(in->center, w)) || (st = sdfccd__check_vec(in->linear_velocity, w)) ||
         (st = sdfccd__check_vec(in->angular_velocity, w)))
         return st;
@@ -558,8 +558,8 @@ static sdfccd_Status guard_response(const sdfccd_GuardResult* result, int32_t re
 {
     sdfccd_Status st;
     scc_body_state b, s;
-    if ((st = sdfccd__check_ptr(result, "sdfccd_guard_response: result")) || (st = body_state(body, "body", &b)) ||
-        (sdf_body && (st = body_state(sdf_body, "sdf_body", &s))))
+    if ((st = sdfccd__check_ptr(result, "sdfccd_guard_response: result")) || (st = body_state(body, "sdfccd_guard_response", "body", &b)) ||
+        (sdf_body && (st = body_state(sdf_body, "sdfccd_guard_response", "sdf_body", &s))))
         return st;
     if (!isfinite(friction) || !(friction >= 0.0))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_guard_response: friction must be finite and >= 0 (got %g)", friction);
@@ -578,4 +578,71 @@ sdfccd_Status sdfccd_guard_response(const sdfccd_GuardResult* result, int32_t re
                                     sdfccd_BodyState* body)
 {
     SDFCCD__HELD_CALL(guard_response(result, repeated, sdf_body, friction, body));
+}
+
+/* Whether every loaded contact's material point moves slower than rest_speed relative to the SDF. */
+static int held_at_rest(const sdfccd_HeldContact* contacts, int32_t count, double rest_speed, const scc_body_state* b)
+{
+    for (int32_t i = 0; i < count; ++i) {
+        const sdfccd_HeldContact* c = &contacts[i];
+        const scc_vec3 p = sdfccd__v(c->point);
+        const scc_vec3 v = scc_sub(scc_add(b->v, scc_cross(b->w, scc_sub(p, b->center))), sdfccd__v(c->surface_velocity));
+        if (c->normal_impulse > 0.0 && !(scc_len(v) < rest_speed)) return 0;
+    }
+    return 1;
+}
+
+static sdfccd_Status friction_hold(const sdfccd_HeldContact* contacts, int32_t count, double rest_speed, sdfccd_BodyState* body,
+                                   sdfccd_Vec3* impulses)
+{
+    static const char fn[] = "sdfccd_friction_hold";
+    enum { CHUNK = SCC_HOLD_MAX };
+    sdfccd_Status st;
+    scc_body_state b;
+    if ((st = body_state(body, fn, "body", &b))) return st;
+    if (count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: count must be >= 0 (got %d)", fn, (int)count);
+    if (count > 0 && !contacts) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: contacts is NULL", fn);
+    if (!isfinite(rest_speed) || !(rest_speed >= 0.0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: rest_speed must be finite and >= 0 (got %g)", fn, rest_speed);
+    for (int32_t i = 0; i < count; ++i) {
+        const sdfccd_HeldContact* c = &contacts[i];
+        if (!isfinite(c->point.x + c->point.y + c->point.z + c->normal.x + c->normal.y + c->normal.z + c->surface_velocity.x +
+                      c->surface_velocity.y + c->surface_velocity.z + c->friction_impulse.x + c->friction_impulse.y +
+                      c->friction_impulse.z + c->normal_impulse + c->friction))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: contact %d has a non-finite value", fn, (int)i);
+        if (!(c->normal_impulse >= 0.0) || !(c->friction >= 0.0))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: contact %d has a negative normal impulse or friction", fn, (int)i);
+        if (!(scc_len(sdfccd__v(c->normal)) > 0.0)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: contact %d has a zero normal", fn, (int)i);
+    }
+    /* The core works on fixed chunks (no allocation): a body's points in one chunk hold together; a
+     * larger set is held chunk by chunk, each chunk seeing the velocities the earlier ones left. */
+    scc_held_contact c[CHUNK];
+    scc_vec3 held[CHUNK];
+    const int at_rest = held_at_rest(contacts, count, rest_speed, &b);
+    if (impulses)
+        for (int32_t i = 0; i < count; ++i) impulses[i] = sdfccd__pv(scc_v3(0, 0, 0));
+    for (int32_t lo = 0; at_rest && lo < count; lo += CHUNK) {
+        const int32_t n = count - lo < CHUNK ? count - lo : CHUNK;
+        for (int32_t i = 0; i < n; ++i) {
+            const sdfccd_HeldContact* in = &contacts[lo + i];
+            c[i].point = sdfccd__v(in->point);
+            c[i].normal = scc_normalize_or(sdfccd__v(in->normal), scc_v3(0, 0, 1));
+            c[i].surface_velocity = sdfccd__v(in->surface_velocity);
+            c[i].applied = sdfccd__v(in->friction_impulse);
+            c[i].normal_impulse = in->normal_impulse;
+            c[i].mu = in->friction;
+        }
+        scc_friction_hold(c, (size_t)n, held, &b);
+        if (impulses)
+            for (int32_t i = 0; i < n; ++i) impulses[lo + i] = sdfccd__pv(held[i]);
+    }
+    body->linear_velocity = sdfccd__pv(b.v);
+    body->angular_velocity = sdfccd__pv(b.w);
+    return SDFCCD_OK;
+}
+
+sdfccd_Status sdfccd_friction_hold(const sdfccd_HeldContact* contacts, int32_t count, double rest_speed, sdfccd_BodyState* body,
+                                   sdfccd_Vec3* impulses)
+{
+    SDFCCD__HELD_CALL(friction_hold(contacts, count, rest_speed, body, impulses));
 }

@@ -587,6 +587,36 @@ SDFCCD_API sdfccd_Status sdfccd_guard_body(sdfccd_Workspace* ws, const sdfccd_Gu
 SDFCCD_API sdfccd_Status sdfccd_swept_aabb(const sdfccd_Aabb* start_box, const sdfccd_Aabb* end_box, const sdfccd_Pose* start,
                                            const sdfccd_Pose* end, double reach, sdfccd_Aabb* out_box);
 
+/** A contact of a rigid body on an SDF after an engine's solve, for sdfccd_friction_hold() (world frame). */
+typedef struct sdfccd_HeldContact {
+    sdfccd_Vec3 point;            /**< Where the impulses act (m). */
+    sdfccd_Vec3 normal;           /**< Unit contact normal, from the SDF towards the body. */
+    sdfccd_Vec3 surface_velocity; /**< The SDF's velocity at `point` (m/s; zero for a static SDF). */
+    sdfccd_Vec3 friction_impulse; /**< Friction impulse the solver applied to the body at the point (N s; its part
+                                       along the normal is ignored). */
+    double normal_impulse;        /**< Normal impulse the solver applied at the point (N s, >= 0; 0: the point
+                                       carried no load and holds nothing). */
+    double friction;              /**< Coulomb coefficient (>= 0). */
+} sdfccd_HeldContact;
+
+/** Static friction that an engine's solve left out, for a body at rest on an SDF. A solver that
+ * gives each contact point one friction direction (Bullet's default: along the point's sliding
+ * velocity) leaves the other tangent direction free, so a body that should stick can creep. When
+ * every loaded contact point (normal_impulse > 0) moves slower than `rest_speed` (m/s) relative to
+ * the SDF (the engine's resting-contact speed; an impact or a fast slide is left to the solver),
+ * this adds at each contact the tangential impulse that stops the point sliding relative to the SDF
+ * (`surface_velocity`), such that the solver's friction impulse and the added one together stay
+ * within the point's Coulomb cone (|friction_impulse + added| <= friction * normal_impulse): a
+ * sticking body stops, a sliding one keeps the friction the cone allows. Sixteen Gauss-Seidel passes
+ * over the points in order (deterministic; more than 64 points are held 64 at a time, in order).
+ * `body` (its velocities after the solve; the SDF counts as infinitely heavy) gets the new
+ * velocities; `impulses` (`count` entries, may be NULL) receives the added impulse per point (zero
+ * when the body is not at rest). Errors (::SDFCCD_INVALID_ARGUMENT, nothing written): NULL `body`,
+ * NULL `contacts` with `count` > 0, `count` < 0, non-finite values, a zero normal, a negative normal
+ * impulse, friction, inverse mass or `rest_speed`. */
+SDFCCD_API sdfccd_Status sdfccd_friction_hold(const sdfccd_HeldContact* contacts, int32_t count, double rest_speed, sdfccd_BodyState* body,
+                                              sdfccd_Vec3* impulses);
+
 #ifdef __cplusplus
 }
 #endif
