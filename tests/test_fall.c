@@ -170,6 +170,26 @@ START_TEST(test_spike_apex_triangle)
 }
 END_TEST
 
+/* A mesh of n separate triangles (v[t][k] the k-th corner of triangle t) in caller-owned arrays of 3n
+ * vertices and indices, with its bounds; no broad-phase hierarchy. */
+static void soup_mesh(const double (*v)[3][3], int n, scc_vec3* vv, uint32_t* f, scc_mesh* mesh)
+{
+    memset(mesh, 0, sizeof *mesh);
+    mesh->bounds.lo = scc_v3(INFINITY, INFINITY, INFINITY);
+    mesh->bounds.hi = scc_v3(-INFINITY, -INFINITY, -INFINITY);
+    for (int t = 0; t < n; ++t)
+        for (int k = 0; k < 3; ++k) {
+            vv[3 * t + k] = scc_v3(v[t][k][0], v[t][k][1], v[t][k][2]);
+            f[3 * t + k] = (uint32_t)(3 * t + k);
+            mesh->bounds.lo = scc_vmin(mesh->bounds.lo, vv[3 * t + k]);
+            mesh->bounds.hi = scc_vmax(mesh->bounds.hi, vv[3 * t + k]);
+        }
+    mesh->vertices = vv;
+    mesh->indices = f;
+    mesh->vertex_count = (uint32_t)(3 * n);
+    mesh->triangle_count = (uint32_t)n;
+}
+
 /* Five triangles of the 100K scene's step 2 with the spike-apex one (70699): the broad phase hands
  * over two triangles with later contacts (at 0.0331 and 0.0279) first, whose FWGSS answers the mesh
  * query now checks only up to the earliest contact (mesh_query.c, deferred checks). The answer must
@@ -188,20 +208,7 @@ START_TEST(test_deferred_checks)
     scc_vec3 vv[15];
     uint32_t f[15];
     scc_mesh mesh;
-    memset(&mesh, 0, sizeof mesh);
-    mesh.bounds.lo = scc_v3(INFINITY, INFINITY, INFINITY);
-    mesh.bounds.hi = scc_v3(-INFINITY, -INFINITY, -INFINITY);
-    for (int t = 0; t < 5; ++t)
-        for (int k = 0; k < 3; ++k) {
-            vv[3 * t + k] = scc_v3(v[t][k][0], v[t][k][1], v[t][k][2]);
-            f[3 * t + k] = (uint32_t)(3 * t + k);
-            mesh.bounds.lo = scc_vmin(mesh.bounds.lo, vv[3 * t + k]);
-            mesh.bounds.hi = scc_vmax(mesh.bounds.hi, vv[3 * t + k]);
-        }
-    mesh.vertices = vv;
-    mesh.indices = f;
-    mesh.vertex_count = 15;
-    mesh.triangle_count = 5;
+    soup_mesh(v, 5, vv, f, &mesh);
     mesh.bsh = scc_bsh_build(&mesh, &k_alloc);
     ck_assert_ptr_nonnull(mesh.bsh);
     scc_sdf_spike_grid spikes;
@@ -258,20 +265,7 @@ START_TEST(test_precheck_clears)
     scc_vec3 vv[18];
     uint32_t f[18];
     scc_mesh mesh;
-    memset(&mesh, 0, sizeof mesh);
-    mesh.bounds.lo = scc_v3(INFINITY, INFINITY, INFINITY);
-    mesh.bounds.hi = scc_v3(-INFINITY, -INFINITY, -INFINITY);
-    for (int t = 0; t < 6; ++t)
-        for (int k = 0; k < 3; ++k) {
-            vv[3 * t + k] = scc_v3(v[t][k][0], v[t][k][1], v[t][k][2]);
-            f[3 * t + k] = (uint32_t)(3 * t + k);
-            mesh.bounds.lo = scc_vmin(mesh.bounds.lo, vv[3 * t + k]);
-            mesh.bounds.hi = scc_vmax(mesh.bounds.hi, vv[3 * t + k]);
-        }
-    mesh.vertices = vv;
-    mesh.indices = f;
-    mesh.vertex_count = 18;
-    mesh.triangle_count = 6;
+    soup_mesh(v, 6, vv, f, &mesh);
     scc_sdf_spike_grid spikes;
     scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
     scc_rigid body = spike_scene_body();
