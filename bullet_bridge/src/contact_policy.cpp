@@ -336,12 +336,8 @@ void BridgeImpl::holdFriction(btCollisionWorld* world, double dt)
         // The lever arms from the centre the solver used (the start pose's, before the integration).
         const btVector3 v = body->getLinearVelocity(), w = body->getAngularVelocity();
         btTransform t1 = body->getWorldTransform(), turn_old, turn_new;
-        sdfccd_BodyState bs;
+        sdfccd_BodyState bs = bodyState(body);
         bs.center = v3(t1.getOrigin() - v * (btScalar)dt);
-        bs.linear_velocity = v3(body->getLinearVelocity());
-        bs.angular_velocity = v3(body->getAngularVelocity());
-        bs.inverse_mass = (double)body->getInvMass();
-        for (int k = 0; k < 9; ++k) bs.inverse_inertia[k] = (double)body->getInvInertiaTensorWorld()[k / 3][k % 3];
         const double rest = (double)si.m_restitutionVelocityThreshold;
         if (cs.empty() || sdfccd_friction_hold(cs.data(), (int32_t)cs.size(), rest, &bs, nullptr) != SDFCCD_OK) continue;
         if (bt(bs.linear_velocity) == v && bt(bs.angular_velocity) == w) continue;

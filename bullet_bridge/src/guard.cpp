@@ -56,6 +56,15 @@ void leaves(const btCollisionShape* s, const btTransform& offset, std::vector<st
     out.push_back(std::make_pair(s, offset));
 }
 
+// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
+sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out)
+{
+    const sdfccd_Pose pa = toPose(a), pb = toPose(b);
+    return sdfccd_rigid_motion_from_poses(&pa, &pb, v3(c), 0, dt, out);
+}
+
+} // namespace
+
 sdfccd_BodyState bodyState(const btRigidBody* b)
 {
     sdfccd_BodyState s;
@@ -66,15 +75,6 @@ sdfccd_BodyState bodyState(const btRigidBody* b)
     for (int k = 0; k < 9; ++k) s.inverse_inertia[k] = (double)b->getInvInertiaTensorWorld()[k / 3][k % 3];
     return s;
 }
-
-// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
-sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out)
-{
-    const sdfccd_Pose pa = toPose(a), pb = toPose(b);
-    return sdfccd_rigid_motion_from_poses(&pa, &pb, v3(c), 0, dt, out);
-}
-
-} // namespace
 
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world)
 {

@@ -39,6 +39,8 @@ sdfccd_Pose toPose(const btTransform& t);
 // The pose `dt` before the object's current one: its pose moved back by its velocities (a kinematic
 // object's, or one that is no rigid body, by its interpolation velocities), undoing Bullet's integration.
 btTransform poseBefore(const btCollisionObject* co, double dt);
+// A rigid body's centre of mass, velocities and inverse mass and world inertia, as the C API takes them.
+sdfccd_BodyState bodyState(const btRigidBody* b);
 
 // The motion of a body (or compound child: `wrapper_transform` includes its offset) over a step:
 // from its start pose to its end pose with the constant velocities that connect them in Bullet's
