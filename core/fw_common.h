@@ -13,7 +13,7 @@
 typedef struct scc_fw_state {
     const scc_sdf* sdf;
     const scc_sdf_torus* torus; /* sdf when it is the built-in torus (NULL otherwise): tested once per sample (scc_fw_sdf) */
-    const scc_sdf_user* user;   /* sdf when it is a user's field (NULL otherwise): phi alone without its eval (scc_fw_sdf) */
+    const scc_sdf_user* user;   /* sdf when it is a user's field (NULL otherwise): its function called without its eval (scc_fw_sdf) */
     double margin;          /* p->margin, one load per sample instead of two */
     const scc_tri_motion* m;
     const scc_params* p;
@@ -211,7 +211,7 @@ static inline void scc_fw_tri_points(scc_fw_state* s, double t, scc_tri_state* s
 SCC_HOT_INLINE double scc_fw_sdf(const scc_fw_state* s, scc_vec3 x, scc_vec3* g)
 {
     if (s->torus) return scc_sdf_torus_value(s->torus, x, g);
-    if (s->user && !g) return scc_sdf_user_value(s->user, x);
+    if (s->user) return scc_sdf_user_value(s->user, x, g);
     return s->sdf->eval(s->sdf, x, g);
 }
 
