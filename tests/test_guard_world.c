@@ -150,30 +150,43 @@ START_TEST(test_moved_through_wall)
 }
 END_TEST
 
-/* Spun through the wall: a 1 m x 4 cm x 4 cm bar (centre 0.3 m above the wall's top) turning by 1.2
- * rad about y in one step about its centre of mass. Its lowest corner, at distance R from the centre,
- * first reaches the half level when R sin(a + phi) = 0.3 - (top - TOL/2): put back at that angle
- * (closed form), and the corner no longer approaches the wall. */
+/* Spun through the wall: a 1 m x 4 cm x 4 cm bar (its centre of mass 0.3 m above the wall's top)
+ * turning by 1.2 rad about y in one step about its centre of mass. The body's origin is at the bar's
+ * end (the part's offset puts the bar's centre at +0.5 m in x), so the motion's centre is the state's
+ * centre, not the origin. The lowest corner, at distance R from the centre, first reaches the half
+ * level when R sin(a + phi) = 0.3 + TOL/2: put back at that angle (closed form), the centre in place,
+ * and the corner no longer approaches the wall. */
+static sdfccd_Pose bar_pose(double angle)
+{
+    sdfccd_Pose p;
+    p.orientation = axis_angle(v3(0, 1, 0), angle);
+    p.position = v3(-0.5 * cos(angle), 0, 0.3 + WALL + 0.5 * sin(angle)); /* the centre minus R(angle) (0.5, 0, 0) */
+    return p;
+}
+
 START_TEST(test_spun_through_wall)
 {
     fixture f = setup();
     const sdfccd_MeshId bar = test_box_mesh(v3(0.5, 0.02, 0.02), 10, 1, 1);
     const sdfccd_GuardSdf wall = wall_sdf(f.wall, at(0, 0, 0), at(0, 0, 0));
-    const sdfccd_GuardPart part = part_of(bar, sdfccd_pose_identity());
-    sdfccd_Pose end = at(0, 0, 0.3 + WALL);
-    end.orientation = axis_angle(v3(0, 1, 0), 1.2);
-    sdfccd_GuardRigidBody body = body_of(&part, 1, at(0, 0, 0.3 + WALL), end, 0.51);
+    const sdfccd_GuardPart part = part_of(bar, at(0.5, 0, 0));
+    sdfccd_GuardRigidBody body = body_of(&part, 1, bar_pose(0), bar_pose(1.2), 1.01);
+    body.state.center = v3(0, 0, 0.3 + WALL);
+    body.state.linear_velocity = v3(0, 0, 0);
     body.state.angular_velocity = v3(0, 1.2 / DT, 0);
     const sdfccd_GuardWorldResult r = run1(&f, &wall, 1, &body);
     const double R = hypot(0.5, 0.02), phi = atan2(0.02, 0.5);
     const double t = (asin((0.3 + 0.5 * TOL) / R) - phi) / (1.2 / DT);
     ck_assert(r.rolled_back == 1 && r.part == 0);
     ck_assert_msg(r.guard.toi <= t && r.guard.toi >= t - 3e-7, "toi %.12g, closed form %.12g", r.guard.toi, t);
-    /* The safe pose: the start turned by 1.2 toi / DT about y, the centre in place. */
-    const double half = 0.5 * 1.2 * r.guard.toi / DT;
-    ck_assert_double_near(r.pose.orientation.w, cos(half), 1e-12);
-    ck_assert_double_near(r.pose.orientation.y, sin(half), 1e-12);
-    ck_assert_double_near(r.pose.position.z, 0.3 + WALL, 1e-12);
+    /* The safe pose: the bar turned by 1.2 toi / DT about y about its centre. */
+    const sdfccd_Pose expect = bar_pose(1.2 * r.guard.toi / DT);
+    ck_assert_double_near(r.pose.orientation.w, expect.orientation.w, 1e-12);
+    ck_assert_double_near(r.pose.orientation.y, expect.orientation.y, 1e-12);
+    ck_assert_double_near(r.pose.position.x, expect.position.x, 1e-12);
+    ck_assert_double_near(r.pose.position.z, expect.position.z, 1e-12);
+    ck_assert_double_near(r.state.center.x, 0.0, 1e-12);
+    ck_assert_double_near(r.state.center.z, 0.3 + WALL, 1e-12);
     /* The corner's velocity into the wall is gone. */
     const sdfccd_Vec3 p = r.guard.point, c = r.state.center, w = r.state.angular_velocity;
     const double vz = r.state.linear_velocity.z + (w.x * (p.y - c.y) - w.y * (p.x - c.x));
@@ -312,21 +325,21 @@ START_TEST(test_still_pair_costs_nothing)
 }
 END_TEST
 
-/* An SDF carried by a dynamic body (a ball of the world) is not checked against that body, and the
- * response takes that body's state: a box falling on a ball body moving up at 2 m/s leaves with the
- * ball's vertical velocity. */
+/* An SDF carried by a dynamic body (a slab of the world rising at 2 m/s, its own mesh inside it) is
+ * not checked against that body, and the response takes that body's state: a box falling on it
+ * leaves with the slab's vertical velocity. */
 START_TEST(test_sdf_of_a_body)
 {
     fixture f = setup();
     const sdfccd_GuardPart part = part_of(f.box, sdfccd_pose_identity());
-    sdfccd_GuardSdf wall = wall_sdf(f.wall, at(0, 0, 0), at(0, 0, 0));
+    const sdfccd_Pose lift = at(0, 0, 2 * DT);
+    sdfccd_GuardSdf wall = wall_sdf(f.wall, at(0, 0, 0), lift);
     wall.body = 1;
     wall.has_state = 1; /* ignored: the body's state counts */
-    sdfccd_GuardRigidBody bodies[2] = { body_of(&part, 1, at(0, 0, 0.5), at(0, 0, -0.5), 0.2), body_of(&part, 1, at(0, 0, 0), at(0, 0, 0), 0.2) };
-    bodies[1].state.linear_velocity = v3(0, 0, 2);
+    sdfccd_GuardRigidBody bodies[2] = { body_of(&part, 1, at(0, 0, 0.5), at(0, 0, -0.5), 0.2), body_of(&part, 1, at(0, 0, 0), lift, 0.2) };
     sdfccd_GuardWorldResult r[2];
     ck_assert_int_eq(sdfccd_guard_world(f.ws, &wall, 1, bodies, 2, 0.0, DT, &f.gp, NULL, NULL, r), SDFCCD_OK);
-    ck_assert(r[0].rolled_back == 1 && r[1].queries == 0);
+    ck_assert(r[0].rolled_back == 1 && r[1].queries == 0 && r[1].rolled_back == 0);
     ck_assert_double_near(r[0].state.linear_velocity.z, 2.0, 1e-9);
     teardown(&f);
 }
