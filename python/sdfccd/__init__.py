@@ -980,23 +980,22 @@ def guard_linear(sdf, mesh, start, end, t0=0.0, t1=1.0 / 60.0, tolerance=None, p
     return GuardResult(out, positions)
 
 
-def _pose_arg(p, name):
-    """(position, orientation w x y z) as an sdfccd_Pose."""
+def _pair_arg(p, name, struct, fields, sizes):
+    """A pair of arrays (e.g. (position, orientation w x y z)) as `struct`'s two `fields` of `sizes`."""
     if not isinstance(p, (tuple, list)) or len(p) != 2:
-        raise TypeError(f"{name}: expected (position, orientation)")
-    out = _lib.Pose()
-    out.position[:] = _float_array(p[0], f"{name} position", (3,))
-    out.orientation[:] = _float_array(p[1], f"{name} orientation", (4,))
+        raise TypeError(f"{name}: expected ({fields[0]}, {fields[1]})")
+    out = struct()
+    for f, v, n in zip(fields, p, sizes):
+        getattr(out, f)[:] = _float_array(v, f"{name} {f}", (n,))
     return out
+
+
+def _pose_arg(p, name):
+    return _pair_arg(p, name, _lib.Pose, ("position", "orientation"), (3, 4))
 
 
 def _box_arg(b, name):
-    if not isinstance(b, (tuple, list)) or len(b) != 2:
-        raise TypeError(f"{name}: expected (lo, hi)")
-    out = _lib.Aabb()
-    out.lo[:] = _float_array(b[0], f"{name} lo", (3,))
-    out.hi[:] = _float_array(b[1], f"{name} hi", (3,))
-    return out
+    return _pair_arg(b, name, _lib.Aabb, ("lo", "hi"), (3, 3))
 
 
 def _state_arg(d, name):
