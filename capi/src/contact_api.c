@@ -530,20 +530,31 @@ sdfccd_Status sdfccd_guard_step_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, co
     SDFCCD__HELD_CALL(guard_rigid(ws, sdf, sdf_motion, mesh, executed, t0, t1, params, out, 1));
 }
 
+/* Whether a body state passes sdfccd__body_state's checks (no message, no formatting). */
+static int body_state_ok(const sdfccd_BodyState* in)
+{
+    if (!in || !scc_vfinite(sdfccd__v(in->center)) || !scc_vfinite(sdfccd__v(in->linear_velocity)) ||
+        !scc_vfinite(sdfccd__v(in->angular_velocity)) || !isfinite(in->inverse_mass) || !(in->inverse_mass >= 0.0))
+        return 0;
+    for (int i = 0; i < 9; ++i)
+        if (!isfinite(in->inverse_inertia[i])) return 0;
+    return 1;
+}
+
 sdfccd_Status sdfccd__body_state(const sdfccd_BodyState* in, const char* fn, const char* what, scc_body_state* out)
 {
-    sdfccd_Status st;
-    char w[96];
-    snprintf(w, sizeof w, "%s: %s", fn, what);
-    if ((st = sdfccd__check_ptr(in, w)) || (st = sdfccd__check_vec(in->center, w)) || (st = sdfccd__check_vec(in->linear_velocity, w)) ||
-        (st = sdfccd__check_vec(in->angular_velocity, w)))
-        return st;
-    if (!isfinite(in->inverse_mass) || !(in->inverse_mass >= 0.0))
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_mass must be finite and >= 0", w);
-    for (int i = 0; i < 9; ++i) {
-        if (!isfinite(in->inverse_inertia[i])) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_inertia is not finite", w);
-        out->inv_inertia[i] = in->inverse_inertia[i];
+    if (!body_state_ok(in)) { /* the message names the field */
+        sdfccd_Status st;
+        char w[96];
+        snprintf(w, sizeof w, "%s: %s", fn, what);
+        if ((st = sdfccd__check_ptr(in, w)) || (st = sdfccd__check_vec(in->center, w)) || (st = sdfccd__check_vec(in->linear_velocity, w)) ||
+            (st = sdfccd__check_vec(in->angular_velocity, w)))
+            return st;
+        if (!isfinite(in->inverse_mass) || !(in->inverse_mass >= 0.0))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_mass must be finite and >= 0", w);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_inertia is not finite", w);
     }
+    for (int i = 0; i < 9; ++i) out->inv_inertia[i] = in->inverse_inertia[i];
     out->center = sdfccd__v(in->center);
     out->v = sdfccd__v(in->linear_velocity);
     out->w = sdfccd__v(in->angular_velocity);

@@ -153,25 +153,33 @@ static int bad_box(const sdfccd_Aabb* b)
     return isnan(b->lo.x) || isnan(b->lo.y) || isnan(b->lo.z) || isnan(b->hi.x) || isnan(b->hi.y) || isnan(b->hi.z);
 }
 
+/* A pose checked as sdfccd_rigid_motion_from_poses does; the message (formatted only on failure)
+ * names it "sdfccd_guard_world: what[i].field". */
+static sdfccd_Status check_pose(const sdfccd_Pose* p, const char* what, int32_t i, const char* field)
+{
+    scc_xform x;
+    if (sdfccd__unit_pose(p, "sdfccd_guard_world", &x) == SDFCCD_OK) return SDFCCD_OK;
+    char w[96];
+    snprintf(w, sizeof w, "sdfccd_guard_world: %s[%d].%s", what, (int)i, field);
+    return sdfccd__unit_pose(p, w, &x);
+}
+
 /* The checks an SDF or body shares: poses, boxes, reach, friction, state. */
 static sdfccd_Status check_moving(const char* what, int32_t i, const sdfccd_Pose* start, const sdfccd_Pose* end, const sdfccd_Aabb* b0,
                                   const sdfccd_Aabb* b1, double reach, double friction, const sdfccd_BodyState* state)
 {
     static const char fn[] = "sdfccd_guard_world";
-    char w[96];
-    scc_xform x;
     scc_body_state s;
     sdfccd_Status st;
-    snprintf(w, sizeof w, "%s: %s[%d].start", fn, what, (int)i);
-    if ((st = sdfccd__unit_pose(start, w, &x))) return st;
-    snprintf(w, sizeof w, "%s: %s[%d].end", fn, what, (int)i);
-    if ((st = sdfccd__unit_pose(end, w, &x))) return st;
+    if ((st = check_pose(start, what, i, "start")) || (st = check_pose(end, what, i, "end"))) return st;
     if (bad_box(b0) || bad_box(b1)) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %s[%d] has a NaN box coordinate", fn, what, (int)i);
     if (!(isfinite(reach) && reach >= 0.0) || !(isfinite(friction) && friction >= 0.0))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: %s[%d]: reach (%g) and friction (%g) must be finite and >= 0", fn, what, (int)i,
                              reach, friction);
+    if (!state || sdfccd__body_state(state, fn, "state", &s) == SDFCCD_OK) return SDFCCD_OK;
+    char w[32];
     snprintf(w, sizeof w, "%s[%d].state", what, (int)i);
-    return state ? sdfccd__body_state(state, fn, w, &s) : SDFCCD_OK;
+    return sdfccd__body_state(state, fn, w, &s);
 }
 
 /* The SDF's motion over the step, from its two poses (about its origin). */
@@ -214,10 +222,12 @@ static sdfccd_Status check_world(sdfccd_Workspace* ws, const sdfccd_GuardSdf* sd
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: bodies[%d].part_count = %d (must be >= 0, with parts not NULL when > 0)", fn, (int)i,
                                  (int)b->part_count);
         for (int32_t k = 0; k < b->part_count; ++k) {
-            char w[96];
             scc_xform x;
-            snprintf(w, sizeof w, "%s: bodies[%d].parts[%d].offset", fn, (int)i, (int)k);
-            if ((st = sdfccd__unit_pose(&b->parts[k].offset, w, &x))) return st;
+            if (sdfccd__unit_pose(&b->parts[k].offset, fn, &x)) {
+                char w[48];
+                snprintf(w, sizeof w, "bodies[%d].parts", (int)i);
+                return check_pose(&b->parts[k].offset, w, k, "offset");
+            }
             if (!sdfccd__mesh_acquire(b->parts[k].mesh)) return SDFCCD_INVALID_HANDLE;
         }
     }
