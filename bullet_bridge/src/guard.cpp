@@ -132,11 +132,11 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
     // sdfccd_guard_world takes them; it checks each body's executed motion and rolls it back.
     std::vector<btRigidBody*> dyn;
     std::vector<int> dyn_object;
-    std::unordered_map<const btCollisionObject*, int32_t> index;
+    std::vector<int32_t> dyn_index((size_t)objs.size(), -1); // object -> body index (-1: not a dynamic body)
     for (int i = 0; i < objs.size(); ++i) {
         btRigidBody* body = btRigidBody::upcast(objs[i]);
         if (!body || body->isStaticOrKinematicObject()) continue;
-        index[body] = (int32_t)dyn.size();
+        dyn_index[(size_t)i] = (int32_t)dyn.size();
         dyn.push_back(body);
         dyn_object.push_back(i);
     }
@@ -155,8 +155,7 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         shapeBoxes(s, t0, t1, o.start_box, o.end_box, o.reach);
         o.friction = (double)objs[i]->getFriction();
         o.shape_key = (uint64_t)(uintptr_t)s;
-        const auto it = index.find(objs[i]);
-        o.body = it == index.end() ? -1 : it->second;
+        o.body = dyn_index[(size_t)i];
         if (const btRigidBody* sb = btRigidBody::upcast(objs[i])) {
             o.has_state = 1;
             o.state = bodyState(sb);
