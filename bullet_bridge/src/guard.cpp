@@ -4,6 +4,8 @@
 // states) to sdfccd_guard_world and puts each body it rolls back at its safe pose, with its velocity.
 #include "internal.h"
 
+#include <cmath>
+
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
 using namespace detail;
@@ -66,6 +68,15 @@ void placeBody(void* user, int32_t i, int32_t j, const sdfccd_Pose* pose, sdfccd
     body->setCenterOfMassTransform(btTransform(btQuaternion((btScalar)q.x, (btScalar)q.y, (btScalar)q.z, (btScalar)q.w).normalized(), bt(pose->position)));
     *state = bodyState(body);
     *friction = (double)(body->getFriction() * (*p->sdf_objects)[(size_t)j]->getFriction());
+}
+
+// False when a pose holds a NaN or infinity (a body that blew up): it is left out of the guard,
+// so the other bodies stay guarded.
+bool finitePose(const btTransform& t)
+{
+    double s = (double)t.getOrigin().x() + (double)t.getOrigin().y() + (double)t.getOrigin().z();
+    for (int i = 0; i < 3; ++i) s += (double)t.getBasis()[i].x() + (double)t.getBasis()[i].y() + (double)t.getBasis()[i].z();
+    return std::isfinite(s);
 }
 
 } // namespace
@@ -136,6 +147,10 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
     for (int i = 0; i < objs.size(); ++i) {
         btRigidBody* body = btRigidBody::upcast(objs[i]);
         if (!body || body->isStaticOrKinematicObject()) continue;
+        if (!finitePose(startOf(i)) || !finitePose(body->getWorldTransform())) {
+            stats.query_errors++;
+            continue;
+        }
         dyn_index[(size_t)i] = (int32_t)dyn.size();
         dyn.push_back(body);
         dyn_object.push_back(i);
@@ -150,6 +165,10 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
         if (!o.sdf.index1) continue;
         const btTransform t1 = objs[i]->getWorldTransform();
         const btTransform t0 = objs[i]->isStaticObject() && !objs[i]->isKinematicObject() ? t1 : startOf(i);
+        if (!finitePose(t0) || !finitePose(t1)) {
+            stats.query_errors++;
+            continue;
+        }
         o.start = toPose(t0);
         o.end = toPose(t1);
         shapeBoxes(s, t0, t1, o.start_box, o.end_box, o.reach);
