@@ -208,13 +208,7 @@ typedef struct item {
     uint32_t tri;     /* a region: its triangle's record (below_tri) */
 } item;
 
-/* Earliest first; items of the same time by node (the resting contacts of a step all come at its
- * start), so their order does not hang on when each was pushed. */
-static inline int item_less(const item* a, const item* b)
-{
-    return a->key < b->key || (a->key == b->key && a->node < b->node);
-}
-SCC_MIN_HEAP_BY(item_heap, item, item_less)
+SCC_MIN_HEAP(item_heap, item, key)
 
 typedef struct trav {
     const scc_bsh* bsh;
@@ -614,13 +608,21 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
      * 4's bunny on the torus grid (94.7 evaluations per triangle) went 15,340 -> 17,541 with it. */
     const int below = bsh->triangle_count > 1 && p->method == SCC_METHOD_FWGSS && in->sdf->kind != SCC_SDF_GRID &&
                       scc_fwgss_verified(in->sdf, p);
+    /* Ordered (there too, after the step's start): a march pauses where its next evaluation is later
+     * than the queue's first item, and children wait in the queue for their march, so every evaluation
+     * comes in time order and none is spent after a contact found meanwhile (march). Elsewhere, and for
+     * the nodes touching at the start (the resting contacts, all of the same time, whose order the
+     * queue's history sets), a node is marched whole when its parent's turn comes, as before: the
+     * answers stay those of before where the triangles are cheap, and the resting contacts are searched
+     * in the same order (Table 4's shuriken: 2,605 evaluations, 2,771 in another order). */
+    const int ordered = below;
     double te = t_end;
     while (ok && heap.n && stats->evals < p->max_evals) { /* marching alone may use up the budget */
         item it = item_heap_pop(&heap);
         if (it.key > te) break;
         uint32_t s = it.seg & ~(SEG_MARCHING | SEG_REGION);
         if (it.seg & SEG_MARCHING) {
-            const double pause = heap.n ? heap.a[0].key : INFINITY;
+            const double pause = ordered && it.key > mm->t0 && heap.n ? heap.a[0].key : INFINITY;
             const int r = march(&tr, it.node, s, fmin(seg[s].tb, te), pause, &it.key, &it.sub);
             if (r == MARCH_STALLED) it.seg = s, it.sub = 0; /* a candidate at it.key */
             if (r != MARCH_CLEAR) ok = item_heap_push(&heap, it);
@@ -654,7 +656,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
             if (!regions) { /* its sphere touches at the start (a resting contact): the triangle's turn */
                 tested[t] = 0xffu;
                 stats->candidates += 1;
-                    ok = visit(user, t, it.key, &te);
+                ok = visit(user, t, it.key, &te);
                 continue;
             }
             tested[t] = 0x80u;
@@ -665,9 +667,14 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
             }
             continue;
         }
-        /* the children are marched from the parent's candidate time when the queue reaches them */
+        /* the children are marched from the parent's candidate time: when the queue reaches them (ordered), or now */
+        const int later = ordered && it.key > mm->t0;
         for (uint32_t k = 0; k < 2 && ok; ++k) {
             item c = { it.key, n->first + k, s | SEG_MARCHING, 0, 0 };
+            if (later) { ok = item_heap_push(&heap, c); continue; }
+            if (march(&tr, c.node, s, fmin(seg[s].tb, te), INFINITY, &c.key, &c.sub) != MARCH_STALLED) continue;
+            c.seg = s;
+            c.sub = 0;
             ok = item_heap_push(&heap, c);
         }
     }

@@ -3,10 +3,9 @@
  * scc_allocator. Used by the earliest-first searches (certified TOI, broad phase).
  *
  *   SCC_MIN_HEAP(name, type, key_field)
- * orders by the double `key_field`; SCC_MIN_HEAP_BY(name, type, less) by `less(const type*, const
- * type*)` (a strict order: a key and a tie-break, say). Either defines `name` (a struct with a, n,
- * cap, alloc, max_bytes, full), `static int name##_push(name*, type)` (0 when the allocator fails, or when growing would pass max_bytes: then `full` is set)
- * and `static type name##_pop(name*)` (the least element; the heap must not be empty). Release the
+ * defines `name` (a struct with a, n, cap, alloc, max_bytes, full), `static int name##_push(name*,
+ * type)` (0 when the allocator fails, or when growing would pass max_bytes: then `full` is set)
+ * and `static type name##_pop(name*)` (the smallest key; the heap must not be empty). Release the
  * storage with scc_free(alloc, h.a, h.cap * sizeof *h.a).
  *
  * max_bytes (0: no limit) bounds what the heap holds at any moment, including the moment of
@@ -18,7 +17,7 @@
 #include <stddef.h>
 #include "alloc.h"
 
-#define SCC_MIN_HEAP_BY(name, type, less)                                                 \
+#define SCC_MIN_HEAP(name, type, key)                                                   \
     typedef struct name {                                                               \
         type* a;                                                                        \
         size_t n, cap;                                                                  \
@@ -46,7 +45,7 @@
         size_t i = h->n++;                                                              \
         while (i > 0) {                                                                 \
             size_t parent = (i - 1) / 2;                                                \
-            if (!less(&elem, &h->a[parent])) break;                                     \
+            if (h->a[parent].key <= elem.key) break;                                    \
             h->a[i] = h->a[parent];                                                     \
             i = parent;                                                                 \
         }                                                                               \
@@ -60,9 +59,9 @@
         size_t i = 0;                                                                   \
         for (;;) {                                                                      \
             size_t l = 2 * i + 1, r = l + 1, m = i;                                     \
-            const type* km = &last;                                                     \
-            if (l < h->n && less(&h->a[l], km)) { m = l; km = &h->a[l]; }              \
-            if (r < h->n && less(&h->a[r], km)) m = r;                                  \
+            double km = last.key;                                                       \
+            if (l < h->n && h->a[l].key < km) { m = l; km = h->a[l].key; }              \
+            if (r < h->n && h->a[r].key < km) m = r;                                    \
             if (m == i) break;                                                          \
             h->a[i] = h->a[m];                                                          \
             i = m;                                                                      \
@@ -70,9 +69,5 @@
         if (h->n) h->a[i] = last;                                                       \
         return top;                                                                     \
     }
-
-#define SCC_MIN_HEAP(name, type, key)                                                   \
-    static inline int name##_less(const type* a, const type* b) { return a->key < b->key; } \
-    SCC_MIN_HEAP_BY(name, type, name##_less)
 
 #endif
