@@ -190,6 +190,14 @@ void scc_bsh_refit_linear(const scc_bsh* bsh, const scc_mesh* mesh, const scc_ve
 /* ---------------------------------------------------------------- traversal */
 
 #define MARCH_MAX_STEPS 48
+/* A march stalls where the sphere's clearance is below this fraction of its radius (plus 1 nm). In
+ * the ordered search (scc_bsh_traverse) a node's candidate time only sets where its children's
+ * marches (an inner node) or its regions below the leaf (a leaf) start, which step on from there
+ * anyway: closing in on it further only adds steps (100K scaling scene: 4,304 -> 4,129 evaluations,
+ * 10K 5,860 -> 5,801, 1K 8,662 -> 8,638). */
+#define MARCH_TOL 1e-3
+#define MARCH_TOL_INNER_ORDERED 0.02
+#define MARCH_TOL_LEAF_ORDERED 0.1
 #define SEG_MARCHING 0x80000000u /* a node being marched: `key` is the time of its next evaluation */
 #define SEG_REGION 0x40000000u /* a region below a leaf (sub_triangle): `sub` names it */
 
@@ -304,13 +312,13 @@ static double field(trav* tr, scc_vec3 x)
 enum { MARCH_CLEAR, MARCH_STALLED, MARCH_PAUSED };
 
 /* Marches node i's padded sphere along the chord of segment s from time *io_t (after *io_steps
- * evaluations of this march) towards `to`. Returns MARCH_STALLED with the candidate time in *io_t,
+ * evaluations of this march) towards `to`, stalling at a clearance below rel_tol times its radius. Returns MARCH_STALLED with the candidate time in *io_t,
  * MARCH_CLEAR when the sphere stays clear up to `to`, or MARCH_PAUSED when its next evaluation
  * would be later than `pause` (the earliest other item of the queue): the march goes on from *io_t
  * when the queue reaches it. So every evaluation is made in time order across the whole queue, and
  * none is spent after a contact found meanwhile (ours; the 100K scaling scene: 410 of 1,227 march
  * evaluations were later than the search's final end). */
-static int march(trav* tr, uint32_t i, uint32_t s, double to, double pause, double* io_t, uint32_t* io_steps)
+static int march(trav* tr, uint32_t i, uint32_t s, double to, double pause, double rel_tol, double* io_t, uint32_t* io_steps)
 {
     const segment* sg = &tr->seg[s];
     if (*io_steps == 0) {
@@ -325,7 +333,7 @@ static int march(trav* tr, uint32_t i, uint32_t s, double to, double pause, doub
     pad = fmax(pad, centre_accel_bound(tr, i) * span * span * 0.125);
     double R = node_radius(tr, i) + pad;
     R += 1e-12 * (1.0 + R);
-    double tol = 1e-3 * R + 1e-9;
+    double tol = rel_tol * R + 1e-9;
     scc_vec3 D = scc_sub(B, A);
     double len = scc_len(D);
     double t = *io_t;
@@ -622,8 +630,10 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
         if (it.key > te) break;
         uint32_t s = it.seg & ~(SEG_MARCHING | SEG_REGION);
         if (it.seg & SEG_MARCHING) {
-            const double pause = ordered && it.key > mm->t0 && heap.n ? heap.a[0].key : INFINITY;
-            const int r = march(&tr, it.node, s, fmin(seg[s].tb, te), pause, &it.key, &it.sub);
+            const int ord = ordered && it.key > mm->t0;
+            const double pause = ord && heap.n ? heap.a[0].key : INFINITY;
+            const double rel_tol = !ord ? MARCH_TOL : bsh->nodes[it.node].is_leaf ? MARCH_TOL_LEAF_ORDERED : MARCH_TOL_INNER_ORDERED;
+            const int r = march(&tr, it.node, s, fmin(seg[s].tb, te), pause, rel_tol, &it.key, &it.sub);
             if (r == MARCH_STALLED) it.seg = s, it.sub = 0; /* a candidate at it.key */
             if (r != MARCH_CLEAR) ok = item_heap_push(&heap, it);
             continue;
@@ -672,7 +682,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
         for (uint32_t k = 0; k < 2 && ok; ++k) {
             item c = { it.key, n->first + k, s | SEG_MARCHING, 0, 0 };
             if (later) { ok = item_heap_push(&heap, c); continue; }
-            if (march(&tr, c.node, s, fmin(seg[s].tb, te), INFINITY, &c.key, &c.sub) != MARCH_STALLED) continue;
+            if (march(&tr, c.node, s, fmin(seg[s].tb, te), INFINITY, MARCH_TOL, &c.key, &c.sub) != MARCH_STALLED) continue;
             c.seg = s;
             c.sub = 0;
             ok = item_heap_push(&heap, c);
