@@ -485,8 +485,9 @@ START_TEST(test_never_culls)
     ck_assert_msg(st.tri_hits == 5746, "%d triangle hits by the certified TOI (5746 at the seed)", st.tri_hits);
     ck_assert_int_eq(st.culled_hits, 0);
     ck_assert_int_eq(st.ordered_missed, 0);
-    /* 24,882 before the ordered marching and the regions' shorter steps (bsh.c), 21,012 with them */
-    ck_assert_msg(st.ordered_evals <= 21012, "the ordered traversals spent %lld evaluations (21,012 measured)", st.ordered_evals);
+    /* 24,882 before the ordered marching, the regions' shorter steps and the looser stalls (bsh.c),
+     * 18,509 with them */
+    ck_assert_msg(st.ordered_evals <= 18509, "the ordered traversals spent %lld evaluations (18,509 measured)", st.ordered_evals);
     ck_assert_int_ge(st.ordered_cases, 50); /* the box and the spike grid: half the cases */
     ck_assert_msg(st.cert_nc <= 22, "the certified method did not converge on %d triangles (measured 22)", st.cert_nc);
     ck_assert_msg(st.narrow_inconsistent <= 2, "%d cases with an inconsistent narrow phase (measured 2)", st.narrow_inconsistent);
