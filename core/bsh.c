@@ -225,6 +225,7 @@ typedef struct trav {
     double lipschitz;
     double w_body2;           /* |w_body|^2 */
     segment* seg;
+    uint32_t nseg;
     scc_bsh_stats* stats;
 } trav;
 
@@ -312,12 +313,13 @@ static double field(trav* tr, scc_vec3 x)
 enum { MARCH_CLEAR, MARCH_STALLED, MARCH_PAUSED };
 
 /* Marches node i's padded sphere along the chord of segment s from time *io_t (after *io_steps
- * evaluations of this march) towards `to`, stalling at a clearance below rel_tol times its radius. Returns MARCH_STALLED with the candidate time in *io_t,
- * MARCH_CLEAR when the sphere stays clear up to `to`, or MARCH_PAUSED when its next evaluation
- * would be later than `pause` (the earliest other item of the queue): the march goes on from *io_t
- * when the queue reaches it. So every evaluation is made in time order across the whole queue, and
- * none is spent after a contact found meanwhile (ours; the 100K scaling scene: 410 of 1,227 march
- * evaluations were later than the search's final end). */
+ * evaluations of this march) towards `to`, stalling at a clearance below rel_tol times its radius.
+ * Returns MARCH_STALLED with the candidate time in *io_t, MARCH_CLEAR when the sphere stays clear
+ * up to `to`, or MARCH_PAUSED when its next evaluation would be later than `pause` (the earliest
+ * other item of the queue): the march goes on from *io_t when the queue reaches it. So every
+ * evaluation is made in time order across the whole queue, and none is spent after a contact found
+ * meanwhile (ours; the 100K scaling scene: 410 of 1,227 march evaluations were later than the
+ * search's final end). */
 static int march(trav* tr, uint32_t i, uint32_t s, double to, double pause, double rel_tol, double* io_t, uint32_t* io_steps)
 {
     const segment* sg = &tr->seg[s];
@@ -375,12 +377,15 @@ static int march(trav* tr, uint32_t i, uint32_t s, double to, double pause, doub
  * below it: a short step costs one evaluation, a split four (100K scaling scene: split below the full
  * radius 5,064 evaluations, below a quarter of it 4,696; 10K 7,213 -> 5,895, 1K 9,571 -> 8,662). */
 #define REGION_STEP_MIN 0.25
+/* A region's centroid is interpolated (region_step) where that pads its radius by at most this fraction. */
+#define REGION_CHORD_PAD 0.05
 
 /* A triangle bounded below its leaf: its motion and speed bound, taken once for all its regions.
  * The same records list every triangle marked in `tested`, so the traversal can clear only those. */
 typedef struct below_tri {
     scc_tri_motion m;
     double speed;
+    double accel; /* a bound on the acceleration of its points (scc_tri_accel_bound) */
     uint32_t triangle;
 } below_tri;
 
@@ -429,10 +434,27 @@ static int region_step(trav* tr, const below_tri* bt, item* it, item kids[4], in
     double rad = 0.0;
     if (mp->kind == SCC_TRI_RIGID) {
         /* a rigid motion keeps distances: the radius from the body-frame corners, only the centroid posed */
-        const double bc[3] = { cu, cv, 1.0 - cu - cv };
-        c = scc_tri_point_at(mp, bc, it->key, NULL);
         const scc_vec3 lc = bary_point(mp->local, cu, cv);
         for (int i = 0; i < 3; ++i) rad = fmax(rad, scc_dist(bary_point(mp->local, u[i], v[i]), lc));
+        uint32_t s = it->seg & ~SEG_REGION;
+        while (s + 1 < tr->nseg && it->key > tr->seg[s].tb) ++s;
+        const segment* sg = tr->nseg ? &tr->seg[s] : NULL;
+        const double span = sg ? sg->tb - sg->ta : 0.0;
+        const double pad = bt->accel * span * span * 0.125;
+        if (sg && !mp->sdf && pad <= REGION_CHORD_PAD * rad) {
+            /* On a static field, where it costs little, the centroid is taken on the chord of the
+             * segment holding the time (its poses at both ends are at hand) rather than posed: the
+             * chord is within accel T^2 / 8 of the path (as a node's centre, march), accel bounding
+             * the acceleration of every point of the triangle. */
+            it->seg = s | SEG_REGION;
+            const scc_vec3 A = scc_add(scc_quat_rotate(sg->q[0], lc), sg->p[0]);
+            const scc_vec3 B = scc_add(scc_quat_rotate(sg->q[2], lc), sg->p[2]);
+            c = scc_lerp(A, B, span > 0.0 ? (it->key - sg->ta) / span : 0.0);
+            rad += pad + 1e-12 * (1.0 + scc_len(c)); /* the poses' rounding */
+        } else {
+            const double bc[3] = { cu, cv, 1.0 - cu - cv };
+            c = scc_tri_point_at(mp, bc, it->key, NULL);
+        }
     } else {
         scc_tri_state st;
         scc_tri_state_at(mp, it->key, &st);
@@ -478,10 +500,11 @@ static below_tri* below_add(below_list* L, scc_workspace* ws, const scc_mesh_mot
     }
     below_tri* b = &L->a[L->n++];
     b->triangle = triangle;
-    b->speed = 0.0;
+    b->speed = b->accel = 0.0;
     if (with_motion) {
         scc_mesh_triangle_motion(mm, triangle, &b->m);
         b->speed = scc_tri_speed_bound(&b->m);
+        b->accel = scc_tri_accel_bound(&b->m);
     }
     return b;
 }
@@ -547,6 +570,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
     tr.w_body2 = mm->body && !moving ? scc_len2(mm->body->w) : 0.0;
     tr.stats = stats;
     tr.seg = NULL;
+    tr.nseg = 0;
     if (p->method == SCC_METHOD_DCD) return traverse_static(&tr, t_end, visit, user);
 
     /* Segments: no more than min(pi, max_rotation) of relative rotation each. */
@@ -594,6 +618,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
     int ok = seg && tested;
     if (ok) {
         tr.seg = seg;
+        tr.nseg = nseg;
         for (uint32_t s = 0; s < nseg; ++s) {
             segment* sg = &seg[s];
             sg->ta = mm->t0 + (t_end - mm->t0) * s / nseg;
