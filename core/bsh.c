@@ -373,6 +373,8 @@ static int march(trav* tr, uint32_t i, uint32_t s, double to, double pause, doub
  * before the regions, 332,550 with them for these, 295,055 without). */
 #define REGION_MAX_DEPTH 5
 #define REGION_MAX_EVALS 48
+/* a triangle's region count lives in 7 bits beside its mark; 127 with the mark would read as "searched" */
+_Static_assert(REGION_MAX_EVALS < 127, "REGION_MAX_EVALS must stay below 127");
 /* A region advances while its clearance is at least this fraction of its radius, and is split only
  * below it: a short step costs one evaluation, a split four (100K scaling scene: split below the full
  * radius 5,064 evaluations, below a quarter of it 4,696; 10K 7,213 -> 5,895, 1K 9,571 -> 8,662). */
