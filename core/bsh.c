@@ -193,8 +193,8 @@ void scc_bsh_refit_linear(const scc_bsh* bsh, const scc_mesh* mesh, const scc_ve
 /* A march stalls where the sphere's clearance is below this fraction of its radius (plus 1 nm). In
  * the ordered search (scc_bsh_traverse) a node's candidate time only sets where its children's
  * marches (an inner node) or its regions below the leaf (a leaf) start, which step on from there
- * anyway: closing in on it further only adds steps (100K scaling scene: 4,304 -> 4,129 evaluations,
- * 10K 5,860 -> 5,801, 1K 8,662 -> 8,638). */
+ * anyway: closing in on it further only adds steps (100K scaling scene: 4,304 -> 4,133 evaluations,
+ * 10K 5,860 -> 5,800, 1K 8,662 -> 8,638). */
 #define MARCH_TOL 1e-3
 #define MARCH_TOL_INNER_ORDERED 0.02
 #define MARCH_TOL_LEAF_ORDERED 0.1
@@ -225,7 +225,7 @@ typedef struct trav {
     double lipschitz;
     double w_body2;           /* |w_body|^2 */
     segment* seg;
-    uint32_t nseg;
+    uint32_t nseg;            /* 0 until the segments are laid out */
     scc_bsh_stats* stats;
 } trav;
 
