@@ -96,28 +96,39 @@ static inline void scc_sincos_series(double d2, double* out_sd, double* out_cd)
  * d the rotation since base_t (mid-interval, |d| <= pi/2 in a segment of at most half a turn): sin d
  * and cos d by their Taylor series, whose first omitted terms are below 2e-18 for |d| <= 1.6, then
  * the angle-sum formulas; cheaper than a libm sincos per time evaluated. Larger |d|: libm. */
-static inline void scc_fw_angle_at(scc_fw_state* s, double t)
+static inline void scc_fw_angle_cs(const scc_fw_state* s, double t, double* out_c, double* out_s)
 {
     double d = s->wlen * (t - s->base_t);
     if (fabs(d) <= 1.6) {
         double d2 = d * d, sd, cd;
         scc_sincos_series(d2, &sd, &cd);
         sd *= d;
-        s->cache_c = s->base_c * cd - s->base_s * sd;
-        s->cache_s = s->base_s * cd + s->base_c * sd;
+        *out_c = s->base_c * cd - s->base_s * sd;
+        *out_s = s->base_s * cd + s->base_c * sd;
     } else {
         double a = s->wlen * (t - s->t0);
-        s->cache_c = cos(a);
-        s->cache_s = sin(a);
+        *out_c = cos(a);
+        *out_s = sin(a);
     }
+}
+
+/* The same into the cache. */
+static inline void scc_fw_angle_at(scc_fw_state* s, double t)
+{
+    scc_fw_angle_cs(s, t, &s->cache_c, &s->cache_s);
     s->cache_t = t;
+}
+
+/* Rodrigues' formula with the rotation's cosine c and sine sn. */
+static inline scc_vec3 scc_fw_rodrigues_cs(const scc_fw_state* s, scc_vec3 r, scc_vec3 kr, double kd, double c, double sn)
+{
+    return scc_add(scc_add(scc_scale(r, c), scc_scale(kr, sn)), scc_scale(s->axis, kd * (1.0 - c)));
 }
 
 /* Rodrigues' formula with the cached cosine and sine. */
 static inline scc_vec3 scc_fw_rodrigues(const scc_fw_state* s, scc_vec3 r, scc_vec3 kr, double kd)
 {
-    double c = s->cache_c, sn = s->cache_s;
-    return scc_add(scc_add(scc_scale(r, c), scc_scale(kr, sn)), scc_scale(s->axis, kd * (1.0 - c)));
+    return scc_fw_rodrigues_cs(s, r, kr, kd, s->cache_c, s->cache_s);
 }
 
 /* Offset R(w tau) r at time t by Rodrigues' formula, with kr = axis x r and kd = axis . r given
@@ -173,6 +184,24 @@ static inline scc_vec3 scc_fw_path_point(scc_fw_state* s, const scc_fw_path* pat
     if (path->motion == 2) { /* the common case first */
         scc_fw_angle_at(s, t);
         rr = scc_fw_rodrigues(s, path->r, path->kr, path->kd);
+    } else if (path->motion == 1) {
+        rr = path->r;
+    } else {
+        return scc_tri_point_at(s->m, path->b, t, NULL);
+    }
+    return scc_add(scc_madd(s->g0, s->v, t - s->t0), rr);
+}
+
+/* scc_fw_path_point without the rotation cache (the same bits): nothing is stored, so the samples
+ * of several paths at different times do not depend on each other through the state (the vertex
+ * traces run side by side, fwgss.c). */
+static inline scc_vec3 scc_fw_path_point_pure(const scc_fw_state* s, const scc_fw_path* path, double t)
+{
+    scc_vec3 rr;
+    if (path->motion == 2) {
+        double c, sn;
+        scc_fw_angle_cs(s, t, &c, &sn);
+        rr = scc_fw_rodrigues_cs(s, path->r, path->kr, path->kd, c, sn);
     } else if (path->motion == 1) {
         rr = path->r;
     } else {

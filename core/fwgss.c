@@ -322,13 +322,17 @@ static void refine_entry(scc_fw_state* s, const scc_fw_path* path, double lo, do
     }
 }
 
-/* Conservative advancement of one vertex path (ours): with |grad phi| <= L and the vertex's speed
- * <= S, phi cannot reach the margin sooner than (phi - margin) / (L S), so stepping by that never
- * skips a crossing (steps are at least the time tolerance). Stops at the first witness (which
- * shrinks te), at te, or after `cap` steps. With a shared record (a mesh query's vertex, motion.h)
- * the part of the path traced for an earlier triangle is not traced again: its witness is reused,
- * a clear stretch is skipped, and the new steps extend the record. */
-static void trace_vertex(scc_fw_state* s, int i, int cap)
+/* One vertex path's conservative advancement (trace_vertices). */
+typedef struct trace_lane {
+    scc_vertex_trace* r; /* shared record, or NULL */
+    scc_fw_path path;
+    double t, start, t_prev, f_prev, clear_to, speed, ls;
+    int k;               /* samples taken */
+} trace_lane;
+
+/* Sets up vertex i's trace: reuses its record's witness or skips its clear stretch. Returns 0 when
+ * there is nothing to trace. */
+static int trace_begin(scc_fw_state* s, int i, trace_lane* L)
 {
     const double b[3] = { i == 0, i == 1, i == 2 };
     scc_vertex_trace* r = s->m->trace[i];
@@ -339,49 +343,113 @@ static void trace_vertex(scc_fw_state* s, int i, int cap)
         speed = r->speed;
         if (r->hit_t >= s->ts && r->hit_t <= s->te) {
             scc_fw_witness(s, r->hit_t, b, r->hit_phi);
-            return;
+            return 0;
         }
         if (r->from <= t && t < r->to) t = r->to;
     } else {
         speed = scc_vertex_speed_bound(s->m, i);
     }
-    if (!(speed > 0.0)) return;
-    const double start = t;
-    double t_prev = t, f_prev = INFINITY, clear_to = t;
-    scc_fw_path path;
-    scc_fw_path_init(s, b, &path);
+    if (!(speed > 0.0)) return 0;
+    L->r = r;
+    scc_fw_path_init(s, b, &L->path);
+    L->t = L->start = L->t_prev = L->clear_to = t;
+    L->f_prev = INFINITY;
+    L->speed = speed;
     /* L x S of the step's bound, once per trace when the field has one global bound (the same product) */
-    const int local_bound = s->sdf->lipschitz_in != NULL;
-    const double ls = local_bound ? NAN : step_lipschitz(s, s->g0, 0.0) * speed;
-    const int64_t max_evals = s->p->max_evals;
-    const double time_tol = s->p->time_tol;
-    for (int k = 0; k < cap && t < s->te && s->evals < max_evals; ++k) {
-        scc_vec3 x = scc_fw_path_point(s, &path, t);
-        double phi = scc_fw_sdf(s, x, NULL);
-        s->evals++;
-        if (phi <= s->margin) {
-            if (k > 0) refine_entry(s, &path, t_prev, f_prev, &t, &phi);
-            scc_fw_witness(s, t, b, phi);
-            if (r && t < r->hit_t) { r->hit_t = t; r->hit_phi = phi; }
-            clear_to = t_prev;
-            break;
-        }
-        t_prev = t;
-        f_prev = phi - s->margin;
-        double step = (phi - s->margin) / (local_bound ? step_lipschitz(s, x, phi) * speed : ls);
-        /* Near the surface the steps shrink geometrically; a step of the time tolerance can then
-         * pass a crossing by at most that tolerance. */
-        t += scc_fmax(step, time_tol);
-        clear_to = t;
-    }
+    L->ls = s->sdf->lipschitz_in ? NAN : step_lipschitz(s, s->g0, 0.0) * speed;
+    L->k = 0;
+    return 1;
+}
+
+/* Vertex trace L has ended: [start, clear_to) is clear, merged with the recorded stretch when they
+ * touch, else the longer one is kept. */
+static void trace_end(const trace_lane* L)
+{
+    scc_vertex_trace* r = L->r;
+    const double start = L->start, clear_to = L->clear_to;
     if (!r || !(clear_to > start)) return;
-    /* [start, clear_to) is clear now: merge it with the recorded stretch when they touch, else
-     * keep the longer one */
     if (!(r->to > r->from) || start > r->to || clear_to < r->from) {
         if (!(r->to > r->from) || clear_to - start > r->to - r->from) { r->from = start; r->to = clear_to; }
     } else {
         r->from = scc_fmin(r->from, start);
         r->to = scc_fmax(r->to, clear_to);
+    }
+}
+
+/* Conservative advancement of the three vertex paths (ours): with |grad phi| <= L and a vertex's
+ * speed <= S, phi cannot reach the margin sooner than (phi - margin) / (L S), so stepping by that
+ * never skips a crossing (steps are at least the time tolerance). A trace stops at its first
+ * witness, at te (the earliest witness so far), or after `cap` samples. The three traces advance
+ * together in time, in rounds: the trace furthest behind (the laggard) and any within its last
+ * step of it take one sample each. So a trace does not run far past a contact another trace is
+ * about to find (one after the other, the first trace ran to its own contact or to the end of the
+ * interval), and the samples of one round, not depending on each other, overlap in the processor
+ * (each trace alone is a chain: the next time needs phi at this one). With a shared record (a
+ * mesh query's vertex, motion.h) the part of the path traced for an earlier triangle is not
+ * traced again: its witness is reused, a clear stretch is skipped, and the new samples extend the
+ * record. Every sample is counted and used. */
+static void trace_vertices(scc_fw_state* s, int cap)
+{
+    trace_lane lanes[3];
+    int live[3], n = 0;
+    for (int i = 0; i < 3; ++i)
+        if (trace_begin(s, i, &lanes[n])) live[n++] = i; /* live[j]: the vertex of lanes[j] */
+    const int local_bound = s->sdf->lipschitz_in != NULL;
+    const int64_t max_evals = s->p->max_evals;
+    const double time_tol = s->p->time_tol;
+    const double margin = s->margin;
+    while (n > 0) {
+        /* the traces that go on (te as it stands at the round's start); the others end */
+        int m = 0;
+        for (int j = 0; j < n; ++j) {
+            if (lanes[j].k < cap && lanes[j].t < s->te && s->evals < max_evals) {
+                if (m != j) { lanes[m] = lanes[j]; live[m] = live[j]; }
+                ++m;
+            } else {
+                trace_end(&lanes[j]);
+            }
+        }
+        n = m;
+        if (n == 0) break;
+        /* The traces within one step (the laggard's last) of the laggard's time go this round: a trace
+         * far ahead waits, so that it does not sample past a contact the laggard is about to find. */
+        double tmin = INFINITY, gate = INFINITY;
+        for (int j = 0; j < n; ++j)
+            if (lanes[j].t < tmin) { tmin = lanes[j].t; gate = lanes[j].t + (lanes[j].t - lanes[j].t_prev); }
+        int sel[3], go = 0;
+        for (int j = 0; j < n; ++j)
+            if (lanes[j].t <= gate && s->evals + go < max_evals) sel[go++] = j;
+        scc_vec3 x[3];
+        double phi[3];
+        for (int q = 0; q < go; ++q) x[q] = scc_fw_path_point_pure(s, &lanes[sel[q]].path, lanes[sel[q]].t);
+        for (int q = 0; q < go; ++q) phi[q] = scc_fw_sdf(s, x[q], NULL);
+        s->evals += go;
+        for (int q = 0; q < go; ++q) {
+            const int j = sel[q];
+            trace_lane* L = &lanes[j];
+            double t = L->t, f = phi[q];
+            if (f <= margin) {
+                const int first = L->k == 0;
+                L->clear_to = L->t_prev;
+                L->k = cap; /* ended: recorded at the next round */
+                /* An entry after the earliest witness (found this round by a trace before this one)
+                 * is not refined: it cannot move te. */
+                if (!first && !(L->t_prev < s->te)) continue;
+                const double b[3] = { live[j] == 0, live[j] == 1, live[j] == 2 };
+                if (!first) refine_entry(s, &L->path, L->t_prev, L->f_prev, &t, &f);
+                scc_fw_witness(s, t, b, f);
+                if (L->r && t < L->r->hit_t) { L->r->hit_t = t; L->r->hit_phi = f; }
+                continue;
+            }
+            L->k++;
+            L->t_prev = t;
+            L->f_prev = f - margin;
+            const double step = (f - margin) / (local_bound ? step_lipschitz(s, x[q], f) * L->speed : L->ls);
+            /* Near the surface the steps shrink geometrically; a step of the time tolerance can
+             * then pass a crossing by at most that tolerance. */
+            L->t = t + scc_fmax(step, time_tol);
+            L->clear_to = L->t;
+        }
     }
 }
 
@@ -582,8 +650,7 @@ void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb
     s.time_slope = p->fwgss_gap_tol > 0.0 ? scc_fmax(sdf->lipschitz, 1.0) * speed / p->fwgss_gap_tol : 0.0;
     /* The vertex paths first: in a mesh query their traces are shared with the neighbouring
      * triangles, and a contact found there rules the proof below out. */
-    if (p->fwgss_vertex_trace > 0)
-        for (int i = 0; i < 3; ++i) trace_vertex(&s, i, p->fwgss_vertex_trace);
+    if (p->fwgss_vertex_trace > 0) trace_vertices(&s, p->fwgss_vertex_trace);
     /* Most triangles the broad phase hands over pass close to the field without touching it; a
      * short proof of that skips the descents. */
     if (!s.hit && p->fwgss_clear_budget > 0 && speed > 0.0 && prove_clear(&s, s.ts, s.te, speed, p->fwgss_clear_budget)) {

@@ -354,6 +354,36 @@ START_TEST(test_mesh_query_earliest)
 }
 END_TEST
 
+/* The vertex traces advance together in time (fwgss.c trace_vertices): a vertex that stays clear
+ * (here sweeping fast over the plane, so its conservative steps are short) stops its trace where
+ * another vertex touches, whichever vertex is listed first. Traced one after the other, the
+ * triangle listed with the sweeping vertex first cost its whole trace (130 evaluations instead of
+ * 110 with the touching vertex first). */
+START_TEST(test_vertex_traces_in_time)
+{
+    sdfccd_SdfId plane;
+    ck_assert_int_eq(sdfccd_create_half_space((sdfccd_Vec3){ 0, 0, 1 }, 0.0, &plane), SDFCCD_OK);
+    /* a touches at 0.005 / 0.6 s; b and c stay above the plane (b ends the step 1 mm above it) */
+    const sdfccd_Vec3 a = { 0.0, 0.0, 0.005 }, b = { 0.1, 0.0, 0.011 }, c = { 0.0, 0.1, 0.02 };
+    const sdfccd_Vec3 orders[3][3] = { { a, b, c }, { b, c, a }, { c, a, b } };
+    sdfccd_RigidMotion m = translating((sdfccd_Vec3){ 0.0, 0.0, -0.6 });
+    m.angular_velocity = (sdfccd_Vec3){ 0.0, 0.0, 100.0 }; /* about a vertical axis through a */
+    sdfccd_QueryParams p = params_for(SDFCCD_METHOD_FWGSS);
+    p.subdivision = 0;
+    int64_t evals[3];
+    for (int k = 0; k < 3; ++k) {
+        sdfccd_QueryResult r;
+        ck_assert_int_eq(sdfccd_query_triangle(plane, NULL, orders[k], &m, 0.0, DT, &p, NULL, 0, &r), SDFCCD_OK);
+        ck_assert(r.hit);
+        ck_assert_double_near(r.toi, 0.005 / 0.6, 1e-9);
+        evals[k] = r.sdf_evaluations;
+    }
+    for (int k = 1; k < 3; ++k)
+        ck_assert_msg(evals[k] <= evals[0], "order %d: %lld evaluations, touching vertex first: %lld", k, (long long)evals[k], (long long)evals[0]);
+    sdfccd_destroy_sdf(plane);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("ccd");
@@ -368,6 +398,7 @@ int main(void)
     tcase_add_test(tc, test_linear_vertices);
     tcase_add_test(tc, test_no_hit_and_penetrating);
     tcase_add_test(tc, test_mesh_query_earliest);
+    tcase_add_test(tc, test_vertex_traces_in_time);
     suite_add_tcase(s, tc);
     TCase* fail = tcase_create("failure_scenes");
     test_add_memory_fixture(fail);
