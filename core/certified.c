@@ -15,7 +15,8 @@
  * popped region's own ta closes the bracket exactly. No false negatives
  * as long as L is a true Lipschitz bound (1 for the analytic fields). When phi is convex (the
  * distance of a convex shape) the first-order bound phi(x) >= phi(c) + grad(c).(x - c) prunes
- * tangential contacts far sooner than the Lipschitz ball. */
+ * tangential contacts far sooner than the Lipschitz ball, and where phi is convex on the region's box
+ * the support planes at its corners as well (planes_bound: they close over a cone's tip). */
 #include "ccd.h"
 #include "min_heap.h"
 #include "sdf_analytic.h"
@@ -41,9 +42,11 @@ SCC_MIN_HEAP(region_heap, region, ta)
  * its active operand, so it bends as that one (the one whose gradient scc_sdf_eval gives); a min,
  * only where one operand decides the whole ball. So a cube minus a ball bends by 1 / |x| where the
  * ball's inside decides, and sliding along the carved sphere costs only that curvature term. */
-static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals)
+static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals);
+
+/* bend_bound where sign * phi is not known to be convex on the box */
+static double bend_bound_nonconvex(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals)
 {
-    if (sdf->kind == SCC_SDF_HALF_SPACE || (sign > 0 && scc_sdf_convex_in(sdf, box))) return 0.0;
     if (sign < 0 && sdf->convex) {
         double inflate;
         switch (sdf->kind) {
@@ -70,6 +73,18 @@ static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_
     if (va + ra < vb - rb) return bend_bound(s->a, sa, box, c, rad, va, evals);
     if (vb + rb < va - ra) return bend_bound(s->b, sb, box, c, rad, vb, evals);
     return INFINITY;
+}
+
+/* Whether phi is convex on the box (a half-space, or the field says so) */
+static int convex_on(const scc_sdf* sdf, const scc_aabb* box)
+{
+    return sdf->kind == SCC_SDF_HALF_SPACE || scc_sdf_convex_in(sdf, box);
+}
+
+static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals)
+{
+    if (sdf->kind == SCC_SDF_HALF_SPACE || (sign > 0 && scc_sdf_convex_in(sdf, box))) return 0.0;
+    return bend_bound_nonconvex(sdf, sign, box, c, rad, v, evals);
 }
 
 double scc_sdf_bend_bound(const scc_sdf* sdf, scc_vec3 c, double rad)
@@ -224,6 +239,125 @@ static first_order first_order_terms(const scc_tri_state* st, const region* r, s
     }
     f.curve = scc_len(gc) * 0.5 * accel * dt * dt;
     return f;
+}
+
+/* The search's samples by (time, weights) (ours): a region split in time keeps its start's samples, the
+ * first half's samples at its end are the second half's at its start, and neighbouring sub-triangles
+ * share corners; a point computed from the same time and weights is the same point, so its value is
+ * looked up instead of evaluated again (direct-mapped; a collision only costs an evaluation). */
+#define SAMPLE_CACHE 128
+typedef struct sample_slot {
+    uint64_t key[3]; /* the bits of t, u, v (t NaN: empty) */
+    double phi;
+    scc_vec3 g;
+} sample_slot;
+typedef struct sample_cache {
+    sample_slot s[SAMPLE_CACHE];
+} sample_cache;
+
+static uint64_t bits_of(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+/* phi and its gradient at weights (u, v, 1 - u - v) of the triangle in state st (time t). */
+static double sample_at(sample_cache* sc, const scc_sdf* sdf, const scc_tri_state* st, double t, double u, double v, scc_vec3* g,
+                        int64_t* evals)
+{
+    const uint64_t k0 = bits_of(t), k1 = bits_of(u), k2 = bits_of(v);
+    const uint64_t hash = (k0 * 0x9E3779B97F4A7C15ull) ^ (k1 * 0xC2B2AE3D27D4EB4Full) ^ (k2 * 0x165667B19E3779F9ull);
+    sample_slot* e = &sc->s[(hash ^ (hash >> 29)) % SAMPLE_CACHE];
+    if (e->key[0] == k0 && e->key[1] == k1 && e->key[2] == k2) {
+        *g = e->g;
+        return e->phi;
+    }
+    ++*evals;
+    e->phi = scc_sdf_eval(sdf, corner(st, u, v), &e->g);
+    e->key[0] = k0;
+    e->key[1] = k1;
+    e->key[2] = k2;
+    *g = e->g;
+    return e->phi;
+}
+
+/* The support-plane bound of a convex phi over a region (ours, issue 20 item 6): with samples y_j of
+ * the region (value f_j, gradient g_j) every plane f_j + g_j.(x - y_j) lies below phi on a box where
+ * phi is convex, so phi >= max_j of them. Over the region (weights b on its corners, s in [0, dt]) each
+ * plane is at least k_j + sum_i b_i d_ji, with d_ji the smaller of its value at corner i at s = 0 and
+ * s = dt and k_j less the motion's curvature (first_order_terms); the bound is the smallest over the
+ * corners' simplex of the largest of these affine functions, attained at a vertex of their
+ * arrangement: a corner, where two cross on an edge, or where three meet inside. Near a kink such as
+ * a cone's tip, planes from around it close over it (a point above the tip at height h: about h^2 /
+ * |y - tip| for each plane, where the centroid's one plane needs regions smaller than h). */
+static double planes_bound(const scc_tri_state* st, const region* r, const scc_vec3* y, const double* f, const scc_vec3* g, int n,
+                           double accel)
+{
+    double k[4], d[4][3], mag = 0.0;
+    const double dt = r->tb - r->ta;
+    scc_vec3 x[3], v[3];
+    for (int i = 0; i < 3; ++i) {
+        x[i] = corner(st, r->u[i], r->v[i]);
+        v[i] = scc_add(scc_add(scc_scale(st->v[0], r->u[i]), scc_scale(st->v[1], r->v[i])), scc_scale(st->v[2], 1.0 - r->u[i] - r->v[i]));
+    }
+    for (int j = 0; j < n; ++j) {
+        const double gl = scc_len(g[j]);
+        k[j] = f[j] - gl * 0.5 * accel * dt * dt;
+        for (int i = 0; i < 3; ++i) {
+            const double a = scc_dot(g[j], scc_sub(x[i], y[j])), b = a + dt * scc_dot(g[j], v[i]);
+            d[j][i] = fmin(a, b);
+            mag = fmax(mag, fabs(f[j]) + gl * (scc_dist(x[i], y[j]) + dt * scc_len(v[i])));
+        }
+    }
+#define PLANES_MAX(B0, B1, B2, OUT)                                          \
+    do {                                                                     \
+        double m_ = -INFINITY;                                               \
+        for (int j_ = 0; j_ < n; ++j_)                                       \
+            m_ = fmax(m_, k[j_] + (B0) * d[j_][0] + (B1) * d[j_][1] + (B2) * d[j_][2]); \
+        OUT = m_;                                                            \
+    } while (0)
+    double best = INFINITY, val;
+    for (int i = 0; i < 3; ++i) { /* the corners */
+        PLANES_MAX(i == 0, i == 1, i == 2, val);
+        best = fmin(best, val);
+    }
+    for (int i = 0; i < 3; ++i) { /* the edges from corner i to corner i + 1: lam in (0, 1) where two planes cross */
+        const int e = (i + 1) % 3;
+        for (int j = 0; j < n; ++j)
+            for (int l = j + 1; l < n; ++l) {
+                const double a0 = k[j] + d[j][i] - k[l] - d[l][i], slope = (d[j][e] - d[j][i]) - (d[l][e] - d[l][i]);
+                if (slope == 0.0) continue;
+                const double lam = -a0 / slope;
+                if (!(lam > 0.0 && lam < 1.0)) continue;
+                double b[3] = { 0, 0, 0 };
+                b[i] = 1.0 - lam;
+                b[e] = lam;
+                PLANES_MAX(b[0], b[1], b[2], val);
+                best = fmin(best, val);
+            }
+    }
+    for (int j = 0; j < n; ++j) /* inside: where three planes meet (b2 = 1 - b0 - b1) */
+        for (int l = j + 1; l < n; ++l)
+            for (int q = l + 1; q < n; ++q) {
+                const int p2[2] = { l, q };
+                double A[2][2], rhs[2];
+                for (int s = 0; s < 2; ++s) {
+                    const int o = p2[s];
+                    A[s][0] = (d[j][0] - d[j][2]) - (d[o][0] - d[o][2]);
+                    A[s][1] = (d[j][1] - d[j][2]) - (d[o][1] - d[o][2]);
+                    rhs[s] = (k[o] + d[o][2]) - (k[j] + d[j][2]);
+                }
+                const double det = A[0][0] * A[1][1] - A[0][1] * A[1][0];
+                if (det == 0.0) continue;
+                const double b0 = (rhs[0] * A[1][1] - A[0][1] * rhs[1]) / det, b1 = (A[0][0] * rhs[1] - rhs[0] * A[1][0]) / det;
+                if (!(b0 > 0.0 && b1 > 0.0 && b0 + b1 < 1.0)) continue;
+                PLANES_MAX(b0, b1, 1.0 - b0 - b1, val);
+                best = fmin(best, val);
+            }
+#undef PLANES_MAX
+    /* the arrangement's vertices are computed with rounding: less a margin relative to the sizes */
+    return best - (1e-12 * mag + 1e-15);
 }
 
 /* The cached polynomial of full-grid cell ijk (hess < 0: no values there). */
@@ -421,6 +555,8 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
     if (isfinite(seed_t))
         for (int j = 0; j < 3; ++j) hit_b[j] = seed_b[j];
     int64_t processed = 0, evals = 0;
+    sample_cache cache;
+    for (int i = 0; i < SAMPLE_CACHE; ++i) cache.s[i].key[0] = bits_of(NAN);
     int clipped = 0; /* a region was cut at seed_t - seed_tol: nothing is proven after that */
     while (h.n) {
         region r = region_heap_pop(&h);
@@ -442,8 +578,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         double cu = (r.u[0] + r.u[1] + r.u[2]) / 3.0, cv = (r.v[0] + r.v[1] + r.v[2]) / 3.0;
         scc_vec3 c = corner(&st, cu, cv);
         scc_vec3 gc;
-        double phi = scc_sdf_eval(sdf, c, &gc);
-        ++evals;
+        double phi = sample_at(&cache, sdf, &st, r.ta, cu, cv, &gc, &evals);
         if (phi <= p->margin && r.ta < hi) {
             hi = r.ta;
             hit_b[0] = cu; hit_b[1] = cv; hit_b[2] = 1.0 - cu - cv;
@@ -460,7 +595,9 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         /* Which part of the bound's slack to refine: the Lipschitz ball's spatial and temporal
          * radii, or, for a convex phi, the spatial and temporal parts of the first-order bound. */
         double slack_space = rs, slack_time = rt;
-        const double bend = grid ? INFINITY : bend_bound(sdf, 1, &box, c, rho, phi, &evals);
+        int done = 0, corners_done = 0;
+        const int convex = !grid && convex_on(sdf, &box);
+        const double bend = grid ? INFINITY : convex ? 0.0 : bend_bound_nonconvex(sdf, 1, &box, c, rho, phi, &evals);
         if (bend < INFINITY) {
             /* First-order bound of a convex phi, less the bending term: phi(x) >= phi(c) + g.(x - c)
              * - K rho^2 / 2 (first_order_terms, bend_bound). Tangential sliding costs only K. */
@@ -468,6 +605,25 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             const double curv = 0.5 * bend * rho * rho;
             const double bound = phi + f.lin - f.curve - curv;
             if (bound > p->margin) continue;
+            if (convex) {
+                /* phi convex on the box (not only its active CSG operand): the corners at ta, which
+                 * are witness samples too, give support planes (planes_bound) */
+                scc_vec3 y[4], gy[4];
+                double fy[4];
+                y[0] = c; fy[0] = phi; gy[0] = gc;
+                for (int i = 0; i < 3 && !done; ++i) {
+                    y[i + 1] = corner(&st, r.u[i], r.v[i]);
+                    fy[i + 1] = sample_at(&cache, sdf, &st, r.ta, r.u[i], r.v[i], &gy[i + 1], &evals);
+                    if (fy[i + 1] <= p->margin) {
+                        hi = lo = r.ta;
+                        hit_b[0] = r.u[i]; hit_b[1] = r.v[i]; hit_b[2] = 1.0 - r.u[i] - r.v[i];
+                        done = 1;
+                    }
+                }
+                if (done) break;
+                corners_done = 1;
+                if (planes_bound(&st, &r, y, fy, gy, 4, accel) > p->margin) continue;
+            }
             if (bound > phi - L * rho) {
                 slack_space = -fmin(f.lin_space, 0.0) + (rho > 0.0 ? curv * rs / rho : 0.0);
                 slack_time = -fmin(f.lin_time, 0.0) + f.curve + (rho > 0.0 ? curv * rt / rho : 0.0);
@@ -486,11 +642,10 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         /* Unresolved: look for witnesses at the corners at ta (a contact there is exact: nothing
          * earlier is unresolved) and at the centroid and corners at tb (an upper bound). Corners
          * matter: at a vertex-first contact the centroid alone stays borderline at every scale. */
-        int done = 0;
         const int sample = !(isfinite(seed_t) && hi == seed_t) || r.depth % WITNESS_EVERY == 0; /* unseeded or past the seed: always */
-        for (int i = 0; i < 3 && !done && sample; ++i) {
-            ++evals;
-            if (scc_sdf_eval(sdf, corner(&st, r.u[i], r.v[i]), NULL) <= p->margin) {
+        for (int i = 0; i < 3 && !done && sample && !corners_done; ++i) {
+            scc_vec3 g;
+            if (sample_at(&cache, sdf, &st, r.ta, r.u[i], r.v[i], &g, &evals) <= p->margin) {
                 hi = lo = r.ta;
                 hit_b[0] = r.u[i]; hit_b[1] = r.v[i]; hit_b[2] = 1.0 - r.u[i] - r.v[i];
                 done = 1;
@@ -502,8 +657,8 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             scc_tri_state_at(m, r.tb, &se);
             double su[4] = { cu, r.u[0], r.u[1], r.u[2] }, sv[4] = { cv, r.v[0], r.v[1], r.v[2] };
             for (int i = 0; i < 4; ++i) {
-                ++evals;
-                if (scc_sdf_eval(sdf, corner(&se, su[i], sv[i]), NULL) <= p->margin) {
+                scc_vec3 g;
+                if (sample_at(&cache, sdf, &se, r.tb, su[i], sv[i], &g, &evals) <= p->margin) {
                     hi = r.tb;
                     hit_b[0] = su[i]; hit_b[1] = sv[i]; hit_b[2] = 1.0 - su[i] - sv[i];
                     break;

@@ -301,6 +301,47 @@ START_TEST(test_precheck_clears)
 }
 END_TEST
 
+/* The support-plane bound of a convex field (certified.c, planes_bound): a face passes 50 um above a
+ * spike's tip (the tip under an off-centre point of the face) and stops 50 um above it. The first-order
+ * bound from a sub-triangle's centroid alone prunes it only once the sub-triangle is about as small as the
+ * gap (some 12 levels of splits here); the planes of its corners close over the tip at every scale. The
+ * certified clear proof must prove the interval clear within the pre-check's 32 evaluations, and the
+ * certified search must agree (no contact), for the tip under each of the face's three corners' sides. */
+START_TEST(test_clear_over_tip)
+{
+    scc_sdf_spike_grid spikes;
+    scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
+    const scc_vec3 tip = scc_v3(0.05, 0.05, 0.1); /* the cone of cell (10, 10) */
+    static const double off[3][3][2] = {
+        { { -0.010, -0.008 }, { 0.012, -0.006 }, { 0.001, 0.011 } },
+        { { -0.004, -0.013 }, { 0.015, 0.002 }, { -0.006, 0.009 } },
+        { { -0.014, 0.001 }, { 0.005, -0.010 }, { 0.007, 0.012 } },
+    };
+    for (int k = 0; k < 3; ++k) {
+        scc_tri_motion m;
+        memset(&m, 0, sizeof m);
+        m.kind = SCC_TRI_LINEAR;
+        m.t0 = 0.0;
+        m.t1 = DT;
+        for (int i = 0; i < 3; ++i) {
+            m.start[i] = scc_v3(tip.x + off[k][i][0], tip.y + off[k][i][1], tip.z + 1e-4);
+            m.end[i] = scc_v3(tip.x + off[k][i][0], tip.y + off[k][i][1], tip.z + 5e-5);
+        }
+        scc_params pf = params_of(SDFCCD_METHOD_FWGSS);
+        scc_tri_hit h;
+        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 1000000, &h));
+        printf("clear over a tip (%d): %lld evaluations, state %d\n", k, (long long)h.evals, (int)h.state);
+        ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "face %d: touches or unproven", k);
+        ck_assert_int_le(h.evals, 32);
+        scc_query_summary c;
+        scc_contact out[1 + SCC_MAX_SUBDIVISION_CONTACTS];
+        scc_params pc = params_of(SDFCCD_METHOD_CERTIFIED);
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &k_alloc, 0, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &c));
+        ck_assert(!c.hit && c.state == SCC_NO_HIT);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("fall");
@@ -310,6 +351,7 @@ int main(void)
     tcase_add_test(tc, test_spike_apex_triangle);
     tcase_add_test(tc, test_deferred_checks);
     tcase_add_test(tc, test_precheck_clears);
+    tcase_add_test(tc, test_clear_over_tip);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }
