@@ -95,15 +95,28 @@ double scc_mesh_speed_bound(const scc_mesh_motion* mm)
     return speed;
 }
 
+/* The records are made usable a page of SCC_TRACE_PAGE at a time, when a triangle first hands one out
+ * (ours): a mark per page after the records says whether its records were set since the marks were
+ * laid out, so a new workspace (scc_query_mesh makes one per call) clears the marks, a byte per page,
+ * instead of every record of a large mesh of which a query tests a few triangles. */
+#define SCC_TRACE_PAGE 16
+
+static uint8_t* trace_pages(scc_vertex_trace* traces, const scc_mesh* mesh)
+{
+    return (uint8_t*)(traces + mesh->vertex_count);
+}
+
 scc_vertex_trace* scc_mesh_traces(scc_workspace* ws, const scc_mesh* mesh)
 {
     /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
-    size_t need = (size_t)mesh->vertex_count * sizeof(scc_vertex_trace);
-    int fresh = ws->slot[SCC_WS_TRACES].bytes < need;
+    const size_t pages = (mesh->vertex_count + SCC_TRACE_PAGE - 1) / SCC_TRACE_PAGE;
+    const size_t need = (size_t)mesh->vertex_count * sizeof(scc_vertex_trace) + pages;
+    const int fresh = ws->slot[SCC_WS_TRACES].bytes < need || ws->trace_count != mesh->vertex_count;
     scc_vertex_trace* traces = scc_ws_get(ws, SCC_WS_TRACES, need);
     if (!traces) return NULL;
     if (fresh || ++ws->trace_epoch == 0) {
-        memset(traces, 0, ws->slot[SCC_WS_TRACES].bytes);
+        memset(trace_pages(traces, mesh), 0, pages);
+        ws->trace_count = mesh->vertex_count;
         ws->trace_epoch = 1;
     }
     return traces;
@@ -112,7 +125,14 @@ scc_vertex_trace* scc_mesh_traces(scc_workspace* ws, const scc_mesh* mesh)
 void scc_triangle_traces(scc_vertex_trace* traces, const scc_mesh* mesh, uint32_t t, uint32_t epoch, scc_vertex_trace* out[3])
 {
     const uint32_t* f = mesh->indices + 3 * t;
+    uint8_t* pages = trace_pages(traces, mesh);
     for (int i = 0; i < 3; ++i) {
+        const uint32_t page = f[i] / SCC_TRACE_PAGE;
+        if (!pages[page]) { /* never set since the marks were laid out: no record of it is in use */
+            const uint32_t first = page * SCC_TRACE_PAGE, n = mesh->vertex_count - first < SCC_TRACE_PAGE ? mesh->vertex_count - first : SCC_TRACE_PAGE;
+            memset(traces + first, 0, n * sizeof *traces);
+            pages[page] = 1;
+        }
         scc_vertex_trace* r = &traces[f[i]];
         if (r->epoch != epoch) {
             r->epoch = epoch;

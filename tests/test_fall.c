@@ -342,6 +342,77 @@ START_TEST(test_clear_over_tip)
 }
 END_TEST
 
+/* New memory with a pattern in it: what the library writes shows (test_traces_lazily). */
+static void* pattern_alloc(size_t n, void* u)
+{
+    (void)u;
+    void* p = malloc(n);
+    if (p) memset(p, 0xA5, n);
+    return p;
+}
+
+/* The vertex records of a mesh query (mesh_query.c, scc_mesh_traces) are set up a page at a time as
+ * triangles are tested, not all at once: a 20K-triangle sheet falls onto the spike grid (FWGSS, broad
+ * phase) through a new workspace whose memory starts with a pattern; after the query, most of the
+ * records must still hold it, and the answer must be bit for bit that of a query through a workspace
+ * that has answered one before (records left by an earlier query). */
+START_TEST(test_traces_lazily)
+{
+    enum { N = 101 };
+    static scc_vec3 vv[N * N];
+    static uint32_t f[6 * (N - 1) * (N - 1)];
+    scc_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    for (int j = 0; j < N; ++j)
+        for (int i = 0; i < N; ++i) vv[j * N + i] = scc_v3(-0.2 + 0.4 * i / (N - 1), -0.2 + 0.4 * j / (N - 1), 0.0);
+    uint32_t nf = 0;
+    for (int j = 0; j + 1 < N; ++j)
+        for (int i = 0; i + 1 < N; ++i) {
+            const uint32_t a = (uint32_t)(j * N + i), b = a + 1, c = a + N, d = c + 1;
+            f[nf++] = a; f[nf++] = b; f[nf++] = d;
+            f[nf++] = a; f[nf++] = d; f[nf++] = c;
+        }
+    mesh.vertices = vv;
+    mesh.indices = f;
+    mesh.vertex_count = N * N;
+    mesh.triangle_count = nf / 3;
+    mesh.bounds.lo = scc_v3(-0.2, -0.2, 0.0);
+    mesh.bounds.hi = scc_v3(0.2, 0.2, 0.0);
+    mesh.bsh = scc_bsh_build(&mesh, &k_alloc);
+    ck_assert_ptr_nonnull(mesh.bsh);
+    scc_sdf_spike_grid spikes;
+    scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
+    scc_rigid body;
+    memset(&body, 0, sizeof body);
+    body.q0 = scc_quat_identity();
+    body.p0 = scc_v3(0.013, -0.021, 0.11);
+    body.v = scc_v3(0.0, 0.0, -2.0);
+    body.w = scc_v3(0.3, 0.2, 1.0);
+    scc_mesh_motion mm = { &mesh, &body, NULL, NULL, NULL, 0.0, DT, NULL, NULL };
+    scc_params p = params_of(SDFCCD_METHOD_FWGSS);
+    static scc_contact out[64], again[64];
+    const scc_allocator patterned = { pattern_alloc, t_free, NULL };
+    scc_workspace ws;
+    scc_ws_init(&ws, &patterned);
+    scc_query_summary r, r2;
+    ck_assert(scc_query_mesh_ws(&spikes.base, &mm, &p, &ws, out, 64, &r));
+    const unsigned char* rec = ws.slot[SCC_WS_TRACES].p;
+    const size_t bytes = (size_t)mesh.vertex_count * sizeof(scc_vertex_trace);
+    size_t kept = 0;
+    for (size_t i = 0; i < bytes; ++i) kept += rec[i] == 0xA5;
+    printf("traces: %u triangles tested, %.1f %% of the vertex records' bytes untouched\n", (unsigned)r.triangles_tested, 100.0 * kept / bytes);
+    ck_assert(r.hit);
+    ck_assert_int_lt(r.triangles_tested, mesh.triangle_count / 100);
+    ck_assert_msg(kept >= bytes * 9 / 10, "%zu of %zu bytes untouched", kept, bytes);
+    /* the same query again through the same workspace (records of the first, a new epoch) */
+    ck_assert(scc_query_mesh_ws(&spikes.base, &mm, &p, &ws, again, 64, &r2));
+    ck_assert(r2.hit == r.hit && r2.toi == r.toi && r2.toi_lower == r.toi_lower && r2.evals == r.evals && r2.contacts_found == r.contacts_found);
+    ck_assert(memcmp(out, again, (size_t)r.contacts_written * sizeof *out) == 0);
+    scc_ws_release(&ws);
+    scc_bsh_destroy((scc_bsh*)mesh.bsh, &k_alloc);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("fall");
@@ -352,6 +423,7 @@ int main(void)
     tcase_add_test(tc, test_deferred_checks);
     tcase_add_test(tc, test_precheck_clears);
     tcase_add_test(tc, test_clear_over_tip);
+    tcase_add_test(tc, test_traces_lazily);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }
