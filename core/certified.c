@@ -291,36 +291,24 @@ static double sample_at(sample_cache* sc, const scc_sdf* sdf, const scc_tri_stat
  * arrangement: a corner, where two cross on an edge, or where three meet inside. Near a kink such as
  * a cone's tip, planes from around it close over it (a point above the tip at height h: about h^2 /
  * |y - tip| for each plane, where the centroid's one plane needs regions smaller than h). */
-static double planes_bound(const scc_tri_state* st, const region* r, const scc_vec3* y, const double* f, const scc_vec3* g, int n,
-                           double accel)
+/* The smallest over the simplex of weights b of max_j (k_j + sum_i b_i d_ji), j < n: attained at a
+ * vertex of the arrangement of these affine functions (a corner, where two cross on an edge, or where
+ * three meet inside), which are all tried. */
+static double simplex_minmax(const double* k, const double (*d)[3], int n)
 {
-    double k[4], d[4][3], mag = 0.0;
-    const double dt = r->tb - r->ta;
-    scc_vec3 x[3], v[3];
-    for (int i = 0; i < 3; ++i) {
-        x[i] = corner(st, r->u[i], r->v[i]);
-        v[i] = scc_add(scc_add(scc_scale(st->v[0], r->u[i]), scc_scale(st->v[1], r->v[i])), scc_scale(st->v[2], 1.0 - r->u[i] - r->v[i]));
-    }
-    for (int j = 0; j < n; ++j) {
-        const double gl = scc_len(g[j]);
-        k[j] = f[j] - gl * 0.5 * accel * dt * dt;
-        for (int i = 0; i < 3; ++i) {
-            const double a = scc_dot(g[j], scc_sub(x[i], y[j])), b = a + dt * scc_dot(g[j], v[i]);
-            d[j][i] = fmin(a, b);
-            mag = fmax(mag, fabs(f[j]) + gl * (scc_dist(x[i], y[j]) + dt * scc_len(v[i])));
-        }
-    }
-#define PLANES_MAX(B0, B1, B2, OUT)                                          \
-    do {                                                                     \
-        double m_ = -INFINITY;                                               \
-        for (int j_ = 0; j_ < n; ++j_)                                       \
-            m_ = fmax(m_, k[j_] + (B0) * d[j_][0] + (B1) * d[j_][1] + (B2) * d[j_][2]); \
-        OUT = m_;                                                            \
+#define PLANES_MAX(B0, B1, B2, OUT)                                                        \
+    do {                                                                                   \
+        double m_ = -INFINITY;                                                             \
+        for (int j_ = 0; j_ < n; ++j_) {                                                   \
+            const double x_ = k[j_] + (B0) * d[j_][0] + (B1) * d[j_][1] + (B2) * d[j_][2]; \
+            m_ = x_ > m_ ? x_ : m_;                                                        \
+        }                                                                                  \
+        OUT = m_;                                                                          \
     } while (0)
     double best = INFINITY, val;
     for (int i = 0; i < 3; ++i) { /* the corners */
         PLANES_MAX(i == 0, i == 1, i == 2, val);
-        best = fmin(best, val);
+        best = val < best ? val : best;
     }
     for (int i = 0; i < 3; ++i) { /* the edges from corner i to corner i + 1: lam in (0, 1) where two planes cross */
         const int e = (i + 1) % 3;
@@ -334,7 +322,7 @@ static double planes_bound(const scc_tri_state* st, const region* r, const scc_v
                 b[i] = 1.0 - lam;
                 b[e] = lam;
                 PLANES_MAX(b[0], b[1], b[2], val);
-                best = fmin(best, val);
+                best = val < best ? val : best;
             }
     }
     for (int j = 0; j < n; ++j) /* inside: where three planes meet (b2 = 1 - b0 - b1) */
@@ -353,11 +341,51 @@ static double planes_bound(const scc_tri_state* st, const region* r, const scc_v
                 const double b0 = (rhs[0] * A[1][1] - A[0][1] * rhs[1]) / det, b1 = (A[0][0] * rhs[1] - rhs[0] * A[1][0]) / det;
                 if (!(b0 > 0.0 && b1 > 0.0 && b0 + b1 < 1.0)) continue;
                 PLANES_MAX(b0, b1, 1.0 - b0 - b1, val);
-                best = fmin(best, val);
+                best = val < best ? val : best;
             }
 #undef PLANES_MAX
+    return best;
+}
+
+/* The support-plane bounds (see above). `full`: over the region. When that does not exceed `margin`,
+ * also `zero`: over the region's start (s = 0) alone, `rate`, the fastest any plane can fall along the
+ * corners' velocities, and `q`, its curvature term's factor: over [ta, ta + s] the bound is then at least
+ * zero - rate s - q s^2 (conservative advancement). All -INFINITY when a sample is not finite. */
+typedef struct planes {
+    double full, zero, rate, q;
+} planes;
+
+static planes planes_bound(const scc_tri_state* st, const region* r, const scc_vec3* y, const double* f, const scc_vec3* g, int n,
+                           double accel, double margin)
+{
+    planes out = { -INFINITY, -INFINITY, 0.0, 0.0 };
+    double k[4], a[4][3], d[4][3], mag = 0.0, mag0 = 0.0;
+    const double dt = r->tb - r->ta;
+    scc_vec3 x[3], v[3];
+    for (int i = 0; i < 3; ++i) {
+        x[i] = corner(st, r->u[i], r->v[i]);
+        v[i] = scc_add(scc_add(scc_scale(st->v[0], r->u[i]), scc_scale(st->v[1], r->v[i])), scc_scale(st->v[2], 1.0 - r->u[i] - r->v[i]));
+    }
+    for (int j = 0; j < n; ++j) {
+        const double gl = scc_len(g[j]);
+        if (!(isfinite(f[j]) && isfinite(gl))) return out;
+        const double q = 0.5 * gl * accel;
+        k[j] = f[j] - gl * 0.5 * accel * dt * dt;
+        out.q = q > out.q ? q : out.q;
+        for (int i = 0; i < 3; ++i) {
+            const double ai = scc_dot(g[j], scc_sub(x[i], y[j])), ci = scc_dot(g[j], v[i]), bi = ai + dt * ci;
+            a[j][i] = ai;
+            d[j][i] = ai < bi ? ai : bi;
+            out.rate = -ci > out.rate ? -ci : out.rate;
+            const double m0 = fabs(f[j]) + gl * scc_dist(x[i], y[j]), m = m0 + gl * dt * scc_len(v[i]);
+            mag = m > mag ? m : mag;
+            mag0 = m0 > mag0 ? m0 : mag0;
+        }
+    }
     /* the arrangement's vertices are computed with rounding: less a margin relative to the sizes */
-    return best - (1e-12 * mag + 1e-15);
+    out.full = simplex_minmax(k, (const double(*)[3])d, n) - (1e-12 * mag + 1e-15);
+    if (out.full <= margin) out.zero = simplex_minmax(f, (const double(*)[3])a, n) - (1e-12 * mag0 + 1e-15);
+    return out;
 }
 
 /* The cached polynomial of full-grid cell ijk (hess < 0: no values there). */
@@ -596,6 +624,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
          * radii, or, for a convex phi, the spatial and temporal parts of the first-order bound. */
         double slack_space = rs, slack_time = rt;
         int done = 0, corners_done = 0;
+        double cut = 0.0; /* > 0: [ta, ta + cut] is proven clear (conservative advancement) */
         const int convex = !grid && convex_on(sdf, &box);
         const double bend = grid ? INFINITY : convex ? 0.0 : bend_bound_nonconvex(sdf, 1, &box, c, rho, phi, &evals);
         if (bend < INFINITY) {
@@ -622,7 +651,15 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
                 }
                 if (done) break;
                 corners_done = 1;
-                if (planes_bound(&st, &r, y, fy, gy, 4, accel) > p->margin) continue;
+                const planes pl = planes_bound(&st, &r, y, fy, gy, 4, accel, p->margin);
+                if (pl.full > p->margin) continue;
+                /* conservative advancement: [ta, ta + s] is clear while zero - margin - rate s - q s^2 > 0;
+                 * used where it proves more than a halving of the interval would */
+                const double b0 = pl.zero - p->margin;
+                if (b0 > 0.0) {
+                    const double sc = 0.99 * 2.0 * b0 / (pl.rate + sqrt(pl.rate * pl.rate + 4.0 * pl.q * b0));
+                    if (sc >= 0.5 * (r.tb - r.ta) && sc < r.tb - r.ta) cut = sc;
+                }
             }
             if (bound > phi - L * rho) {
                 slack_space = -fmin(f.lin_space, 0.0) + (rho > 0.0 ? curv * rs / rho : 0.0);
@@ -665,7 +702,16 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
                 }
             }
         }
-        if (slack_time >= slack_space) {
+        if (cut > 0.0) {
+            region b = r;
+            b.depth = r.depth + 1;
+            b.ta = r.ta + cut;
+            if (b.ta < hi && !region_heap_push(&h, b)) {
+                if (h.full) capped = 1;
+                else ok = 0;
+                break;
+            }
+        } else if (slack_time >= slack_space) {
             double tm = 0.5 * (r.ta + r.tb);
             region a = r, b = r;
             a.depth = b.depth = r.depth + 1;
