@@ -29,6 +29,7 @@ typedef struct region {
     double ta, tb;
     double u[3], v[3]; /* barycentric corners: weights (u, v, 1 - u - v) */
     int depth;         /* splits from the root */
+    int convex;        /* phi is convex on a box holding the region (its own or an ancestor's) */
 } region;
 
 SCC_MIN_HEAP(region_heap, region, ta)
@@ -282,6 +283,24 @@ static double sample_at(sample_cache* sc, const scc_sdf* sdf, const scc_tri_stat
     return e->phi;
 }
 
+/* The triangle's last two states (regions popped in a row often start at the same time): the same
+ * numbers scc_tri_state_at gives, computed once. */
+typedef struct state_cache {
+    scc_tri_state s[2];
+    int next;
+} state_cache;
+
+static const scc_tri_state* state_at(state_cache* sc, const scc_tri_motion* m, double t)
+{
+    for (int i = 0; i < 2; ++i)
+        if (bits_of(sc->s[i].t) == bits_of(t)) return &sc->s[i];
+    scc_tri_state* e = &sc->s[sc->next];
+    sc->next ^= 1;
+    scc_tri_state_at(m, t, e);
+    e->t = t;
+    return e;
+}
+
 /* The support-plane bound of a convex phi over a region (ours, issue 20 item 6): with samples y_j of
  * the region (value f_j, gradient g_j) every plane f_j + g_j.(x - y_j) lies below phi on a box where
  * phi is convex, so phi >= max_j of them. Over the region (weights b on its corners, s in [0, dt]) each
@@ -293,8 +312,8 @@ static double sample_at(sample_cache* sc, const scc_sdf* sdf, const scc_tri_stat
  * |y - tip| for each plane, where the centroid's one plane needs regions smaller than h). */
 /* The smallest over the simplex of weights b of max_j (k_j + sum_i b_i d_ji), j < n: attained at a
  * vertex of the arrangement of these affine functions (a corner, where two cross on an edge, or where
- * three meet inside), which are all tried. */
-static double simplex_minmax(const double* k, const double (*d)[3], int n)
+ * three meet inside), which are all tried; or, once one is at most `stop`, that one. */
+static double simplex_minmax(const double* k, const double (*d)[3], int n, double stop)
 {
 #define PLANES_MAX(B0, B1, B2, OUT)                                                        \
     do {                                                                                   \
@@ -310,6 +329,7 @@ static double simplex_minmax(const double* k, const double (*d)[3], int n)
         PLANES_MAX(i == 0, i == 1, i == 2, val);
         best = val < best ? val : best;
     }
+    if (best <= stop) return best;
     for (int i = 0; i < 3; ++i) { /* the edges from corner i to corner i + 1: lam in (0, 1) where two planes cross */
         const int e = (i + 1) % 3;
         for (int j = 0; j < n; ++j)
@@ -323,6 +343,7 @@ static double simplex_minmax(const double* k, const double (*d)[3], int n)
                 b[e] = lam;
                 PLANES_MAX(b[0], b[1], b[2], val);
                 best = val < best ? val : best;
+                if (best <= stop) return best;
             }
     }
     for (int j = 0; j < n; ++j) /* inside: where three planes meet (b2 = 1 - b0 - b1) */
@@ -342,6 +363,7 @@ static double simplex_minmax(const double* k, const double (*d)[3], int n)
                 if (!(b0 > 0.0 && b1 > 0.0 && b0 + b1 < 1.0)) continue;
                 PLANES_MAX(b0, b1, 1.0 - b0 - b1, val);
                 best = val < best ? val : best;
+                if (best <= stop) return best;
             }
 #undef PLANES_MAX
     return best;
@@ -383,8 +405,9 @@ static planes planes_bound(const scc_tri_state* st, const region* r, const scc_v
         }
     }
     /* the arrangement's vertices are computed with rounding: less a margin relative to the sizes */
-    out.full = simplex_minmax(k, (const double(*)[3])d, n) - (1e-12 * mag + 1e-15);
-    if (out.full <= margin) out.zero = simplex_minmax(f, (const double(*)[3])a, n) - (1e-12 * mag0 + 1e-15);
+    const double eps = 1e-12 * mag + 1e-15;
+    out.full = simplex_minmax(k, (const double(*)[3])d, n, margin + eps) - eps;
+    if (out.full <= margin) out.zero = simplex_minmax(f, (const double(*)[3])a, n, -INFINITY) - (1e-12 * mag0 + 1e-15);
     return out;
 }
 
@@ -515,7 +538,7 @@ int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const dou
     grid_bound_ctx ctx;
     ctx.g = (const scc_grid*)sdf;
     for (int i = 0; i < CELL_CACHE; ++i) ctx.cell[i].l = UINT64_MAX;
-    region r = { ta, tb, { u[0], u[1], u[2] }, { v[0], v[1], v[2] }, 0 };
+    region r = { ta, tb, { u[0], u[1], u[2] }, { v[0], v[1], v[2] }, 0, 0 };
     scc_tri_state st;
     scc_tri_state_at(m, ta, &st);
     const double cu = (u[0] + u[1] + u[2]) / 3.0, cv = (v[0] + v[1] + v[2]) / 3.0;
@@ -570,7 +593,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
      * popped region's start as the proven lower bound. */
     region_heap h = { NULL, 0, 0, alloc, 0, 0 };
     if (p->cert_max_bytes > 0) h.max_bytes = (uint64_t)p->cert_max_bytes > SIZE_MAX ? SIZE_MAX : (size_t)p->cert_max_bytes;
-    region root = { ta, tb, { 1, 0, 0 }, { 0, 1, 0 }, 0 };
+    region root = { ta, tb, { 1, 0, 0 }, { 0, 1, 0 }, 0, 0 };
     int capped = 0, ok = 1;
     if (!region_heap_push(&h, root)) {
         if (!h.full) return 0;
@@ -585,6 +608,9 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
     int64_t processed = 0, evals = 0;
     sample_cache cache;
     for (int i = 0; i < SAMPLE_CACHE; ++i) cache.s[i].key[0] = bits_of(NAN);
+    state_cache states;
+    states.s[0].t = states.s[1].t = NAN;
+    states.next = 0;
     int clipped = 0; /* a region was cut at seed_t - seed_tol: nothing is proven after that */
     while (h.n) {
         region r = region_heap_pop(&h);
@@ -601,8 +627,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             r.tb = seed_t - seed_tol;
             clipped = 1;
         }
-        scc_tri_state st;
-        scc_tri_state_at(m, r.ta, &st);
+        const scc_tri_state st = *state_at(&states, m, r.ta);
         double cu = (r.u[0] + r.u[1] + r.u[2]) / 3.0, cv = (r.v[0] + r.v[1] + r.v[2]) / 3.0;
         scc_vec3 c = corner(&st, cu, cv);
         scc_vec3 gc;
@@ -625,7 +650,9 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         double slack_space = rs, slack_time = rt;
         int done = 0, corners_done = 0;
         double cut = 0.0; /* > 0: [ta, ta + cut] is proven clear (conservative advancement) */
-        const int convex = !grid && convex_on(sdf, &box);
+        /* an ancestor's box holds the region too, so its convexity is inherited (sub-regions skip the test) */
+        const int convex = !grid && (r.convex || convex_on(sdf, &box));
+        r.convex = convex;
         const double bend = grid ? INFINITY : convex ? 0.0 : bend_bound_nonconvex(sdf, 1, &box, c, rho, phi, &evals);
         if (bend < INFINITY) {
             /* First-order bound of a convex phi, less the bending term: phi(x) >= phi(c) + g.(x - c)
@@ -690,8 +717,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         }
         if (done) break;
         if (r.tb < hi && sample) {
-            scc_tri_state se;
-            scc_tri_state_at(m, r.tb, &se);
+            const scc_tri_state se = *state_at(&states, m, r.tb);
             double su[4] = { cu, r.u[0], r.u[1], r.u[2] }, sv[4] = { cv, r.v[0], r.v[1], r.v[2] };
             for (int i = 0; i < 4; ++i) {
                 scc_vec3 g;
@@ -730,10 +756,10 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
                 mv[i] = 0.5 * (r.v[i] + r.v[j]);
             }
             region k[4] = {
-                { r.ta, r.tb, { r.u[0], mu[0], mu[2] }, { r.v[0], mv[0], mv[2] }, r.depth + 1 },
-                { r.ta, r.tb, { mu[0], r.u[1], mu[1] }, { mv[0], r.v[1], mv[1] }, r.depth + 1 },
-                { r.ta, r.tb, { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] }, r.depth + 1 },
-                { r.ta, r.tb, { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] }, r.depth + 1 },
+                { r.ta, r.tb, { r.u[0], mu[0], mu[2] }, { r.v[0], mv[0], mv[2] }, r.depth + 1, r.convex },
+                { r.ta, r.tb, { mu[0], r.u[1], mu[1] }, { mv[0], r.v[1], mv[1] }, r.depth + 1, r.convex },
+                { r.ta, r.tb, { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] }, r.depth + 1, r.convex },
+                { r.ta, r.tb, { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] }, r.depth + 1, r.convex },
             };
             for (int i = 0; i < 4 && ok; ++i) ok = region_heap_push(&h, k[i]);
             if (!ok) {
