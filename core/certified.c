@@ -226,20 +226,39 @@ typedef struct first_order {
     double lin, lin_space, lin_time, curve;
 } first_order;
 
-static first_order first_order_terms(const scc_tri_state* st, const region* r, scc_vec3 c, scc_vec3 gc, double accel)
+/* A region's corners at its start and their velocities. */
+typedef struct corners {
+    scc_vec3 x[3], v[3];
+} corners;
+
+static corners corners_of(const scc_tri_state* st, const region* r)
+{
+    corners k;
+    for (int i = 0; i < 3; ++i) {
+        k.x[i] = corner(st, r->u[i], r->v[i]);
+        k.v[i] = scc_add(scc_add(scc_scale(st->v[0], r->u[i]), scc_scale(st->v[1], r->v[i])), scc_scale(st->v[2], 1.0 - r->u[i] - r->v[i]));
+    }
+    return k;
+}
+
+static first_order first_order_of(const corners* k, double dt, scc_vec3 c, scc_vec3 gc, double accel)
 {
     first_order f = { INFINITY, INFINITY, INFINITY, 0.0 };
-    const double dt = r->tb - r->ta;
     for (int i = 0; i < 3; ++i) {
-        scc_vec3 xi = corner(st, r->u[i], r->v[i]);
-        scc_vec3 vi = scc_add(scc_add(scc_scale(st->v[0], r->u[i]), scc_scale(st->v[1], r->v[i])), scc_scale(st->v[2], 1.0 - r->u[i] - r->v[i]));
-        double at0 = scc_dot(gc, scc_sub(xi, c)), drift = dt * scc_dot(gc, vi);
-        f.lin = fmin(f.lin, fmin(at0, at0 + drift));
-        f.lin_space = fmin(f.lin_space, at0);
-        f.lin_time = fmin(f.lin_time, drift);
+        const double at0 = scc_dot(gc, scc_sub(k->x[i], c)), drift = dt * scc_dot(gc, k->v[i]);
+        const double lo = drift < 0.0 ? at0 + drift : at0;
+        f.lin = lo < f.lin ? lo : f.lin;
+        f.lin_space = at0 < f.lin_space ? at0 : f.lin_space;
+        f.lin_time = drift < f.lin_time ? drift : f.lin_time;
     }
     f.curve = scc_len(gc) * 0.5 * accel * dt * dt;
     return f;
+}
+
+static first_order first_order_terms(const scc_tri_state* st, const region* r, scc_vec3 c, scc_vec3 gc, double accel)
+{
+    const corners k = corners_of(st, r);
+    return first_order_of(&k, r->tb - r->ta, c, gc, accel);
 }
 
 /* The search's samples by (time, weights) (ours): a region split in time keeps its start's samples, the
@@ -377,17 +396,13 @@ typedef struct planes {
     double full, zero, rate, q;
 } planes;
 
-static planes planes_bound(const scc_tri_state* st, const region* r, const scc_vec3* y, const double* f, const scc_vec3* g, int n,
-                           double accel, double margin)
+static planes planes_bound(const corners* cx, double dt, const scc_vec3* y, const double* f, const scc_vec3* g, int n, double accel,
+                           double margin)
 {
     planes out = { -INFINITY, -INFINITY, 0.0, 0.0 };
     double k[4], a[4][3], d[4][3], mag = 0.0, mag0 = 0.0;
-    const double dt = r->tb - r->ta;
-    scc_vec3 x[3], v[3];
-    for (int i = 0; i < 3; ++i) {
-        x[i] = corner(st, r->u[i], r->v[i]);
-        v[i] = scc_add(scc_add(scc_scale(st->v[0], r->u[i]), scc_scale(st->v[1], r->v[i])), scc_scale(st->v[2], 1.0 - r->u[i] - r->v[i]));
-    }
+    const scc_vec3* x = cx->x;
+    const scc_vec3* v = cx->v;
     for (int j = 0; j < n; ++j) {
         const double gl = scc_len(g[j]);
         if (!(isfinite(f[j]) && isfinite(gl))) return out;
@@ -407,7 +422,9 @@ static planes planes_bound(const scc_tri_state* st, const region* r, const scc_v
     /* the arrangement's vertices are computed with rounding: less a margin relative to the sizes */
     const double eps = 1e-12 * mag + 1e-15;
     out.full = simplex_minmax(k, (const double(*)[3])d, n, margin + eps) - eps;
-    if (out.full <= margin) out.zero = simplex_minmax(f, (const double(*)[3])a, n, -INFINITY) - (1e-12 * mag0 + 1e-15);
+    /* `zero` matters only above margin + rate dt / 2 (the caller's advancement must exceed half the span) */
+    const double eps0 = 1e-12 * mag0 + 1e-15;
+    if (out.full <= margin) out.zero = simplex_minmax(f, (const double(*)[3])a, n, margin + 0.5 * dt * out.rate + eps0) - eps0;
     return out;
 }
 
@@ -639,7 +656,8 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             break; /* sampled at the region's earliest time: nothing earlier is unresolved */
         }
         double rs = 0.0;
-        for (int i = 0; i < 3; ++i) rs = fmax(rs, scc_dist(corner(&st, r.u[i], r.v[i]), c));
+        const corners cx = corners_of(&st, &r);
+        for (int i = 0; i < 3; ++i) rs = fmax(rs, scc_dist(cx.x[i], c));
         double rt = speed * (r.tb - r.ta);
         double rho = rs + rt;
         scc_aabb box = { scc_sub(c, scc_v3(rho, rho, rho)), scc_add(c, scc_v3(rho, rho, rho)) };
@@ -657,7 +675,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         if (bend < INFINITY) {
             /* First-order bound of a convex phi, less the bending term: phi(x) >= phi(c) + g.(x - c)
              * - K rho^2 / 2 (first_order_terms, bend_bound). Tangential sliding costs only K. */
-            const first_order f = first_order_terms(&st, &r, c, gc, accel);
+            const first_order f = first_order_of(&cx, r.tb - r.ta, c, gc, accel);
             const double curv = 0.5 * bend * rho * rho;
             const double bound = phi + f.lin - f.curve - curv;
             if (bound > p->margin) continue;
@@ -668,7 +686,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
                 double fy[4];
                 y[0] = c; fy[0] = phi; gy[0] = gc;
                 for (int i = 0; i < 3 && !done; ++i) {
-                    y[i + 1] = corner(&st, r.u[i], r.v[i]);
+                    y[i + 1] = cx.x[i];
                     fy[i + 1] = sample_at(&cache, sdf, &st, r.ta, r.u[i], r.v[i], &gy[i + 1], &evals);
                     if (fy[i + 1] <= p->margin) {
                         hi = lo = r.ta;
@@ -678,7 +696,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
                 }
                 if (done) break;
                 corners_done = 1;
-                const planes pl = planes_bound(&st, &r, y, fy, gy, 4, accel, p->margin);
+                const planes pl = planes_bound(&cx, r.tb - r.ta, y, fy, gy, 4, accel, p->margin);
                 if (pl.full > p->margin) continue;
                 /* conservative advancement: [ta, ta + s] is clear while zero - margin - rate s - q s^2 > 0;
                  * used where it proves more than a halving of the interval would */

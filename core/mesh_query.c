@@ -15,8 +15,9 @@
 
 #include <string.h>
 
-/* Evaluations of the certified clear proof tried on a triangle before FWGSS (test_triangle). */
-#define SCC_PRECHECK_EVALS 32
+/* Evaluations of the certified clear proof tried on a triangle before FWGSS (test_triangle; chosen
+ * on the scaling scene, CHANGELOG). */
+#define SCC_PRECHECK_EVALS 24
 /* Proofs that may fail before the first clears (then two more per triangle cleared): where they fail
  * the triangles are large against their clearance (1K scaling scene: 19 of 19 failed, 6.6 % more
  * evaluations when every triangle tried). */
@@ -224,9 +225,9 @@ static int take_answer(mesh_ctx* c, scc_query_summary* s, const scc_contact* loc
 /* The certified search's short clear proof before FWGSS (ours, issue 20 item 6): on a kinked
  * analytic field its first-order bounds clear a triangle that passes a convex piece without touching
  * it in tens of evaluations, where FWGSS's descents spend hundreds before their deferred check proves
- * the same (100K scaling scene: 9 of 13 triangles cleared in 1-23 evaluations each). Returns 1 when
- * the triangle is done (cleared on [ta, tb], or the budget ran out), 0 when FWGSS goes on, -1 on
- * allocation failure; tp->max_evals loses what the proof spent. */
+ * the same. Where it does not close, *lower is the start of the interval it left unproven (ta when it
+ * proved nothing). Returns 1 when the triangle is done (cleared on [ta, tb], or the budget ran out), 0
+ * when FWGSS goes on, -1 on allocation failure; tp->max_evals loses what the proof spent. */
 static int precheck(mesh_ctx* c, const scc_tri_motion* m, double ta, double tb, scc_params* tp, double* lower)
 {
     *lower = ta;

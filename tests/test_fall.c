@@ -250,7 +250,7 @@ END_TEST
  * that pass spikes without touching them before the scene's earliest contact (0.0270795 s) plus the
  * window. Certified queries of each triangle say so; the FWGSS mesh query over that interval (no
  * broad phase: every triangle on [t0, t1]) must answer no hit and cost exactly the triangles'
- * certified clear proofs (scc_certified_clear within the pre-check's 32 evaluations, each closing), so
+ * certified clear proofs (scc_certified_clear within the pre-check's 24 evaluations, each closing), so
  * no descent and no check runs, and fewer than the triangles' own checked FWGSS queries. */
 START_TEST(test_precheck_clears)
 {
@@ -285,8 +285,8 @@ START_TEST(test_precheck_clears)
         ck_assert(!s.hit);
         own += s.evals;
         scc_tri_hit h;
-        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 32, &h));
-        ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "triangle %u: no clear proof in 32 evaluations", t);
+        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 24, &h));
+        ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "triangle %u: no clear proof in 24 evaluations", t);
         proofs += h.evals;
     }
     scc_query_summary r;
@@ -305,7 +305,7 @@ END_TEST
  * spike's tip (the tip under an off-centre point of the face) and stops 50 um above it. The first-order
  * bound from a sub-triangle's centroid alone prunes it only once the sub-triangle is about as small as the
  * gap (some 12 levels of splits here); the planes of its corners close over the tip at every scale. The
- * certified clear proof must prove the interval clear within the pre-check's 32 evaluations, and the
+ * certified clear proof must prove the interval clear within the pre-check's 24 evaluations, and the
  * certified search must agree (no contact), for the tip under each of the face's three corners' sides. */
 START_TEST(test_clear_over_tip)
 {
@@ -332,7 +332,7 @@ START_TEST(test_clear_over_tip)
         ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 1000000, &h));
         printf("clear over a tip (%d): %lld evaluations, state %d\n", k, (long long)h.evals, (int)h.state);
         ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "face %d: touches or unproven", k);
-        ck_assert_int_le(h.evals, 32);
+        ck_assert_int_le(h.evals, 24);
         scc_query_summary c;
         scc_contact out[1 + SCC_MAX_SUBDIVISION_CONTACTS];
         scc_params pc = params_of(SDFCCD_METHOD_CERTIFIED);
