@@ -27,8 +27,11 @@
  * on an analytic field with kinks) the tracing goes on below a leaf over its triangle's sub-triangles,
  * in the same queue (bsh.c, "below the leaf": a leaf's sphere can be much wider than its triangle);
  * the triangle goes to the caller at the time its earliest sub-triangle stalls, or never when they
- * all pass the interval's end. The caller may shrink the end of the searched interval (every narrow-phase hit does), which
- * stops the march of everything later.
+ * all pass the interval's end. There (after the step's start) the search is also ordered: a march
+ * pauses where its next evaluation would be later than the queue's first item and resumes when the
+ * queue reaches it, so no evaluation is spent after a contact found meanwhile, and a node stalls at a
+ * looser clearance (its time only starts its children or its regions). The caller may shrink the end
+ * of the searched interval (every narrow-phase hit does), which stops the march of everything later.
  *
  * DCD (end pose only) uses the same tree statically: a node is culled when its sphere at the end
  * pose is clear.

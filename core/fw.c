@@ -9,6 +9,7 @@ void scc_fw_begin(scc_fw_state* s, const scc_sdf* sdf, const scc_tri_motion* m, 
 {
     s->sdf = sdf;
     s->torus = sdf->kind == SCC_SDF_TORUS && sdf->eval == scc_sdf_torus_eval ? (const scc_sdf_torus*)sdf : NULL;
+    s->user = sdf->eval == scc_sdf_user_eval ? (const scc_sdf_user*)sdf : NULL;
     s->margin = p->margin;
     s->m = m;
     s->p = p;

@@ -52,6 +52,22 @@ struct scc_sdf {
     scc_sdf_kind kind;
 };
 
+/* A user's field (the public API's sdfccd_create_callback_sdf): the user's function, of the public
+ * type sdfccd_SdfEvalFcn, and its pointer. eval is scc_sdf_user_eval (sdf_user.h), which calls the
+ * function; the solvers call it directly for phi alone (fw_common.h), one call less per sample. The
+ * function is kept as a generic function pointer (core does not include the public headers;
+ * sdf_user.h converts it back to its type). */
+typedef void scc_generic_fn(void);
+typedef struct scc_sdf_user {
+    scc_sdf base; /* first member; eval = scc_sdf_user_eval */
+    scc_generic_fn* fn;
+    void* user;
+} scc_sdf_user;
+
+/* phi of a user's field (scc_sdf_user) and its gradient when g is not NULL: (0, 0, 1) where the
+ * function leaves it unset or writes a non-finite one (never NaN to a solver). */
+double scc_sdf_user_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g);
+
 static inline double scc_sdf_eval(const scc_sdf* s, scc_vec3 p, scc_vec3* out_grad)
 {
     return s->eval(s, p, out_grad);

@@ -16,7 +16,7 @@ enum {
                          holds all sum->contacts_found of them, earliest first */
     SCC_WS_HEAP,      /* broad phase: earliest-candidate heap */
     SCC_WS_SEGMENTS,  /* broad phase: time segments */
-    SCC_WS_TESTED,    /* broad phase: one bit per triangle */
+    SCC_WS_TESTED,    /* broad phase: one byte per triangle, all zero between traversals (bsh.c) */
     SCC_WS_STACK,     /* broad phase (DCD): descent stack */
     SCC_WS_MOVING,    /* broad phase: nodes refitted for linear motion */
     SCC_WS_STAGING,   /* the ABI: contacts before conversion to the world frame */
@@ -33,6 +33,7 @@ enum {
     SCC_WS_START,     /* contact sets: the start-pose query's contacts, kept while the CCD runs (contacts.c) */
     SCC_WS_VERTEX_LIST, /* contact sets: the vertices of the touching triangles, sorted (contacts.c) */
     SCC_WS_DEFERRED,  /* mesh query: FWGSS answers whose check waits for the earliest contact (mesh_query.c) */
+    SCC_WS_BELOW,     /* broad phase: the triangles a traversal marked, with the motions of those bounded below their leaves (bsh.c) */
     SCC_WS_SLOTS
 };
 

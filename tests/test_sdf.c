@@ -353,6 +353,47 @@ START_TEST(test_callback_smooth)
 }
 END_TEST
 
+/* The plane z = 0 as a user's field: its gradient (0, 0, 1), or not finite where asked for. */
+static double plane_field(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
+{
+    if (g) *g = user ? (sdfccd_Vec3){ NAN, 0.0, INFINITY } : (sdfccd_Vec3){ 0.0, 0.0, 1.0 };
+    return p.z;
+}
+
+/* A user's gradient that is not finite reaches no solver: it reads as (0, 0, 1), through
+ * sdfccd_sdf_eval and inside a query, where the solvers call the user's function themselves. */
+START_TEST(test_callback_nonfinite_gradient)
+{
+    static int nonfinite = 1;
+    sdfccd_SdfId f[2];
+    for (int k = 0; k < 2; ++k) {
+        sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
+        def.eval = plane_field;
+        def.user = k ? &nonfinite : NULL;
+        def.smooth = 1;
+        ck_assert_int_eq(sdfccd_create_callback_sdf(&def, &f[k]), SDFCCD_OK);
+    }
+    double v;
+    sdfccd_Vec3 g;
+    ck_assert_int_eq(sdfccd_sdf_eval(f[1], (sdfccd_Vec3){ 0.1, 0.2, 0.3 }, &v, &g), SDFCCD_OK);
+    ck_assert(v == 0.3 && g.x == 0.0 && g.y == 0.0 && g.z == 1.0);
+    const sdfccd_Vec3 tri[3] = { { -0.05, -0.03, 0.2 }, { 0.05, -0.03, 0.25 }, { 0, 0.06, 0.3 } };
+    sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+    m.linear_velocity = (sdfccd_Vec3){ 0.1, 0.0, -30.0 };
+    m.angular_velocity = (sdfccd_Vec3){ 20.0, -10.0, 5.0 };
+    const sdfccd_QueryParams p = sdfccd_default_query_params();
+    sdfccd_QueryResult r[2];
+    sdfccd_Contact c[2][8];
+    for (int k = 0; k < 2; ++k) ck_assert_int_eq(sdfccd_query_triangle(f[k], NULL, tri, &m, 0.0, 1.0 / 60.0, &p, c[k], 8, &r[k]), SDFCCD_OK);
+    ck_assert(r[0].hit);
+    ck_assert_int_eq(r[1].hit, r[0].hit);
+    ck_assert(r[1].toi == r[0].toi);
+    ck_assert_int_eq(r[1].sdf_evaluations, r[0].sdf_evaluations);
+    ck_assert(memcmp(&c[1][0], &c[0][0], sizeof c[0][0]) == 0);
+    for (int k = 0; k < 2; ++k) sdfccd_destroy_sdf(f[k]);
+}
+END_TEST
+
 START_TEST(test_bad_parameters)
 {
     sdfccd_SdfId s;
@@ -396,6 +437,7 @@ int main(void)
     tcase_add_test(tc, test_csg_and_transform);
     tcase_add_test(tc, test_callback);
     tcase_add_test(tc, test_callback_smooth);
+    tcase_add_test(tc, test_callback_nonfinite_gradient);
     tcase_add_test(tc, test_bad_parameters);
     tcase_add_test(tc, test_eval_batch_matches_eval);
     suite_add_tcase(s, tc);

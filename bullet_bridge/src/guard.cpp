@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // sdfccd Bullet bridge: the no-tunnelling guarantee (paper, Section 4). After Bullet integrates a
-// step, an action hands each dynamic body's executed motion (per part and SDF) to sdfccd_guard_body
-// and puts a body it rolls back at its safe pose, with sdfccd_guard_response's velocity.
+// step, an action hands the SDFs and the dynamic bodies (poses at both ends of the step, parts,
+// states) to sdfccd_guard_world and puts each body it rolls back at its safe pose, with its velocity.
 #include "internal.h"
 
-#include <LinearMath/btAabbUtil2.h>
+#include <cmath>
 
 SDFCCD_BULLET_NAMESPACE_BEGIN
 
@@ -26,22 +26,18 @@ private:
     BridgeImpl* m_bridge;
 };
 
-// The box a shape can occupy while its object moves from t0 to t1 (sdfccd_swept_aabb: origin lerp,
-// any turn about the origin; false for a NaN pose or box).
-bool sweptBox(const btCollisionShape* s, const btTransform& t0, const btTransform& t1, btVector3& lo, btVector3& hi)
+// A shape's world boxes at two poses and the reach of its points from its origin (Bullet's box
+// and bounding sphere), as sdfccd_guard_world takes them.
+void shapeBoxes(const btCollisionShape* s, const btTransform& t0, const btTransform& t1, sdfccd_Aabb& b0, sdfccd_Aabb& b1, double& reach)
 {
-    btVector3 lo0, hi0, lo1, hi1, c;
+    btVector3 lo, hi, c;
     btScalar r;
-    s->getAabb(t0, lo0, hi0);
-    s->getAabb(t1, lo1, hi1);
+    s->getAabb(t0, lo, hi);
+    b0 = { v3(lo), v3(hi) };
+    s->getAabb(t1, lo, hi);
+    b1 = { v3(lo), v3(hi) };
     s->getBoundingSphere(c, r);
-    const sdfccd_Aabb b0 = { v3(lo0), v3(hi0) }, b1 = { v3(lo1), v3(hi1) };
-    const sdfccd_Pose p0 = toPose(t0), p1 = toPose(t1);
-    sdfccd_Aabb out;
-    if (sdfccd_swept_aabb(&b0, &b1, &p0, &p1, (double)(c.length() + r), &out) != SDFCCD_OK) return false;
-    lo = bt(out.lo);
-    hi = bt(out.hi);
-    return true;
+    reach = (double)(c.length() + r);
 }
 
 // The mesh parts of a shape with their offsets in the body frame: the shape itself, or the
@@ -56,11 +52,31 @@ void leaves(const btCollisionShape* s, const btTransform& offset, std::vector<st
     out.push_back(std::make_pair(s, offset));
 }
 
-// The executed motion from pose a (time 0) to pose b (time dt), rotating about c (local frame).
-sdfccd_Status motionFromPoses(const btTransform& a, const btTransform& b, const btVector3& c, double dt, sdfccd_RigidMotion* out)
+// What sdfccd_guard_world's hook needs: the bodies and SDF objects behind its indices.
+struct Placing {
+    const std::vector<btRigidBody*>* bodies;
+    const std::vector<const btCollisionObject*>* sdf_objects;
+};
+
+// The hook: Bullet puts the body at the safe pose and gives its state there (its own inertia
+// update, in btScalar) and the pair's friction (Bullet's product, in btScalar).
+void placeBody(void* user, int32_t i, int32_t j, const sdfccd_Pose* pose, sdfccd_BodyState* state, double* friction)
 {
-    const sdfccd_Pose pa = toPose(a), pb = toPose(b);
-    return sdfccd_rigid_motion_from_poses(&pa, &pb, v3(c), 0, dt, out);
+    const Placing* p = static_cast<const Placing*>(user);
+    btRigidBody* body = (*p->bodies)[(size_t)i];
+    const sdfccd_Quat& q = pose->orientation;
+    body->setCenterOfMassTransform(btTransform(btQuaternion((btScalar)q.x, (btScalar)q.y, (btScalar)q.z, (btScalar)q.w).normalized(), bt(pose->position)));
+    *state = bodyState(body);
+    *friction = (double)(body->getFriction() * (*p->sdf_objects)[(size_t)j]->getFriction());
+}
+
+// False when a pose holds a NaN or infinity (a body that blew up): it is left out of the guard,
+// so the other bodies stay guarded.
+bool finitePose(const btTransform& t)
+{
+    double s = (double)t.getOrigin().x() + (double)t.getOrigin().y() + (double)t.getOrigin().z();
+    for (int i = 0; i < 3; ++i) s += (double)t.getBasis()[i].x() + (double)t.getBasis()[i].y() + (double)t.getBasis()[i].z();
+    return std::isfinite(s);
 }
 
 } // namespace
@@ -123,103 +139,94 @@ void BridgeImpl::guardStep(btCollisionWorld* world, double dt)
     gp.tolerance = cfg.guard_tolerance;
     gp.query.fwgss_restarts = cfg.query.fwgss_restarts; // the bridge's (0): the core's discrete check backs it
     gp.query.fwgss_verify = cfg.query.fwgss_verify;
-    // The SDFs and the boxes they sweep in the step.
-    struct SdfObject { // the SDF's motion: a static one still has its pose (NULL would mean the world origin)
-        const btCollisionObject* co;
-        sdfccd_SdfId sdf;
-        btTransform t0, t1;
-        btVector3 lo, hi;
-        sdfccd_RigidMotion motion;
-    };
-    std::vector<SdfObject> sdfs;
+    // The dynamic bodies with their mesh parts, and the SDFs (a static one keeps its pose), as
+    // sdfccd_guard_world takes them; it checks each body's executed motion and rolls it back.
+    std::vector<btRigidBody*> dyn;
+    std::vector<int> dyn_object;
+    std::vector<int32_t> dyn_index((size_t)objs.size(), -1); // object -> body index (-1: not a dynamic body)
     for (int i = 0; i < objs.size(); ++i) {
-        const btCollisionShape* s = objs[i]->getCollisionShape();
-        if (!isOurSdf(s)) continue;
-        SdfObject o;
-        o.co = objs[i];
-        o.sdf = shapes.sdfFor(s, cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
-        if (!o.sdf.index1) continue;
-        o.t1 = objs[i]->getWorldTransform();
-        if (objs[i]->isStaticObject() && !objs[i]->isKinematicObject()) o.t0 = o.t1;
-        else o.t0 = startOf(i);
-        if (!sweptBox(s, o.t0, o.t1, o.lo, o.hi) || motionFromPoses(o.t0, o.t1, btVector3(0, 0, 0), dt, &o.motion) != SDFCCD_OK) {
+        btRigidBody* body = btRigidBody::upcast(objs[i]);
+        if (!body || body->isStaticOrKinematicObject()) continue;
+        if (!finitePose(startOf(i)) || !finitePose(body->getWorldTransform())) {
             stats.query_errors++;
             continue;
         }
-        sdfs.push_back(o);
+        dyn_index[(size_t)i] = (int32_t)dyn.size();
+        dyn.push_back(body);
+        dyn_object.push_back(i);
     }
-    std::vector<std::pair<const btCollisionShape*, btTransform>> parts;
-    std::vector<sdfccd_GuardPair> pairs;
-    std::vector<std::pair<const SdfObject*, btTransform>> which; // each pair's SDF and part offset
-    for (int i = 0; i < objs.size() && !sdfs.empty(); ++i) {
-        btRigidBody* body = btRigidBody::upcast(objs[i]);
-        if (!body || body->isStaticOrKinematicObject()) continue;
-        const btTransform t0 = startOf(i);
-        const btTransform t1 = body->getWorldTransform();
-        const btCollisionShape* shape = body->getCollisionShape();
-        btVector3 lo, hi, pad = btVector3(1, 1, 1) * (btScalar)gp.tolerance;
-        if (!sweptBox(shape, t0, t1, lo, hi)) continue;
-        lo -= pad;
-        hi += pad;
-        parts.clear();
-        pairs.clear();
-        which.clear();
-        for (const SdfObject& o : sdfs) {
-            if (o.co == body || !TestAabbAgainstAabb2(lo, hi, o.lo, o.hi)) continue;
-            if (t0 == t1 && o.t0 == o.t1) continue; // neither moved (a sleeping body): nothing went deeper
-            if (parts.empty()) leaves(shape, btTransform::getIdentity(), parts);
-            for (const auto& part : parts) {
-                if (part.first == o.co->getCollisionShape() || !isMeshLike(part.first)) continue;
-                const MeshEntry* me = shapes.meshFor(part.first);
-                if (!me) continue;
-                sdfccd_GuardPair pair = { o.sdf, &o.motion, me->id, sdfccd_RigidMotion() };
-                stats.guard_queries++;
-                if (motionFromPoses(t0 * part.second, t1 * part.second, part.second.inverse().getOrigin(), dt, &pair.executed) != SDFCCD_OK) {
-                    stats.query_errors++;
-                    continue;
-                }
-                pairs.push_back(pair);
-                which.push_back(std::make_pair(&o, part.second));
-            }
+    std::vector<sdfccd_GuardSdf> sdfs;
+    std::vector<const btCollisionObject*> sdf_objects;
+    for (int i = 0; i < objs.size(); ++i) {
+        const btCollisionShape* s = objs[i]->getCollisionShape();
+        if (!isOurSdf(s)) continue;
+        sdfccd_GuardSdf o = sdfccd_GuardSdf();
+        o.sdf = shapes.sdfFor(s, cfg.sdf_shape_type, cfg.handle_bt_sdf_shape);
+        if (!o.sdf.index1) continue;
+        const btTransform t1 = objs[i]->getWorldTransform();
+        const btTransform t0 = objs[i]->isStaticObject() && !objs[i]->isKinematicObject() ? t1 : startOf(i);
+        if (!finitePose(t0) || !finitePose(t1)) {
+            stats.query_errors++;
+            continue;
         }
-        // The earliest rollback of the body's checks (sdfccd_guard_body).
-        sdfccd_GuardBodyResult r;
-        if (pairs.empty() || sdfccd_guard_body(workspace, pairs.data(), (int32_t)pairs.size(), 0, dt, &gp, &r) != SDFCCD_OK) continue;
-        stats.query_errors += r.failed;
+        o.start = toPose(t0);
+        o.end = toPose(t1);
+        shapeBoxes(s, t0, t1, o.start_box, o.end_box, o.reach);
+        o.friction = (double)objs[i]->getFriction();
+        o.shape_key = (uint64_t)(uintptr_t)s;
+        o.body = dyn_index[(size_t)i];
+        if (const btRigidBody* sb = btRigidBody::upcast(objs[i])) {
+            o.has_state = 1;
+            o.state = bodyState(sb);
+        }
+        sdfs.push_back(o);
+        sdf_objects.push_back(objs[i]);
+    }
+    if (sdfs.empty()) return;
+    std::vector<sdfccd_GuardRigidBody> bodies(dyn.size());
+    std::vector<sdfccd_GuardPart> parts;
+    std::vector<size_t> first_part(dyn.size());
+    std::vector<std::pair<const btCollisionShape*, btTransform>> leaf;
+    for (size_t k = 0; k < dyn.size(); ++k) {
+        btRigidBody* body = dyn[k];
+        const btTransform t0 = startOf(dyn_object[k]), t1 = body->getWorldTransform();
+        sdfccd_GuardRigidBody& b = bodies[k];
+        b.start = toPose(t0);
+        b.end = toPose(t1);
+        shapeBoxes(body->getCollisionShape(), t0, t1, b.start_box, b.end_box, b.reach);
+        b.friction = (double)body->getFriction();
+        b.state = bodyState(body);
+        leaf.clear();
+        leaves(body->getCollisionShape(), btTransform::getIdentity(), leaf);
+        first_part[k] = parts.size();
+        for (const auto& l : leaf) {
+            const MeshEntry* me = isMeshLike(l.first) ? shapes.meshFor(l.first) : nullptr;
+            if (me) parts.push_back({ me->id, toPose(l.second), (uint64_t)(uintptr_t)l.first });
+        }
+        b.part_count = (int32_t)(parts.size() - first_part[k]);
+    }
+    for (size_t k = 0; k < bodies.size(); ++k) bodies[k].parts = parts.data() + first_part[k];
+    std::vector<sdfccd_GuardWorldResult> results(bodies.size());
+    Placing placing = { &dyn, &sdf_objects };
+    if (sdfccd_guard_world(workspace, sdfs.data(), (int32_t)sdfs.size(), bodies.data(), (int32_t)bodies.size(), 0, dt, &gp, placeBody,
+                           &placing, results.data()) != SDFCCD_OK) {
+        stats.query_errors++;
+        return;
+    }
+    // The rolled-back bodies are at their safe poses (placeBody); they leave with the response's velocity.
+    for (size_t k = 0; k < results.size(); ++k) {
+        const sdfccd_GuardWorldResult& r = results[k];
+        stats.guard_queries += r.queries;
+        stats.query_errors += r.failures;
         stats.sdf_evaluations += r.sdf_evaluations;
-        if (r.index < 0) continue;
-        const sdfccd_GuardResult& best = r.first;
-        const SdfObject* best_sdf = which[(size_t)r.index].first;
-        const btTransform& best_part = which[(size_t)r.index].second;
-        // The safe pose (of the part that hit first: the body's follows), then the velocity
-        // (sdfccd_guard_response, always as "repeated": the body loses its velocity into the surface;
-        // keeping it for a first rollback raised the body and left the velocity that sank it, and
-        // bodies rocking on a ring in gimpact-demo did not come to rest).
-        const sdfccd_Quat& q = best.safe_pose.orientation;
-        btTransform safe = btTransform(btQuaternion((btScalar)q.x, (btScalar)q.y, (btScalar)q.z, (btScalar)q.w).normalized(),
-                                       bt(best.safe_pose.position)) * best_part.inverse();
-        // A moving SDF (kinematic or dynamic) goes on to its end pose: the body goes with it from the
-        // time of impact, so it keeps the safe pose relative to the SDF instead of being left behind
-        // inside it.
-        if (!(best_sdf->t0 == best_sdf->t1)) {
-            btTransform at_toi;
-            btTransformUtil::integrateTransform(best_sdf->t0, bt(best_sdf->motion.linear_velocity), bt(best_sdf->motion.angular_velocity),
-                                                (btScalar)best.toi, at_toi);
-            safe = best_sdf->t1 * at_toi.inverse() * safe;
-        }
-        body->setCenterOfMassTransform(safe);
-        const btRigidBody* sb = btRigidBody::upcast(best_sdf->co);
-        const sdfccd_BodyState ss = sb ? bodyState(sb) : sdfccd_BodyState();
-        sdfccd_BodyState bs = bodyState(body);
-        const double mu = (double)(body->getFriction() * best_sdf->co->getFriction());
-        if (sdfccd_guard_response(&best, 1, sb ? &ss : nullptr, mu, &bs) == SDFCCD_OK) {
-            body->setLinearVelocity(bt(bs.linear_velocity));
-            body->setAngularVelocity(bt(bs.angular_velocity));
-        }
+        if (!r.rolled_back) continue;
+        btRigidBody* body = dyn[k];
+        body->setLinearVelocity(bt(r.state.linear_velocity));
+        body->setAngularVelocity(bt(r.state.angular_velocity));
         body->setInterpolationLinearVelocity(body->getLinearVelocity());
         body->setInterpolationAngularVelocity(body->getAngularVelocity());
         stats.rollbacks++;
-        stats.last_toi_fraction = best.fraction;
+        stats.last_toi_fraction = r.guard.fraction;
     }
 }
 

@@ -157,6 +157,18 @@ sdfccd_Status sdfccd__mesh_topology_message(const struct scc_mesh_topology* t, c
 struct scc_params;
 sdfccd_Status sdfccd__convert_params(const sdfccd_QueryParams* in, const char* fn, struct scc_params* out);
 
+/* ---- the guard's argument checks (contact_api.c), shared with guard_api.c ---- */
+struct scc_xform;
+struct scc_body_state;
+/* A finite pose with a unit orientation (within 1e-4, then normalised into *out) and a position
+ * within SDFCCD_MAX_QUERY_MAGNITUDE; `what` names it in messages. */
+sdfccd_Status sdfccd__unit_pose(const sdfccd_Pose* pose, const char* what, struct scc_xform* out);
+/* Guard params (from sdfccd_default_guard_params(), a finite tolerance > 0, no DCD) as the core's
+ * query params and tolerance. */
+sdfccd_Status sdfccd__convert_guard_params(const sdfccd_GuardParams* in, const char* fn, struct scc_params* out, double* out_tol);
+/* A body state (finite, inverse mass >= 0) in the core's form; "fn: what" names it in messages. */
+sdfccd_Status sdfccd__body_state(const sdfccd_BodyState* in, const char* fn, const char* what, struct scc_body_state* out);
+
 /* ---- query arguments (ccd_api.c), shared by every call that runs a query ---- */
 struct scc_rigid;
 /* A public rigid motion over [t0, t1] (validated: finite, within SDFCCD_MAX_QUERY_MAGNITUDE and

@@ -11,7 +11,7 @@
 #include <stdio.h>
 
 /* Finite pose with a unit orientation (within 1e-4, then normalised) and a bounded position. */
-static sdfccd_Status unit_pose(const sdfccd_Pose* pose, const char* what, scc_xform* out)
+sdfccd_Status sdfccd__unit_pose(const sdfccd_Pose* pose, const char* what, scc_xform* out)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_ptr(pose, what)) || (st = sdfccd__check_pose(*pose, what, out))) return st;
@@ -31,8 +31,8 @@ sdfccd_Status sdfccd_rigid_motion_from_poses(const sdfccd_Pose* start, const sdf
     sdfccd_Status st;
     scc_xform a, b;
     if ((st = sdfccd__check_ptr(out_motion, "sdfccd_rigid_motion_from_poses: out_motion")) ||
-        (st = unit_pose(start, "sdfccd_rigid_motion_from_poses: start", &a)) ||
-        (st = unit_pose(end, "sdfccd_rigid_motion_from_poses: end", &b)) ||
+        (st = sdfccd__unit_pose(start, "sdfccd_rigid_motion_from_poses: start", &a)) ||
+        (st = sdfccd__unit_pose(end, "sdfccd_rigid_motion_from_poses: end", &b)) ||
         (st = sdfccd__check_vec(local_center, "sdfccd_rigid_motion_from_poses: local_center")))
         return st;
     if (!(scc_maxc(scc_vabs(sdfccd__v(local_center))) <= SDFCCD_MAX_QUERY_MAGNITUDE))
@@ -64,8 +64,7 @@ sdfccd_Status sdfccd_rigid_motion_from_poses(const sdfccd_Pose* start, const sdf
     return SDFCCD_OK;
 }
 
-/* Guard params (checked) as the core's query params and tolerance. */
-static sdfccd_Status convert_guard_params(const sdfccd_GuardParams* in, const char* fn, scc_params* out, double* out_tol)
+sdfccd_Status sdfccd__convert_guard_params(const sdfccd_GuardParams* in, const char* fn, scc_params* out, double* out_tol)
 {
     sdfccd_Status st;
     if (!in) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: params is NULL", fn);
@@ -141,7 +140,7 @@ static sdfccd_Status run_guard(sdfccd_Workspace* ws, const step_setup* q, const 
     scc_params p;
     double tol = 0.0;
     sdfccd_Status st;
-    if ((st = convert_guard_params(params, fn, &p, &tol))) return st;
+    if ((st = sdfccd__convert_guard_params(params, fn, &p, &tol))) return st;
     scc_guard_out g;
     if (!(step ? scc_guard_step : scc_guard)(q->sdf->sdf, mm, &p, tol, &ws->ws, &g))
         return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory", fn);
@@ -531,21 +530,31 @@ sdfccd_Status sdfccd_guard_step_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, co
     SDFCCD__HELD_CALL(guard_rigid(ws, sdf, sdf_motion, mesh, executed, t0, t1, params, out, 1));
 }
 
-/* A body state (checked) in the core's form. */
-static sdfccd_Status body_state(const sdfccd_BodyState* in, const char* fn, const char* what, scc_body_state* out)
+/* Whether a body state passes sdfccd__body_state's checks (no message, no formatting). */
+static int body_state_ok(const sdfccd_BodyState* in)
 {
-    sdfccd_Status st;
-    char w[96];
-    snprintf(w, sizeof w, "%s: %s", fn, what);
-    if ((st = sdfccd__check_ptr(in, w)) || (st = sdfccd__check_vec(in->center, w)) || (st = sdfccd__check_vec(in->linear_velocity, w)) ||
-        (st = sdfccd__check_vec(in->angular_velocity, w)))
-        return st;
-    if (!isfinite(in->inverse_mass) || !(in->inverse_mass >= 0.0))
-        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_mass must be finite and >= 0", w);
-    for (int i = 0; i < 9; ++i) {
-        if (!isfinite(in->inverse_inertia[i])) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_inertia is not finite", w);
-        out->inv_inertia[i] = in->inverse_inertia[i];
+    if (!in || !scc_vfinite(sdfccd__v(in->center)) || !scc_vfinite(sdfccd__v(in->linear_velocity)) ||
+        !scc_vfinite(sdfccd__v(in->angular_velocity)) || !isfinite(in->inverse_mass) || !(in->inverse_mass >= 0.0))
+        return 0;
+    for (int i = 0; i < 9; ++i)
+        if (!isfinite(in->inverse_inertia[i])) return 0;
+    return 1;
+}
+
+sdfccd_Status sdfccd__body_state(const sdfccd_BodyState* in, const char* fn, const char* what, scc_body_state* out)
+{
+    if (!body_state_ok(in)) { /* the message names the field */
+        sdfccd_Status st;
+        char w[96];
+        snprintf(w, sizeof w, "%s: %s", fn, what);
+        if ((st = sdfccd__check_ptr(in, w)) || (st = sdfccd__check_vec(in->center, w)) || (st = sdfccd__check_vec(in->linear_velocity, w)) ||
+            (st = sdfccd__check_vec(in->angular_velocity, w)))
+            return st;
+        if (!isfinite(in->inverse_mass) || !(in->inverse_mass >= 0.0))
+            return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_mass must be finite and >= 0", w);
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: inverse_inertia is not finite", w);
     }
+    for (int i = 0; i < 9; ++i) out->inv_inertia[i] = in->inverse_inertia[i];
     out->center = sdfccd__v(in->center);
     out->v = sdfccd__v(in->linear_velocity);
     out->w = sdfccd__v(in->angular_velocity);
@@ -558,8 +567,8 @@ static sdfccd_Status guard_response(const sdfccd_GuardResult* result, int32_t re
 {
     sdfccd_Status st;
     scc_body_state b, s;
-    if ((st = sdfccd__check_ptr(result, "sdfccd_guard_response: result")) || (st = body_state(body, "sdfccd_guard_response", "body", &b)) ||
-        (sdf_body && (st = body_state(sdf_body, "sdfccd_guard_response", "sdf_body", &s))))
+    if ((st = sdfccd__check_ptr(result, "sdfccd_guard_response: result")) || (st = sdfccd__body_state(body, "sdfccd_guard_response", "body", &b)) ||
+        (sdf_body && (st = sdfccd__body_state(sdf_body, "sdfccd_guard_response", "sdf_body", &s))))
         return st;
     if (!isfinite(friction) || !(friction >= 0.0))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_guard_response: friction must be finite and >= 0 (got %g)", friction);
@@ -599,7 +608,7 @@ static sdfccd_Status friction_hold(const sdfccd_HeldContact* contacts, int32_t c
     enum { CHUNK = SCC_HOLD_MAX };
     sdfccd_Status st;
     scc_body_state b;
-    if ((st = body_state(body, fn, "body", &b))) return st;
+    if ((st = sdfccd__body_state(body, fn, "body", &b))) return st;
     if (count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: count must be >= 0 (got %d)", fn, (int)count);
     if (count > 0 && !contacts) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: contacts is NULL", fn);
     if (!isfinite(rest_speed) || !(rest_speed >= 0.0))

@@ -200,24 +200,7 @@ sdfccd_Status sdfccd_create_transformed(sdfccd_SdfId child, sdfccd_Pose pose, do
     SDFCCD__HELD_CALL(create_transformed_held(child, pose, scale, out_sdf));
 }
 
-/* ---- user callbacks ---- */
-typedef struct callback_sdf {
-    scc_sdf base;
-    sdfccd_SdfEvalFcn* fn;
-    void* user;
-} callback_sdf;
-
-static double callback_eval(const scc_sdf* self, scc_vec3 p, scc_vec3* g)
-{
-    const callback_sdf* c = (const callback_sdf*)self;
-    if (!g) return c->fn(sdfccd__pv(p), NULL, c->user); /* most samples: no gradient, nothing to check */
-    sdfccd_Vec3 gp = { 0.0, 0.0, 1.0 };
-    double v = c->fn(sdfccd__pv(p), &gp, c->user);
-    *g = sdfccd__v(gp);
-    if (!scc_vfinite(*g)) *g = scc_v3(0.0, 0.0, 1.0); /* never hand NaN to a solver */
-    return v;
-}
-
+/* ---- user callbacks: scc_sdf_user (core/sdf.h), whose eval calls the user's function ---- */
 sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfccd_SdfId* out_sdf)
 {
     sdfccd_Status st;
@@ -229,10 +212,10 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: bounds contain NaN");
     if (def->smooth != 0 && def->smooth != 1)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: smooth must be 0 or 1 (got %d)", (int)def->smooth);
-    sdfccd__sdf* s = new_shape(sizeof(callback_sdf), "a callback SDF");
+    sdfccd__sdf* s = new_shape(sizeof(scc_sdf_user), "a callback SDF");
     if (!s) return SDFCCD_OUT_OF_MEMORY;
-    callback_sdf* c = s->storage;
-    c->base.eval = callback_eval;
+    scc_sdf_user* c = s->storage;
+    c->base.eval = scc_sdf_user_eval;
     c->base.lipschitz_in = NULL;
     c->base.domain.lo = scc_v3(-INFINITY, -INFINITY, -INFINITY);
     c->base.domain.hi = scc_v3(INFINITY, INFINITY, INFINITY);
@@ -242,7 +225,7 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
     c->base.convex_in = NULL;
     c->base.smooth = def->smooth;
     c->base.kind = SCC_SDF_CALLBACK;
-    c->fn = def->eval;
+    c->fn = (scc_generic_fn*)def->eval;
     c->user = def->user;
     return sdfccd__sdf_register(s, out_sdf);
 }

@@ -32,7 +32,7 @@ __all__ = [
     "torus", "capsule", "cylinder", "half_space", "spike_grid", "union", "intersection", "difference",
     "transformed", "callback", "load_grid", "grid_from_mesh", "grid_from_sdf", "load_mesh", "query_triangle",
     "query_triangle_linear", "query_mesh", "query_mesh_linear", "query_batch", "extract_isosurface", "run_cases",
-    "byte_count", "Workspace", "motion_from_poses", "guard_rigid", "guard_linear", "GuardResult", "generate_contacts",
+    "byte_count", "Workspace", "motion_from_poses", "guard_rigid", "guard_linear", "guard_world", "GuardResult", "generate_contacts",
     "generate_contacts_linear", "reduce_contacts", "CONTACT_POINT_DTYPE", "HAVE_CONTACTS", "CONTACT_DTYPE", "RESULT_DTYPE", "MOTION_DTYPE", "CASES_DTYPE", "CASES_COLUMNS", "library_path",
 ]
 
@@ -978,6 +978,102 @@ def guard_linear(sdf, mesh, start, end, t0=0.0, t1=1.0 / 60.0, tolerance=None, p
     _raise_callback_errors(sdf)
     _check(st)
     return GuardResult(out, positions)
+
+
+def _pair_arg(p, name, struct, fields, sizes):
+    """A pair of arrays (e.g. (position, orientation w x y z)) as `struct`'s two `fields` of `sizes`."""
+    if not isinstance(p, (tuple, list)) or len(p) != 2:
+        raise TypeError(f"{name}: expected ({fields[0]}, {fields[1]})")
+    out = struct()
+    for f, v, n in zip(fields, p, sizes):
+        getattr(out, f)[:] = _float_array(v, f"{name} {f}", (n,))
+    return out
+
+
+def _pose_arg(p, name):
+    return _pair_arg(p, name, _lib.Pose, ("position", "orientation"), (3, 4))
+
+
+def _box_arg(b, name):
+    return _pair_arg(b, name, _lib.Aabb, ("lo", "hi"), (3, 3))
+
+
+def _state_arg(d, name):
+    """A body state dict (center, linear_velocity, angular_velocity, inverse_mass, inverse_inertia 3x3)."""
+    out = _lib.BodyState()
+    out.center[:] = _float_array(d["center"], f"{name} center", (3,))
+    out.linear_velocity[:] = _float_array(d.get("linear_velocity", (0.0, 0.0, 0.0)), f"{name} linear_velocity", (3,))
+    out.angular_velocity[:] = _float_array(d.get("angular_velocity", (0.0, 0.0, 0.0)), f"{name} angular_velocity", (3,))
+    out.inverse_mass = _scalar(d.get("inverse_mass", 0.0), f"{name} inverse_mass")
+    out.inverse_inertia[:] = _float_array(d.get("inverse_inertia", np.zeros((3, 3))), f"{name} inverse_inertia", (3, 3)).ravel()
+    return out
+
+
+def _moving_arg(out, d, name):
+    """The poses, boxes and reach that an SDF and a body of guard_world share ("end" defaults to "start")."""
+    out.start = _pose_arg(d["start"], f"{name} start")
+    out.end = _pose_arg(d.get("end", d["start"]), f"{name} end")
+    out.start_box = _box_arg(d["start_box"], f"{name} start_box")
+    out.end_box = _box_arg(d.get("end_box", d["start_box"]), f"{name} end_box")
+    out.reach = _scalar(d.get("reach", 0.0), f"{name} reach")
+    out.friction = _scalar(d.get("friction", 0.0), f"{name} friction")
+
+
+def guard_world(sdfs, bodies, t0=0.0, t1=1.0 / 60.0, tolerance=None, params=None, method="fwgss", workspace=None):
+    """The guarantee for a world after an engine's step (sdfccd_guard_world), from plain data.
+
+    `sdfs`: dicts with "sdf" (an Sdf), "start" and "end" poses ((position, orientation w x y z); "end"
+    defaults to "start": static), "start_box" and "end_box" ((lo, hi)), "reach" (its points' largest
+    distance from its origin), and optionally "friction", "body" (the index in `bodies` of the body
+    that carries it), "state" (a state dict: its kinematic or static rigid body), "shape_key".
+    `bodies`: dicts with the same poses, boxes, reach and friction, "parts" (a list of (Mesh, offset
+    pose), or of (Mesh, offset pose, shape_key)) and "state" (dict: center, linear_velocity,
+    angular_velocity, inverse_mass, inverse_inertia 3x3, at the end pose).
+    Returns one dict per body: rolled_back, sdf, part (indices, -1), position and orientation (where the
+    body is to be), center, linear_velocity, angular_velocity, guard (a GuardResult), queries, failures,
+    sdf_evaluations."""
+    _need_contacts()
+    cs = (_lib.GuardSdf * max(1, len(sdfs)))()
+    for i, d in enumerate(sdfs):
+        cs[i].sdf = _sdf_arg(d["sdf"], f"sdfs[{i}] sdf")
+        _moving_arg(cs[i], d, f"sdfs[{i}]")
+        cs[i].shape_key = int(d.get("shape_key", 0))
+        cs[i].body = int(d.get("body", -1))
+        if d.get("state") is not None:
+            cs[i].has_state = 1
+            cs[i].state = _state_arg(d["state"], f"sdfs[{i}] state")
+    cb = (_lib.GuardRigidBody * max(1, len(bodies)))()
+    keep = []
+    for i, d in enumerate(bodies):
+        _moving_arg(cb[i], d, f"bodies[{i}]")
+        cb[i].state = _state_arg(d["state"], f"bodies[{i}] state")
+        parts = d.get("parts", ())
+        cp = (_lib.GuardPart * max(1, len(parts)))()
+        for k, part in enumerate(parts):
+            cp[k].mesh = _mesh_arg(part[0], f"bodies[{i}] parts[{k}]")
+            cp[k].offset = _pose_arg(part[1], f"bodies[{i}] parts[{k}] offset")
+            cp[k].shape_key = int(part[2]) if len(part) > 2 else 0
+        keep.append(cp)
+        cb[i].parts = cp
+        cb[i].part_count = len(parts)
+    g = _guard_params(tolerance, params, method)
+    out = (_lib.GuardWorldResult * max(1, len(bodies)))()
+    a, b = _scalar(t0, "t0"), _scalar(t1, "t1")
+    st = _with_workspace(workspace, lambda ws: _L.sdfccd_guard_world(ws, cs, len(sdfs), cb, len(bodies), a, b, C.byref(g),
+                                                                     None, None, out))
+    _raise_callback_errors(*[d["sdf"] for d in sdfs])
+    _check(st)
+    results = []
+    for i in range(len(bodies)):
+        r = out[i]
+        results.append({
+            "rolled_back": bool(r.rolled_back), "sdf": r.sdf, "part": r.part,
+            "position": np.array(r.pose.position), "orientation": np.array(r.pose.orientation),
+            "center": np.array(r.state.center), "linear_velocity": np.array(r.state.linear_velocity),
+            "angular_velocity": np.array(r.state.angular_velocity), "guard": GuardResult(r.guard),
+            "queries": r.queries, "failures": r.failures, "sdf_evaluations": r.sdf_evaluations,
+        })
+    return results
 
 
 def _contact_params(params, method, vertex_distance, same_place_distance):

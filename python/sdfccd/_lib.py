@@ -279,6 +279,64 @@ class GuardResult(C.Structure):
     ]
 
 
+class BodyState(C.Structure):
+    _fields_ = [
+        ("center", c_double3),
+        ("linear_velocity", c_double3),
+        ("angular_velocity", c_double3),
+        ("inverse_mass", C.c_double),
+        ("inverse_inertia", C.c_double * 9),
+    ]
+
+
+class GuardSdf(C.Structure):
+    _fields_ = [
+        ("sdf", SdfId),
+        ("start", Pose),
+        ("end", Pose),
+        ("start_box", Aabb),
+        ("end_box", Aabb),
+        ("reach", C.c_double),
+        ("friction", C.c_double),
+        ("shape_key", C.c_uint64),
+        ("body", C.c_int32),
+        ("has_state", C.c_int32),
+        ("state", BodyState),
+    ]
+
+
+class GuardPart(C.Structure):
+    _fields_ = [("mesh", MeshId), ("offset", Pose), ("shape_key", C.c_uint64)]
+
+
+class GuardRigidBody(C.Structure):
+    _fields_ = [
+        ("start", Pose),
+        ("end", Pose),
+        ("start_box", Aabb),
+        ("end_box", Aabb),
+        ("reach", C.c_double),
+        ("parts", C.POINTER(GuardPart)),
+        ("part_count", C.c_int32),
+        ("friction", C.c_double),
+        ("state", BodyState),
+    ]
+
+
+class GuardWorldResult(C.Structure):
+    _fields_ = [
+        ("rolled_back", C.c_int32),
+        ("sdf", C.c_int32),
+        ("part", C.c_int32),
+        ("pose", Pose),
+        ("state", BodyState),
+        ("guard", GuardResult),
+        ("queries", C.c_int32),
+        ("failures", C.c_int32),
+        ("sdf_evaluations", C.c_int64),
+    ]
+
+
 class ContactPoint(C.Structure):
     _fields_ = [
         ("point", c_double3),
@@ -347,6 +405,8 @@ STRUCTS = {
 CONTACT_STRUCTS = {
     "sdfccd_GuardParams": GuardParams, "sdfccd_GuardResult": GuardResult, "sdfccd_ContactPoint": ContactPoint,
     "sdfccd_ContactParams": ContactParams, "sdfccd_ContactSet": ContactSet, "sdfccd_KeepPrevious": KeepPrevious,
+    "sdfccd_BodyState": BodyState, "sdfccd_GuardSdf": GuardSdf, "sdfccd_GuardPart": GuardPart,
+    "sdfccd_GuardRigidBody": GuardRigidBody, "sdfccd_GuardWorldResult": GuardWorldResult,
 }
 
 _S = C.c_int  # sdfccd_Status
@@ -417,6 +477,8 @@ _OPTIONAL_PROTOTYPES = {
                                 _P(GuardParams), _P(GuardResult)]),
     "sdfccd_guard_linear": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, C.c_void_p, C.c_void_p, C.c_double,
                                  C.c_double, _P(GuardParams), _P(GuardResult), C.c_void_p]),
+    "sdfccd_guard_world": (_S, [C.c_void_p, _P(GuardSdf), C.c_int32, _P(GuardRigidBody), C.c_int32, C.c_double,
+                                C.c_double, _P(GuardParams), C.c_void_p, C.c_void_p, _P(GuardWorldResult)]),
     "sdfccd_reduce_contacts": (_S, [C.c_void_p, C.c_int32, C.c_double, C.c_void_p, C.c_int32, _P(C.c_int32)]),
     "sdfccd_default_contact_params": (ContactParams, []),
     "sdfccd_generate_contacts": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, _P(RigidMotion), C.c_double,

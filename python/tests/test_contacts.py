@@ -111,6 +111,40 @@ def test_reduction_keeps_the_deepest(scene):
         sdfccd.reduce_contacts(pts, 4, same_place_distance=-1.0)
 
 
+def test_guard_world_rolls_back_the_falling_body(scene):
+    # Two cubes over the ground: one falling from c = 1 at 120 m/s, which goes back to where its bottom
+    # was half the tolerance deep, t = (0.5 + tol / 2) / 120 s, and loses its velocity into the ground;
+    # one moving up, left at its end pose.
+    ground, cube = scene
+    tol, dt = 5e-4, 1.0 / 60.0
+    q = (1.0, 0.0, 0.0, 0.0)
+    big = 1e9
+    sdfs = [{"sdf": ground, "start": ((0, 0, 0), q), "start_box": ((-big, -big, -big), (big, big, 0.0)), "friction": 0.5}]
+
+    def body(z0, z1):
+        r = math.sqrt(3) * H
+        return {"start": ((0, 0, z0), q), "end": ((0, 0, z1), q), "reach": r,
+                "start_box": ((-r, -r, z0 - r), (r, r, z0 + r)), "end_box": ((-r, -r, z1 - r), (r, r, z1 + r)),
+                "parts": [(cube, ((0, 0, 0), q))], "friction": 0.5,
+                "state": {"center": (0, 0, z1), "linear_velocity": (0, 0, (z1 - z0) / dt), "inverse_mass": 1.0,
+                          "inverse_inertia": np.eye(3)}}
+
+    with sdfccd.Workspace() as ws:
+        fall, up = sdfccd.guard_world(sdfs, [body(1.0, -1.0), body(0.6, 1.1)], 0.0, dt, tolerance=tol, workspace=ws)
+    want = (0.5 + 0.5 * tol) / 120.0
+    assert fall["rolled_back"] and fall["sdf"] == 0 and fall["part"] == 0 and fall["queries"] == 1
+    assert want - 0.1 * tol / 120.0 <= fall["guard"].toi <= want + 1e-12
+    assert abs(fall["position"][2] - (1.0 - 120.0 * fall["guard"].toi)) < 1e-12
+    assert abs(fall["linear_velocity"][2]) < 1e-9 and fall["sdf_evaluations"] > 0
+    assert not up["rolled_back"] and up["sdf"] == -1 and np.allclose(up["position"], (0, 0, 1.1))
+    assert up["linear_velocity"][2] == pytest.approx(30.0)
+    # Bad input: an SDF's body index out of range, a NaN pose.
+    with pytest.raises(sdfccd.Error):
+        sdfccd.guard_world([dict(sdfs[0], body=5)], [body(1.0, -1.0)])
+    with pytest.raises(ValueError):
+        sdfccd.guard_world(sdfs, [body(1.0, float("nan"))])
+
+
 def test_bad_input(scene):
     ground, cube = scene
     m = sdfccd.Motion(position=(0, 0, 1.0), velocity=(0, 0, -120.0))

@@ -587,6 +587,99 @@ SDFCCD_API sdfccd_Status sdfccd_guard_body(sdfccd_Workspace* ws, const sdfccd_Gu
 SDFCCD_API sdfccd_Status sdfccd_swept_aabb(const sdfccd_Aabb* start_box, const sdfccd_Aabb* end_box, const sdfccd_Pose* start,
                                            const sdfccd_Pose* end, double reach, sdfccd_Aabb* out_box);
 
+/** One SDF of sdfccd_guard_world(): its field, its motion over the step and its body. */
+typedef struct sdfccd_GuardSdf {
+    sdfccd_SdfId sdf;          /**< The SDF, in the frame of its poses. */
+    sdfccd_Pose start;         /**< Its pose at t0. */
+    sdfccd_Pose end;           /**< Its pose at t1 (equal to `start`: it does not move). */
+    sdfccd_Aabb start_box;     /**< Its world box at `start` (sdfccd_swept_aabb() makes the box of its motion from these). */
+    sdfccd_Aabb end_box;       /**< Its world box at `end`. */
+    double reach;              /**< A bound (m, >= 0) on its points' distance from its origin (sdfccd_swept_aabb()). */
+    double friction;           /**< Its Coulomb coefficient (>= 0); a rolled-back body's is the product with the body's. */
+    uint64_t shape_key;        /**< Nonzero: a part with the same key is this SDF's own surface and is not checked
+                                    against it (the engine's shape identity, e.g. its address). 0: none. */
+    int32_t body;              /**< The index in `bodies` of the dynamic body that carries this SDF, else -1: that body is
+                                    not checked against it, and a response against it takes that body's state as the call
+                                    has it then (after its own rollback, if it had one). */
+    int32_t has_state;         /**< 1: `state` is the SDF's (kinematic or static) rigid body, which the response counts as
+                                    infinitely heavy; 0: a static SDF without a body. Not used when `body` >= 0. */
+    sdfccd_BodyState state;    /**< See `has_state`. */
+} sdfccd_GuardSdf;
+
+/** One mesh of a body of sdfccd_guard_world(): the body itself, or a part of a compound. */
+typedef struct sdfccd_GuardPart {
+    sdfccd_MeshId mesh;        /**< The mesh, in the part's frame. */
+    sdfccd_Pose offset;        /**< The part's pose in the body frame (the identity for a body that is one mesh). */
+    uint64_t shape_key;        /**< See sdfccd_GuardSdf::shape_key (0: none). */
+} sdfccd_GuardPart;
+
+/** One dynamic body of sdfccd_guard_world(): where it was and where the engine's step put it. */
+typedef struct sdfccd_GuardRigidBody {
+    sdfccd_Pose start;              /**< Its pose at t0. */
+    sdfccd_Pose end;                /**< Its pose at t1, as the engine integrated it. */
+    sdfccd_Aabb start_box;          /**< Its world box at `start`. */
+    sdfccd_Aabb end_box;            /**< Its world box at `end`. */
+    double reach;                   /**< A bound (m, >= 0) on its points' distance from its origin. */
+    const sdfccd_GuardPart* parts;  /**< Its meshes (`part_count`; may be NULL when 0). */
+    int32_t part_count;             /**< >= 0. */
+    double friction;                /**< Its Coulomb coefficient (>= 0). */
+    sdfccd_BodyState state;         /**< At `end`: centre of mass, velocities after the solve, inverse mass, world inverse
+                                         inertia. The executed motion turns about this centre. */
+} sdfccd_GuardRigidBody;
+
+/** What sdfccd_guard_world() did to one body. */
+typedef struct sdfccd_GuardWorldResult {
+    int32_t rolled_back;       /**< 1 when the body went back to a time of impact. */
+    int32_t sdf;               /**< The index in `sdfs` of the SDF it went back for, else -1. */
+    int32_t part;              /**< The index in its parts of the part that reached it first, else -1. */
+    sdfccd_Pose pose;          /**< Where the body is to be: its safe pose when rolled back, else its `end` pose. */
+    sdfccd_BodyState state;    /**< Its state there: when rolled back, its centre and inertia at `pose` and the velocities
+                                    sdfccd_guard_response() leaves it; else its `state`. */
+    sdfccd_GuardResult guard;  /**< The part's check (the part's safe pose and the SDF's point and normal at the time of
+                                    impact); CLEAR with toi t1 when the body was not rolled back. */
+    int32_t queries;           /**< (part, SDF) checks run for it. */
+    int32_t failures;          /**< Checks that returned an error: skipped, the others still guard the body. */
+    int64_t sdf_evaluations;   /**< SDF evaluations of its checks. */
+} sdfccd_GuardWorldResult;
+
+/** Optional engine hook of sdfccd_guard_world(), called once for each body it rolls back, in body
+ * order, before that body's response: the engine puts body `body` at `pose` and may overwrite
+ * `state` (filled with the body's centre and inertia at `pose` as the library computes them) and
+ * `friction` (the product of the two coefficients) with its own, e.g. in its own precision. */
+typedef void (*sdfccd_GuardPlaceFn)(void* user, int32_t body, int32_t sdf, const sdfccd_Pose* pose, sdfccd_BodyState* state,
+                                    double* friction);
+
+/** The guarantee for a whole world after an engine's step (Section 4: the simulation never
+ * advances past a time of impact), with plain arrays: the SDFs with their two poses, and every
+ * dynamic body with its two poses, its meshes and its state. For each body in order:
+ *  - broad phase: the box it can occupy over the step (sdfccd_swept_aabb() of its boxes, grown by
+ *    the tolerance) against each SDF's; a pair where neither moved (equal start and end poses: a
+ *    sleeping body on a static SDF) costs no query;
+ *  - each part against each SDF it can reach (SDFs outer, parts inner): the part's executed motion
+ *    (sdfccd_rigid_motion_from_poses() of the body's poses times its offset, turning about the
+ *    body's centre) checked by sdfccd_guard_step_rigid(), the SDF moving with the motion of its own
+ *    two poses; the earliest rollback of all wins (the first of equal times);
+ *  - a rolled-back body goes to the hitting part's safe pose times the inverse of its offset; when
+ *    that SDF moves, the body is carried with it from the time of impact to the SDF's end pose (it
+ *    keeps its place relative to the SDF instead of being left inside it);
+ *  - its velocity: sdfccd_guard_response() with `repeated` = 1 (it loses its velocity into the
+ *    surface), the SDF's state as described in ::sdfccd_GuardSdf, friction the product of the two.
+ * `place` (NULL: none) is called with `place_user` for each rolled-back body, see ::sdfccd_GuardPlaceFn.
+ * `results` (`body_count`) receives each body's outcome; the engine applies `pose` and `state`.
+ *
+ * Uses the workspace: no allocation after a first call of a given size. Errors
+ * (::SDFCCD_INVALID_ARGUMENT, ::SDFCCD_INVALID_HANDLE; nothing written, `place` not called): NULL
+ * `ws` or `params`, params not from sdfccd_default_guard_params() or refused by the guard, negative
+ * counts, NULL arrays with a count > 0, t1 <= t0 or not finite, a pose that is not finite, not unit
+ * (1e-4) or above SDFCCD_MAX_QUERY_MAGNITUDE, an SDF whose two poses give no motion
+ * (sdfccd_rigid_motion_from_poses()), a NaN box, a reach or friction not finite and >= 0, an SDF's
+ * `body` outside [-1, body_count), a non-finite state, a stale SDF or mesh handle. A failing
+ * check of one pair is counted in the body's `failures` and skipped. */
+SDFCCD_API sdfccd_Status sdfccd_guard_world(sdfccd_Workspace* ws, const sdfccd_GuardSdf* sdfs, int32_t sdf_count,
+                                            const sdfccd_GuardRigidBody* bodies, int32_t body_count, double t0, double t1,
+                                            const sdfccd_GuardParams* params, sdfccd_GuardPlaceFn place, void* place_user,
+                                            sdfccd_GuardWorldResult* results);
+
 /** A contact of a rigid body on an SDF after an engine's solve, for sdfccd_friction_hold() (world frame). */
 typedef struct sdfccd_HeldContact {
     sdfccd_Vec3 point;            /**< Where the impulses act (m). */
