@@ -15,7 +15,8 @@
  * popped region's own ta closes the bracket exactly. No false negatives
  * as long as L is a true Lipschitz bound (1 for the analytic fields). When phi is convex (the
  * distance of a convex shape) the first-order bound phi(x) >= phi(c) + grad(c).(x - c) prunes
- * tangential contacts far sooner than the Lipschitz ball. */
+ * tangential contacts far sooner than the Lipschitz ball, and where phi is convex on the region's box
+ * the support planes at its corners as well (planes_bound: they close over a cone's tip). */
 #include "ccd.h"
 #include "min_heap.h"
 #include "sdf_analytic.h"
@@ -28,6 +29,7 @@ typedef struct region {
     double ta, tb;
     double u[3], v[3]; /* barycentric corners: weights (u, v, 1 - u - v) */
     int depth;         /* splits from the root */
+    int convex;        /* phi is convex on a box holding the region (its own or an ancestor's) */
 } region;
 
 SCC_MIN_HEAP(region_heap, region, ta)
@@ -41,9 +43,11 @@ SCC_MIN_HEAP(region_heap, region, ta)
  * its active operand, so it bends as that one (the one whose gradient scc_sdf_eval gives); a min,
  * only where one operand decides the whole ball. So a cube minus a ball bends by 1 / |x| where the
  * ball's inside decides, and sliding along the carved sphere costs only that curvature term. */
-static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals)
+static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals);
+
+/* bend_bound where sign * phi is not known to be convex on the box */
+static double bend_bound_nonconvex(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals)
 {
-    if (sdf->kind == SCC_SDF_HALF_SPACE || (sign > 0 && scc_sdf_convex_in(sdf, box))) return 0.0;
     if (sign < 0 && sdf->convex) {
         double inflate;
         switch (sdf->kind) {
@@ -70,6 +74,18 @@ static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_
     if (va + ra < vb - rb) return bend_bound(s->a, sa, box, c, rad, va, evals);
     if (vb + rb < va - ra) return bend_bound(s->b, sb, box, c, rad, vb, evals);
     return INFINITY;
+}
+
+/* Whether phi is convex on the box (a half-space, or the field says so) */
+static int convex_on(const scc_sdf* sdf, const scc_aabb* box)
+{
+    return sdf->kind == SCC_SDF_HALF_SPACE || scc_sdf_convex_in(sdf, box);
+}
+
+static double bend_bound(const scc_sdf* sdf, int sign, const scc_aabb* box, scc_vec3 c, double rad, double v, int64_t* evals)
+{
+    if (sdf->kind == SCC_SDF_HALF_SPACE || (sign > 0 && scc_sdf_convex_in(sdf, box))) return 0.0;
+    return bend_bound_nonconvex(sdf, sign, box, c, rad, v, evals);
 }
 
 double scc_sdf_bend_bound(const scc_sdf* sdf, scc_vec3 c, double rad)
@@ -210,20 +226,206 @@ typedef struct first_order {
     double lin, lin_space, lin_time, curve;
 } first_order;
 
-static first_order first_order_terms(const scc_tri_state* st, const region* r, scc_vec3 c, scc_vec3 gc, double accel)
+/* A region's corners at its start and their velocities. */
+typedef struct corners {
+    scc_vec3 x[3], v[3];
+} corners;
+
+static corners corners_of(const scc_tri_state* st, const region* r)
+{
+    corners k;
+    for (int i = 0; i < 3; ++i) {
+        k.x[i] = corner(st, r->u[i], r->v[i]);
+        k.v[i] = scc_add(scc_add(scc_scale(st->v[0], r->u[i]), scc_scale(st->v[1], r->v[i])), scc_scale(st->v[2], 1.0 - r->u[i] - r->v[i]));
+    }
+    return k;
+}
+
+static first_order first_order_of(const corners* k, double dt, scc_vec3 c, scc_vec3 gc, double accel)
 {
     first_order f = { INFINITY, INFINITY, INFINITY, 0.0 };
-    const double dt = r->tb - r->ta;
     for (int i = 0; i < 3; ++i) {
-        scc_vec3 xi = corner(st, r->u[i], r->v[i]);
-        scc_vec3 vi = scc_add(scc_add(scc_scale(st->v[0], r->u[i]), scc_scale(st->v[1], r->v[i])), scc_scale(st->v[2], 1.0 - r->u[i] - r->v[i]));
-        double at0 = scc_dot(gc, scc_sub(xi, c)), drift = dt * scc_dot(gc, vi);
-        f.lin = fmin(f.lin, fmin(at0, at0 + drift));
-        f.lin_space = fmin(f.lin_space, at0);
-        f.lin_time = fmin(f.lin_time, drift);
+        const double at0 = scc_dot(gc, scc_sub(k->x[i], c)), drift = dt * scc_dot(gc, k->v[i]);
+        const double lo = drift < 0.0 ? at0 + drift : at0;
+        f.lin = lo < f.lin ? lo : f.lin;
+        f.lin_space = at0 < f.lin_space ? at0 : f.lin_space;
+        f.lin_time = drift < f.lin_time ? drift : f.lin_time;
     }
     f.curve = scc_len(gc) * 0.5 * accel * dt * dt;
     return f;
+}
+
+static first_order first_order_terms(const scc_tri_state* st, const region* r, scc_vec3 c, scc_vec3 gc, double accel)
+{
+    const corners k = corners_of(st, r);
+    return first_order_of(&k, r->tb - r->ta, c, gc, accel);
+}
+
+/* The search's samples by (time, weights) (ours): a region split in time keeps its start's samples, the
+ * first half's samples at its end are the second half's at its start, and neighbouring sub-triangles
+ * share corners; a point computed from the same time and weights is the same point, so its value is
+ * looked up instead of evaluated again (direct-mapped; a collision only costs an evaluation). */
+#define SAMPLE_CACHE 128
+typedef struct sample_slot {
+    uint64_t key[3]; /* the bits of t, u, v (t NaN: empty) */
+    double phi;
+    scc_vec3 g;
+} sample_slot;
+typedef struct sample_cache {
+    sample_slot s[SAMPLE_CACHE];
+} sample_cache;
+
+static uint64_t bits_of(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+/* phi and its gradient at weights (u, v, 1 - u - v) of the triangle in state st (time t). */
+static double sample_at(sample_cache* sc, const scc_sdf* sdf, const scc_tri_state* st, double t, double u, double v, scc_vec3* g,
+                        int64_t* evals)
+{
+    const uint64_t k0 = bits_of(t), k1 = bits_of(u), k2 = bits_of(v);
+    const uint64_t hash = (k0 * 0x9E3779B97F4A7C15ull) ^ (k1 * 0xC2B2AE3D27D4EB4Full) ^ (k2 * 0x165667B19E3779F9ull);
+    sample_slot* e = &sc->s[(hash ^ (hash >> 29)) % SAMPLE_CACHE];
+    if (e->key[0] == k0 && e->key[1] == k1 && e->key[2] == k2) {
+        *g = e->g;
+        return e->phi;
+    }
+    ++*evals;
+    e->phi = scc_sdf_eval(sdf, corner(st, u, v), &e->g);
+    e->key[0] = k0;
+    e->key[1] = k1;
+    e->key[2] = k2;
+    *g = e->g;
+    return e->phi;
+}
+
+/* The triangle's last two states (regions popped in a row often start at the same time): the same
+ * numbers scc_tri_state_at gives, computed once. */
+typedef struct state_cache {
+    scc_tri_state s[2];
+    int next;
+} state_cache;
+
+static const scc_tri_state* state_at(state_cache* sc, const scc_tri_motion* m, double t)
+{
+    for (int i = 0; i < 2; ++i)
+        if (bits_of(sc->s[i].t) == bits_of(t)) return &sc->s[i];
+    scc_tri_state* e = &sc->s[sc->next];
+    sc->next ^= 1;
+    scc_tri_state_at(m, t, e);
+    e->t = t;
+    return e;
+}
+
+/* The support-plane bound of a convex phi over a region (ours, issue 20 item 6): with samples y_j of
+ * the region (value f_j, gradient g_j) every plane f_j + g_j.(x - y_j) lies below phi on a box where
+ * phi is convex, so phi >= max_j of them. Over the region (weights b on its corners, s in [0, dt]) each
+ * plane is at least k_j + sum_i b_i d_ji, with d_ji the smaller of its value at corner i at s = 0 and
+ * s = dt and k_j less the motion's curvature (first_order_terms); the bound is the smallest over the
+ * corners' simplex of the largest of these affine functions, attained at a vertex of their
+ * arrangement: a corner, where two cross on an edge, or where three meet inside. Near a kink such as
+ * a cone's tip, planes from around it close over it (a point above the tip at height h: about h^2 /
+ * |y - tip| for each plane, where the centroid's one plane needs regions smaller than h). */
+/* The smallest over the simplex of weights b of max_j (k_j + sum_i b_i d_ji), j < n: attained at a
+ * vertex of the arrangement of these affine functions (a corner, where two cross on an edge, or where
+ * three meet inside), which are all tried; or, once one is at most `stop`, that one. */
+static double simplex_minmax(const double* k, const double (*d)[3], int n, double stop)
+{
+#define PLANES_MAX(B0, B1, B2, OUT)                                                        \
+    do {                                                                                   \
+        double m_ = -INFINITY;                                                             \
+        for (int j_ = 0; j_ < n; ++j_) {                                                   \
+            const double x_ = k[j_] + (B0) * d[j_][0] + (B1) * d[j_][1] + (B2) * d[j_][2]; \
+            m_ = x_ > m_ ? x_ : m_;                                                        \
+        }                                                                                  \
+        OUT = m_;                                                                          \
+    } while (0)
+    double best = INFINITY, val;
+    for (int i = 0; i < 3; ++i) { /* the corners */
+        PLANES_MAX(i == 0, i == 1, i == 2, val);
+        best = val < best ? val : best;
+    }
+    if (best <= stop) return best;
+    for (int i = 0; i < 3; ++i) { /* the edges from corner i to corner i + 1: lam in (0, 1) where two planes cross */
+        const int e = (i + 1) % 3;
+        for (int j = 0; j < n; ++j)
+            for (int l = j + 1; l < n; ++l) {
+                const double a0 = k[j] + d[j][i] - k[l] - d[l][i], slope = (d[j][e] - d[j][i]) - (d[l][e] - d[l][i]);
+                if (slope == 0.0) continue;
+                const double lam = -a0 / slope;
+                if (!(lam > 0.0 && lam < 1.0)) continue;
+                double b[3] = { 0, 0, 0 };
+                b[i] = 1.0 - lam;
+                b[e] = lam;
+                PLANES_MAX(b[0], b[1], b[2], val);
+                best = val < best ? val : best;
+                if (best <= stop) return best;
+            }
+    }
+    for (int j = 0; j < n; ++j) /* inside: where three planes meet (b2 = 1 - b0 - b1) */
+        for (int l = j + 1; l < n; ++l)
+            for (int q = l + 1; q < n; ++q) {
+                const int p2[2] = { l, q };
+                double A[2][2], rhs[2];
+                for (int s = 0; s < 2; ++s) {
+                    const int o = p2[s];
+                    A[s][0] = (d[j][0] - d[j][2]) - (d[o][0] - d[o][2]);
+                    A[s][1] = (d[j][1] - d[j][2]) - (d[o][1] - d[o][2]);
+                    rhs[s] = (k[o] + d[o][2]) - (k[j] + d[j][2]);
+                }
+                const double det = A[0][0] * A[1][1] - A[0][1] * A[1][0];
+                if (det == 0.0) continue;
+                const double b0 = (rhs[0] * A[1][1] - A[0][1] * rhs[1]) / det, b1 = (A[0][0] * rhs[1] - rhs[0] * A[1][0]) / det;
+                if (!(b0 > 0.0 && b1 > 0.0 && b0 + b1 < 1.0)) continue;
+                PLANES_MAX(b0, b1, 1.0 - b0 - b1, val);
+                best = val < best ? val : best;
+                if (best <= stop) return best;
+            }
+#undef PLANES_MAX
+    return best;
+}
+
+/* The support-plane bounds (see above). `full`: over the region. When that does not exceed `margin`,
+ * also `zero`: over the region's start (s = 0) alone, `rate`, the fastest any plane can fall along the
+ * corners' velocities, and `q`, its curvature term's factor: over [ta, ta + s] the bound is then at least
+ * zero - rate s - q s^2 (conservative advancement). All -INFINITY when a sample is not finite. */
+typedef struct planes {
+    double full, zero, rate, q;
+} planes;
+
+static planes planes_bound(const corners* cx, double dt, const scc_vec3* y, const double* f, const scc_vec3* g, int n, double accel,
+                           double margin)
+{
+    planes out = { -INFINITY, -INFINITY, 0.0, 0.0 };
+    double k[4], a[4][3], d[4][3], mag = 0.0, mag0 = 0.0;
+    const scc_vec3* x = cx->x;
+    const scc_vec3* v = cx->v;
+    for (int j = 0; j < n; ++j) {
+        const double gl = scc_len(g[j]);
+        if (!(isfinite(f[j]) && isfinite(gl))) return out;
+        const double q = 0.5 * gl * accel;
+        k[j] = f[j] - gl * 0.5 * accel * dt * dt;
+        out.q = q > out.q ? q : out.q;
+        for (int i = 0; i < 3; ++i) {
+            const double ai = scc_dot(g[j], scc_sub(x[i], y[j])), ci = scc_dot(g[j], v[i]), bi = ai + dt * ci;
+            a[j][i] = ai;
+            d[j][i] = ai < bi ? ai : bi;
+            out.rate = -ci > out.rate ? -ci : out.rate;
+            const double m0 = fabs(f[j]) + gl * scc_dist(x[i], y[j]), m = m0 + gl * dt * scc_len(v[i]);
+            mag = m > mag ? m : mag;
+            mag0 = m0 > mag0 ? m0 : mag0;
+        }
+    }
+    /* the arrangement's vertices are computed with rounding: less a margin relative to the sizes */
+    const double eps = 1e-12 * mag + 1e-15;
+    out.full = simplex_minmax(k, (const double(*)[3])d, n, margin + eps) - eps;
+    /* `zero` matters only above margin + rate dt / 2 (the caller's advancement must exceed half the span) */
+    const double eps0 = 1e-12 * mag0 + 1e-15;
+    if (out.full <= margin) out.zero = simplex_minmax(f, (const double(*)[3])a, n, margin + 0.5 * dt * out.rate + eps0) - eps0;
+    return out;
 }
 
 /* The cached polynomial of full-grid cell ijk (hess < 0: no values there). */
@@ -353,7 +555,7 @@ int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const dou
     grid_bound_ctx ctx;
     ctx.g = (const scc_grid*)sdf;
     for (int i = 0; i < CELL_CACHE; ++i) ctx.cell[i].l = UINT64_MAX;
-    region r = { ta, tb, { u[0], u[1], u[2] }, { v[0], v[1], v[2] }, 0 };
+    region r = { ta, tb, { u[0], u[1], u[2] }, { v[0], v[1], v[2] }, 0, 0 };
     scc_tri_state st;
     scc_tri_state_at(m, ta, &st);
     const double cu = (u[0] + u[1] + u[2]) / 3.0, cv = (v[0] + v[1] + v[2]) / 3.0;
@@ -408,7 +610,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
      * popped region's start as the proven lower bound. */
     region_heap h = { NULL, 0, 0, alloc, 0, 0 };
     if (p->cert_max_bytes > 0) h.max_bytes = (uint64_t)p->cert_max_bytes > SIZE_MAX ? SIZE_MAX : (size_t)p->cert_max_bytes;
-    region root = { ta, tb, { 1, 0, 0 }, { 0, 1, 0 }, 0 };
+    region root = { ta, tb, { 1, 0, 0 }, { 0, 1, 0 }, 0, 0 };
     int capped = 0, ok = 1;
     if (!region_heap_push(&h, root)) {
         if (!h.full) return 0;
@@ -421,6 +623,11 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
     if (isfinite(seed_t))
         for (int j = 0; j < 3; ++j) hit_b[j] = seed_b[j];
     int64_t processed = 0, evals = 0;
+    sample_cache cache;
+    for (int i = 0; i < SAMPLE_CACHE; ++i) cache.s[i].key[0] = bits_of(NAN);
+    state_cache states;
+    states.s[0].t = states.s[1].t = NAN;
+    states.next = 0;
     int clipped = 0; /* a region was cut at seed_t - seed_tol: nothing is proven after that */
     while (h.n) {
         region r = region_heap_pop(&h);
@@ -437,13 +644,11 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             r.tb = seed_t - seed_tol;
             clipped = 1;
         }
-        scc_tri_state st;
-        scc_tri_state_at(m, r.ta, &st);
+        const scc_tri_state st = *state_at(&states, m, r.ta);
         double cu = (r.u[0] + r.u[1] + r.u[2]) / 3.0, cv = (r.v[0] + r.v[1] + r.v[2]) / 3.0;
         scc_vec3 c = corner(&st, cu, cv);
         scc_vec3 gc;
-        double phi = scc_sdf_eval(sdf, c, &gc);
-        ++evals;
+        double phi = sample_at(&cache, sdf, &st, r.ta, cu, cv, &gc, &evals);
         if (phi <= p->margin && r.ta < hi) {
             hi = r.ta;
             hit_b[0] = cu; hit_b[1] = cv; hit_b[2] = 1.0 - cu - cv;
@@ -451,7 +656,8 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             break; /* sampled at the region's earliest time: nothing earlier is unresolved */
         }
         double rs = 0.0;
-        for (int i = 0; i < 3; ++i) rs = fmax(rs, scc_dist(corner(&st, r.u[i], r.v[i]), c));
+        const corners cx = corners_of(&st, &r);
+        for (int i = 0; i < 3; ++i) rs = fmax(rs, scc_dist(cx.x[i], c));
         double rt = speed * (r.tb - r.ta);
         double rho = rs + rt;
         scc_aabb box = { scc_sub(c, scc_v3(rho, rho, rho)), scc_add(c, scc_v3(rho, rho, rho)) };
@@ -460,14 +666,46 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         /* Which part of the bound's slack to refine: the Lipschitz ball's spatial and temporal
          * radii, or, for a convex phi, the spatial and temporal parts of the first-order bound. */
         double slack_space = rs, slack_time = rt;
-        const double bend = grid ? INFINITY : bend_bound(sdf, 1, &box, c, rho, phi, &evals);
+        int done = 0, corners_done = 0;
+        double cut = 0.0; /* > 0: [ta, ta + cut] is proven clear (conservative advancement) */
+        /* an ancestor's box holds the region too, so its convexity is inherited (sub-regions skip the test) */
+        const int convex = !grid && (r.convex || convex_on(sdf, &box));
+        r.convex = convex;
+        const double bend = grid ? INFINITY : convex ? 0.0 : bend_bound_nonconvex(sdf, 1, &box, c, rho, phi, &evals);
         if (bend < INFINITY) {
             /* First-order bound of a convex phi, less the bending term: phi(x) >= phi(c) + g.(x - c)
              * - K rho^2 / 2 (first_order_terms, bend_bound). Tangential sliding costs only K. */
-            const first_order f = first_order_terms(&st, &r, c, gc, accel);
+            const first_order f = first_order_of(&cx, r.tb - r.ta, c, gc, accel);
             const double curv = 0.5 * bend * rho * rho;
             const double bound = phi + f.lin - f.curve - curv;
             if (bound > p->margin) continue;
+            if (convex) {
+                /* phi convex on the box (not only its active CSG operand): the corners at ta, which
+                 * are witness samples too, give support planes (planes_bound) */
+                scc_vec3 y[4], gy[4];
+                double fy[4];
+                y[0] = c; fy[0] = phi; gy[0] = gc;
+                for (int i = 0; i < 3 && !done; ++i) {
+                    y[i + 1] = cx.x[i];
+                    fy[i + 1] = sample_at(&cache, sdf, &st, r.ta, r.u[i], r.v[i], &gy[i + 1], &evals);
+                    if (fy[i + 1] <= p->margin) {
+                        hi = lo = r.ta;
+                        hit_b[0] = r.u[i]; hit_b[1] = r.v[i]; hit_b[2] = 1.0 - r.u[i] - r.v[i];
+                        done = 1;
+                    }
+                }
+                if (done) break;
+                corners_done = 1;
+                const planes pl = planes_bound(&cx, r.tb - r.ta, y, fy, gy, 4, accel, p->margin);
+                if (pl.full > p->margin) continue;
+                /* conservative advancement: [ta, ta + s] is clear while zero - margin - rate s - q s^2 > 0;
+                 * used where it proves more than a halving of the interval would */
+                const double b0 = pl.zero - p->margin;
+                if (b0 > 0.0) {
+                    const double sc = 0.99 * 2.0 * b0 / (pl.rate + sqrt(pl.rate * pl.rate + 4.0 * pl.q * b0));
+                    if (sc >= 0.5 * (r.tb - r.ta) && sc < r.tb - r.ta) cut = sc;
+                }
+            }
             if (bound > phi - L * rho) {
                 slack_space = -fmin(f.lin_space, 0.0) + (rho > 0.0 ? curv * rs / rho : 0.0);
                 slack_time = -fmin(f.lin_time, 0.0) + f.curve + (rho > 0.0 ? curv * rt / rho : 0.0);
@@ -486,11 +724,10 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         /* Unresolved: look for witnesses at the corners at ta (a contact there is exact: nothing
          * earlier is unresolved) and at the centroid and corners at tb (an upper bound). Corners
          * matter: at a vertex-first contact the centroid alone stays borderline at every scale. */
-        int done = 0;
         const int sample = !(isfinite(seed_t) && hi == seed_t) || r.depth % WITNESS_EVERY == 0; /* unseeded or past the seed: always */
-        for (int i = 0; i < 3 && !done && sample; ++i) {
-            ++evals;
-            if (scc_sdf_eval(sdf, corner(&st, r.u[i], r.v[i]), NULL) <= p->margin) {
+        for (int i = 0; i < 3 && !done && sample && !corners_done; ++i) {
+            scc_vec3 g;
+            if (sample_at(&cache, sdf, &st, r.ta, r.u[i], r.v[i], &g, &evals) <= p->margin) {
                 hi = lo = r.ta;
                 hit_b[0] = r.u[i]; hit_b[1] = r.v[i]; hit_b[2] = 1.0 - r.u[i] - r.v[i];
                 done = 1;
@@ -498,19 +735,27 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         }
         if (done) break;
         if (r.tb < hi && sample) {
-            scc_tri_state se;
-            scc_tri_state_at(m, r.tb, &se);
+            const scc_tri_state se = *state_at(&states, m, r.tb);
             double su[4] = { cu, r.u[0], r.u[1], r.u[2] }, sv[4] = { cv, r.v[0], r.v[1], r.v[2] };
             for (int i = 0; i < 4; ++i) {
-                ++evals;
-                if (scc_sdf_eval(sdf, corner(&se, su[i], sv[i]), NULL) <= p->margin) {
+                scc_vec3 g;
+                if (sample_at(&cache, sdf, &se, r.tb, su[i], sv[i], &g, &evals) <= p->margin) {
                     hi = r.tb;
                     hit_b[0] = su[i]; hit_b[1] = sv[i]; hit_b[2] = 1.0 - su[i] - sv[i];
                     break;
                 }
             }
         }
-        if (slack_time >= slack_space) {
+        if (cut > 0.0) {
+            region b = r;
+            b.depth = r.depth + 1;
+            b.ta = r.ta + cut;
+            if (b.ta < hi && !region_heap_push(&h, b)) {
+                if (h.full) capped = 1;
+                else ok = 0;
+                break;
+            }
+        } else if (slack_time >= slack_space) {
             double tm = 0.5 * (r.ta + r.tb);
             region a = r, b = r;
             a.depth = b.depth = r.depth + 1;
@@ -529,10 +774,10 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
                 mv[i] = 0.5 * (r.v[i] + r.v[j]);
             }
             region k[4] = {
-                { r.ta, r.tb, { r.u[0], mu[0], mu[2] }, { r.v[0], mv[0], mv[2] }, r.depth + 1 },
-                { r.ta, r.tb, { mu[0], r.u[1], mu[1] }, { mv[0], r.v[1], mv[1] }, r.depth + 1 },
-                { r.ta, r.tb, { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] }, r.depth + 1 },
-                { r.ta, r.tb, { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] }, r.depth + 1 },
+                { r.ta, r.tb, { r.u[0], mu[0], mu[2] }, { r.v[0], mv[0], mv[2] }, r.depth + 1, r.convex },
+                { r.ta, r.tb, { mu[0], r.u[1], mu[1] }, { mv[0], r.v[1], mv[1] }, r.depth + 1, r.convex },
+                { r.ta, r.tb, { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] }, r.depth + 1, r.convex },
+                { r.ta, r.tb, { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] }, r.depth + 1, r.convex },
             };
             for (int i = 0; i < 4 && ok; ++i) ok = region_heap_push(&h, k[i]);
             if (!ok) {

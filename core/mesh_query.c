@@ -15,8 +15,9 @@
 
 #include <string.h>
 
-/* Evaluations of the certified clear proof tried on a triangle before FWGSS (test_triangle). */
-#define SCC_PRECHECK_EVALS 32
+/* Evaluations of the certified clear proof tried on a triangle before FWGSS (test_triangle; chosen
+ * on the scaling scene, CHANGELOG). */
+#define SCC_PRECHECK_EVALS 24
 /* Proofs that may fail before the first clears (then two more per triangle cleared): where they fail
  * the triangles are large against their clearance (1K scaling scene: 19 of 19 failed, 6.6 % more
  * evaluations when every triangle tried). */
@@ -95,15 +96,28 @@ double scc_mesh_speed_bound(const scc_mesh_motion* mm)
     return speed;
 }
 
+/* The records are made usable a page of SCC_TRACE_PAGE at a time, when a triangle first hands one out
+ * (ours): a mark per page after the records says whether its records were set since the marks were
+ * laid out, so a new workspace (scc_query_mesh makes one per call) clears the marks, a byte per page,
+ * instead of every record of a large mesh of which a query tests a few triangles. */
+#define SCC_TRACE_PAGE 16
+
+static uint8_t* trace_pages(scc_vertex_trace* traces, const scc_mesh* mesh)
+{
+    return (uint8_t*)(traces + mesh->vertex_count);
+}
+
 scc_vertex_trace* scc_mesh_traces(scc_workspace* ws, const scc_mesh* mesh)
 {
     /* Records of earlier queries are told apart by the epoch, so nothing is cleared per query. */
-    size_t need = (size_t)mesh->vertex_count * sizeof(scc_vertex_trace);
-    int fresh = ws->slot[SCC_WS_TRACES].bytes < need;
+    const size_t pages = (mesh->vertex_count + SCC_TRACE_PAGE - 1) / SCC_TRACE_PAGE;
+    const size_t need = (size_t)mesh->vertex_count * sizeof(scc_vertex_trace) + pages;
+    const int fresh = ws->slot[SCC_WS_TRACES].bytes < need || ws->trace_count != mesh->vertex_count;
     scc_vertex_trace* traces = scc_ws_get(ws, SCC_WS_TRACES, need);
     if (!traces) return NULL;
     if (fresh || ++ws->trace_epoch == 0) {
-        memset(traces, 0, ws->slot[SCC_WS_TRACES].bytes);
+        memset(trace_pages(traces, mesh), 0, pages);
+        ws->trace_count = mesh->vertex_count;
         ws->trace_epoch = 1;
     }
     return traces;
@@ -112,7 +126,14 @@ scc_vertex_trace* scc_mesh_traces(scc_workspace* ws, const scc_mesh* mesh)
 void scc_triangle_traces(scc_vertex_trace* traces, const scc_mesh* mesh, uint32_t t, uint32_t epoch, scc_vertex_trace* out[3])
 {
     const uint32_t* f = mesh->indices + 3 * t;
+    uint8_t* pages = trace_pages(traces, mesh);
     for (int i = 0; i < 3; ++i) {
+        const uint32_t page = f[i] / SCC_TRACE_PAGE;
+        if (!pages[page]) { /* never set since the marks were laid out: no record of it is in use */
+            const uint32_t first = page * SCC_TRACE_PAGE, n = mesh->vertex_count - first < SCC_TRACE_PAGE ? mesh->vertex_count - first : SCC_TRACE_PAGE;
+            memset(traces + first, 0, n * sizeof *traces);
+            pages[page] = 1;
+        }
         scc_vertex_trace* r = &traces[f[i]];
         if (r->epoch != epoch) {
             r->epoch = epoch;
@@ -137,6 +158,16 @@ typedef struct deferred_tri {
     uint32_t triangle;
 } deferred_tri;
 
+/* A triangle whose FWGSS waits until the earliest candidate time reaches the lower bound its pre-check
+ * proved (test_triangle). */
+typedef struct pending_tri {
+    double lower, tb;   /* the bound, and the end of the interval its pre-check had */
+    uint32_t triangle;
+    int rounds;         /* pre-checks so far */
+} pending_tri;
+#define SCC_PENDING_MAX 32
+#define SCC_PENDING_ROUNDS 3 /* pre-checks per triangle at most */
+
 typedef struct mesh_ctx {
     scc_mesh_query_in in;        /* the query's inputs, handed to the broad phase as they are */
     contact_buf buf;
@@ -159,6 +190,8 @@ typedef struct mesh_ctx {
     deferred_tri* deferred;      /* the triangles searched so, in the order searched */
     size_t n_deferred, cap_deferred;
     double provisional;          /* the earliest of their FWGSS contacts (a witness: the TOI is no later) */
+    pending_tri pending[SCC_PENDING_MAX]; /* triangles whose pre-check raised their lower bound, waiting for FWGSS */
+    int n_pending;
 } mesh_ctx;
 
 /* Evaluations left of the query's budget (narrow phase so far plus the broad phase's marching). */
@@ -192,11 +225,12 @@ static int take_answer(mesh_ctx* c, scc_query_summary* s, const scc_contact* loc
 /* The certified search's short clear proof before FWGSS (ours, issue 20 item 6): on a kinked
  * analytic field its first-order bounds clear a triangle that passes a convex piece without touching
  * it in tens of evaluations, where FWGSS's descents spend hundreds before their deferred check proves
- * the same (100K scaling scene: 9 of 13 triangles cleared in 1-23 evaluations each). Returns 1 when
- * the triangle is done (cleared on [ta, tb], or the budget ran out), 0 when FWGSS goes on, -1 on
- * allocation failure; tp->max_evals loses what the proof spent. */
-static int precheck(mesh_ctx* c, const scc_tri_motion* m, double ta, double tb, scc_params* tp)
+ * the same. Where it does not close, *lower is the start of the interval it left unproven (ta when it
+ * proved nothing). Returns 1 when the triangle is done (cleared on [ta, tb], or the budget ran out), 0
+ * when FWGSS goes on, -1 on allocation failure; tp->max_evals loses what the proof spent. */
+static int precheck(mesh_ctx* c, const scc_tri_motion* m, double ta, double tb, scc_params* tp, double* lower)
 {
+    *lower = ta;
     scc_tri_hit h;
     const int64_t budget = tp->max_evals < SCC_PRECHECK_EVALS ? tp->max_evals : SCC_PRECHECK_EVALS;
     if (!scc_certified_clear(c->in.sdf, m, ta, tb, tp, c->in.ws->alloc, budget, &h)) return -1;
@@ -209,13 +243,14 @@ static int precheck(mesh_ctx* c, const scc_tri_motion* m, double ta, double tb, 
         return 1;
     }
     c->pre_failed += 1;
+    if (h.state == SCC_NOT_CONVERGED && h.toi_lower > ta) *lower = h.toi_lower; /* proven: no contact before it */
     if (tp->max_evals <= 0) c->budget_exhausted = 1; /* its contacts stay unproven */
     return c->budget_exhausted;
 }
 
 /* Narrow phase of triangle t on [ta, min(t1, best + window)], where ta is t0 or the broad phase's
  * candidate time (a proven lower bound of the triangle's contacts). Returns 0 on allocation failure. */
-static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
+static int test_triangle(mesh_ctx* c, uint32_t t, double ta, int rounds)
 {
     const scc_mesh_motion* mm = c->in.mm;
     scc_params tp = *c->in.p;
@@ -253,10 +288,14 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta)
     if (c->probe) c->probe(c->probe_user, t, 1);
     if (!(ta < tb)) ta = mm->t0;
     /* while the proofs pay: at most SCC_PRECHECK_MISSES more failed than twice the cleared */
-    const int pre = c->precheck && c->pre_failed < SCC_PRECHECK_MISSES + 2 * c->pre_cleared ? precheck(c, &m, ta, tb, &tp) : 0;
-    if (pre != 0) {
+    double lower = ta;
+    const int pre = rounds >= 0 && c->precheck && c->pre_failed < SCC_PRECHECK_MISSES + 2 * c->pre_cleared ? precheck(c, &m, ta, tb, &tp, &lower) : 0;
+    if (pre != 0 || (lower > ta && rounds < SCC_PENDING_ROUNDS && c->n_pending < SCC_PENDING_MAX)) {
+        /* done, or FWGSS waits until the candidates reach the raised lower bound (drain_pending): by
+         * then an earlier contact may have been found and the triangle need not be searched at all */
+        if (pre == 0) c->pending[c->n_pending++] = (pending_tri){ lower, tb, t, rounds + 1 };
         if (c->probe) c->probe(c->probe_user, t, 0);
-        return pre > 0;
+        return pre >= 0;
     }
     int deferred = 0;
     scc_tri_hit raw;
@@ -311,15 +350,39 @@ static int finish_deferred(mesh_ctx* c)
     return 1;
 }
 
+/* The waiting triangles whose lower bound is at most `upto`, earliest first: FWGSS from that bound, or
+ * nothing when the earliest contact found plus the window lies before it (ours, issue 20 item 6). */
+static int drain_pending(mesh_ctx* c, double upto)
+{
+    while (c->n_pending > 0 && !c->budget_exhausted) {
+        int k = 0;
+        for (int i = 1; i < c->n_pending; ++i)
+            if (c->pending[i].lower < c->pending[k].lower) k = i;
+        const pending_tri w = c->pending[k];
+        if (w.lower > upto) break;
+        c->pending[k] = c->pending[--c->n_pending];
+        const double tb = fmin(c->in.mm->t1, fmin(c->best, c->provisional) + c->in.p->toi_window);
+        if (w.lower >= tb) { /* its contacts start after the window */
+            c->sum->triangles_tested += 1;
+            c->lower = fmin(c->lower, w.lower);
+            continue;
+        }
+        /* the pre-check again where the interval has shrunk since, else FWGSS */
+        if (!test_triangle(c, w.triangle, w.lower, tb < w.tb ? w.rounds : -1)) return 0;
+    }
+    return 1;
+}
+
 static int visit_candidate(void* user, uint32_t triangle, double t_candidate, double* io_t_end)
 {
     mesh_ctx* c = user;
     const scc_mesh_motion* mm = c->in.mm;
+    if (!drain_pending(c, t_candidate)) return 0;
     /* The candidate time is a proven lower bound of the triangle's contacts, so the narrow phase
      * searches from there. FW (the paper's Section 4.2 baseline) keeps the whole interval: it is a
      * local method whose step sizes scale with the interval. */
     double ta = c->in.p->method == SCC_METHOD_FW ? mm->t0 : fmax(mm->t0, t_candidate);
-    if (!test_triangle(c, triangle, ta)) return 0;
+    if (!test_triangle(c, triangle, ta, 0)) return 0;
     *io_t_end = fmin(*io_t_end, fmin(mm->t1, fmin(c->best, c->provisional) + c->in.p->toi_window));
     if (c->budget_exhausted) *io_t_end = -INFINITY; /* stops the traversal */
     return 1;
@@ -451,6 +514,7 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
         c.cap_deferred = 0;
     }
     c.provisional = INFINITY;
+    c.n_pending = 0;
     sum->iterations = sum->evals = sum->triangles_tested = 0;
     int ok = 1;
     /* FWGSS's vertex traces; DCD keeps each vertex's value at the tested pose there (scc_dcd_traced) */
@@ -468,8 +532,9 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     } else if (p->broad_phase && mm->mesh->triangle_count > 0) {
         ok = run_broad_phase(&c);
     } else {
-        for (uint32_t t = 0; t < mm->mesh->triangle_count && ok && !c.budget_exhausted; ++t) ok = test_triangle(&c, t, mm->t0);
+        for (uint32_t t = 0; t < mm->mesh->triangle_count && ok && !c.budget_exhausted; ++t) ok = test_triangle(&c, t, mm->t0, 0);
     }
+    if (ok) ok = drain_pending(&c, INFINITY);
     if (ok) ok = finish_deferred(&c);
     scc_ws_adopt(ws, SCC_WS_DEFERRED, c.deferred, c.cap_deferred * sizeof *c.deferred);
     if (out_broad_evals) *out_broad_evals = c.broad_evals;

@@ -43,6 +43,7 @@ typedef struct scc_workspace {
     const scc_allocator* alloc;
     scc_ws_slot slot[SCC_WS_SLOTS];
     uint32_t trace_epoch;  /* mesh queries so far (tags the SCC_WS_TRACES records in use) */
+    uint32_t trace_count;  /* the records' count the SCC_WS_TRACES page marks are laid out for (mesh_query.c) */
     uint32_t mark_epoch;   /* vertex marks handed out so far (tags SCC_WS_MARKS) */
 } scc_workspace;
 
@@ -50,6 +51,7 @@ static inline void scc_ws_init(scc_workspace* ws, const scc_allocator* alloc)
 {
     ws->alloc = alloc;
     ws->trace_epoch = 0;
+    ws->trace_count = 0;
     ws->mark_epoch = 0;
     for (int i = 0; i < SCC_WS_SLOTS; ++i) {
         ws->slot[i].p = NULL;

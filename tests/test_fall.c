@@ -190,6 +190,16 @@ static void soup_mesh(const double (*v)[3][3], int n, scc_vec3* vv, uint32_t* f,
     mesh->triangle_count = (uint32_t)n;
 }
 
+/* Five triangles of the 100K scene's step 2 (corners in the armadillo's frame): two far from the
+ * spike-apex one, then 35101, 6138 and the spike-apex one, 70699. */
+static const double k_step2[5][3][3] = {
+    { { 0.23302899999999999, 0.079539499999999999, -0.564276 }, { 0.23854449999999999, 0.044285000000000005, -0.5660639999999999 }, { 0.2241205, 0.060809500000000002, -0.56586500000000006 } },
+    { { 0.23302899999999999, 0.079539499999999999, -0.564276 }, { 0.24745300000000001, 0.063015000000000002, -0.56447499999999995 }, { 0.23854449999999999, 0.044285000000000005, -0.5660639999999999 } },
+    { { -0.25264049999999999, 0.08133, -0.57058399999999998 }, { -0.26492100000000002, 0.060382999999999999, -0.570608 }, { -0.25639000000000001, 0.074555499999999997, -0.56993099999999997 } },
+    { { -0.25264049999999999, 0.08133, -0.57058399999999998 }, { -0.2544515, 0.063916500000000001, -0.57114500000000001 }, { -0.26492100000000002, 0.060382999999999999, -0.570608 } },
+    { { -0.25639000000000001, 0.074555499999999997, -0.56993099999999997 }, { -0.26352050000000005, 0.067516499999999993, -0.56918650000000004 }, { -0.25498949999999998, 0.081688999999999998, -0.5685095 } },
+};
+
 /* Five triangles of the 100K scene's step 2 with the spike-apex one (70699): the broad phase hands
  * over two triangles with later contacts (at 0.0331 and 0.0279) first, whose FWGSS answers the mesh
  * query now checks only up to the earliest contact (mesh_query.c, deferred checks). The answer must
@@ -198,13 +208,7 @@ static void soup_mesh(const double (*v)[3][3], int n, scc_vec3* vv, uint32_t* f,
  * bracket, and the query must spend fewer evaluations than the triangles' own checked queries. */
 START_TEST(test_deferred_checks)
 {
-    static const double v[5][3][3] = {
-        { { 0.23302899999999999, 0.079539499999999999, -0.564276 }, { 0.23854449999999999, 0.044285000000000005, -0.5660639999999999 }, { 0.2241205, 0.060809500000000002, -0.56586500000000006 } },
-        { { 0.23302899999999999, 0.079539499999999999, -0.564276 }, { 0.24745300000000001, 0.063015000000000002, -0.56447499999999995 }, { 0.23854449999999999, 0.044285000000000005, -0.5660639999999999 } },
-        { { -0.25264049999999999, 0.08133, -0.57058399999999998 }, { -0.26492100000000002, 0.060382999999999999, -0.570608 }, { -0.25639000000000001, 0.074555499999999997, -0.56993099999999997 } },
-        { { -0.25264049999999999, 0.08133, -0.57058399999999998 }, { -0.2544515, 0.063916500000000001, -0.57114500000000001 }, { -0.26492100000000002, 0.060382999999999999, -0.570608 } },
-        { { -0.25639000000000001, 0.074555499999999997, -0.56993099999999997 }, { -0.26352050000000005, 0.067516499999999993, -0.56918650000000004 }, { -0.25498949999999998, 0.081688999999999998, -0.5685095 } },
-    };
+    const double (*v)[3][3] = k_step2;
     scc_vec3 vv[15];
     uint32_t f[15];
     scc_mesh mesh;
@@ -250,7 +254,7 @@ END_TEST
  * that pass spikes without touching them before the scene's earliest contact (0.0270795 s) plus the
  * window. Certified queries of each triangle say so; the FWGSS mesh query over that interval (no
  * broad phase: every triangle on [t0, t1]) must answer no hit and cost exactly the triangles'
- * certified clear proofs (scc_certified_clear within the pre-check's 32 evaluations, each closing), so
+ * certified clear proofs (scc_certified_clear within the pre-check's 24 evaluations, each closing), so
  * no descent and no check runs, and fewer than the triangles' own checked FWGSS queries. */
 START_TEST(test_precheck_clears)
 {
@@ -285,8 +289,8 @@ START_TEST(test_precheck_clears)
         ck_assert(!s.hit);
         own += s.evals;
         scc_tri_hit h;
-        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 32, &h));
-        ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "triangle %u: no clear proof in 32 evaluations", t);
+        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 24, &h));
+        ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "triangle %u: no clear proof in 24 evaluations", t);
         proofs += h.evals;
     }
     scc_query_summary r;
@@ -301,6 +305,162 @@ START_TEST(test_precheck_clears)
 }
 END_TEST
 
+/* The support-plane bound of a convex field (certified.c, planes_bound): a face passes 50 um above a
+ * spike's tip (the tip under an off-centre point of the face) and stops 50 um above it. The first-order
+ * bound from a sub-triangle's centroid alone prunes it only once the sub-triangle is about as small as the
+ * gap (some 12 levels of splits here); the planes of its corners close over the tip at every scale. The
+ * certified clear proof must prove the interval clear within the pre-check's 24 evaluations, and the
+ * certified search must agree (no contact), for the tip under each of the face's three corners' sides. */
+START_TEST(test_clear_over_tip)
+{
+    scc_sdf_spike_grid spikes;
+    scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
+    const scc_vec3 tip = scc_v3(0.05, 0.05, 0.1); /* the cone of cell (10, 10) */
+    static const double off[3][3][2] = {
+        { { -0.010, -0.008 }, { 0.012, -0.006 }, { 0.001, 0.011 } },
+        { { -0.004, -0.013 }, { 0.015, 0.002 }, { -0.006, 0.009 } },
+        { { -0.014, 0.001 }, { 0.005, -0.010 }, { 0.007, 0.012 } },
+    };
+    for (int k = 0; k < 3; ++k) {
+        scc_tri_motion m;
+        memset(&m, 0, sizeof m);
+        m.kind = SCC_TRI_LINEAR;
+        m.t0 = 0.0;
+        m.t1 = DT;
+        for (int i = 0; i < 3; ++i) {
+            m.start[i] = scc_v3(tip.x + off[k][i][0], tip.y + off[k][i][1], tip.z + 1e-4);
+            m.end[i] = scc_v3(tip.x + off[k][i][0], tip.y + off[k][i][1], tip.z + 5e-5);
+        }
+        scc_params pf = params_of(SDFCCD_METHOD_FWGSS);
+        scc_tri_hit h;
+        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 1000000, &h));
+        printf("clear over a tip (%d): %lld evaluations, state %d\n", k, (long long)h.evals, (int)h.state);
+        ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "face %d: touches or unproven", k);
+        ck_assert_int_le(h.evals, 24);
+        scc_query_summary c;
+        scc_contact out[1 + SCC_MAX_SUBDIVISION_CONTACTS];
+        scc_params pc = params_of(SDFCCD_METHOD_CERTIFIED);
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &k_alloc, 0, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &c));
+        ck_assert(!c.hit && c.state == SCC_NO_HIT);
+    }
+}
+END_TEST
+
+/* New memory with a pattern in it: what the library writes shows (test_traces_lazily). */
+static void* pattern_alloc(size_t n, void* u)
+{
+    (void)u;
+    void* p = malloc(n);
+    if (p) memset(p, 0xA5, n);
+    return p;
+}
+
+/* The vertex records of a mesh query (mesh_query.c, scc_mesh_traces) are set up a page at a time as
+ * triangles are tested, not all at once: a 20K-triangle sheet falls onto the spike grid (FWGSS, broad
+ * phase) through a new workspace whose memory starts with a pattern; after the query, most of the
+ * records must still hold it, and the answer must be bit for bit that of a query through a workspace
+ * that has answered one before (records left by an earlier query). */
+START_TEST(test_traces_lazily)
+{
+    enum { N = 101 };
+    static scc_vec3 vv[N * N];
+    static uint32_t f[6 * (N - 1) * (N - 1)];
+    scc_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    for (int j = 0; j < N; ++j)
+        for (int i = 0; i < N; ++i) vv[j * N + i] = scc_v3(-0.2 + 0.4 * i / (N - 1), -0.2 + 0.4 * j / (N - 1), 0.0);
+    uint32_t nf = 0;
+    for (int j = 0; j + 1 < N; ++j)
+        for (int i = 0; i + 1 < N; ++i) {
+            const uint32_t a = (uint32_t)(j * N + i), b = a + 1, c = a + N, d = c + 1;
+            f[nf++] = a; f[nf++] = b; f[nf++] = d;
+            f[nf++] = a; f[nf++] = d; f[nf++] = c;
+        }
+    mesh.vertices = vv;
+    mesh.indices = f;
+    mesh.vertex_count = N * N;
+    mesh.triangle_count = nf / 3;
+    mesh.bounds.lo = scc_v3(-0.2, -0.2, 0.0);
+    mesh.bounds.hi = scc_v3(0.2, 0.2, 0.0);
+    mesh.bsh = scc_bsh_build(&mesh, &k_alloc);
+    ck_assert_ptr_nonnull(mesh.bsh);
+    scc_sdf_spike_grid spikes;
+    scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
+    scc_rigid body;
+    memset(&body, 0, sizeof body);
+    body.q0 = scc_quat_identity();
+    body.p0 = scc_v3(0.013, -0.021, 0.11);
+    body.v = scc_v3(0.0, 0.0, -2.0);
+    body.w = scc_v3(0.3, 0.2, 1.0);
+    scc_mesh_motion mm = { &mesh, &body, NULL, NULL, NULL, 0.0, DT, NULL, NULL };
+    scc_params p = params_of(SDFCCD_METHOD_FWGSS);
+    static scc_contact out[64], again[64];
+    const scc_allocator patterned = { pattern_alloc, t_free, NULL };
+    scc_workspace ws;
+    scc_ws_init(&ws, &patterned);
+    scc_query_summary r, r2;
+    ck_assert(scc_query_mesh_ws(&spikes.base, &mm, &p, &ws, out, 64, &r));
+    const unsigned char* rec = ws.slot[SCC_WS_TRACES].p;
+    const size_t bytes = (size_t)mesh.vertex_count * sizeof(scc_vertex_trace);
+    size_t kept = 0;
+    for (size_t i = 0; i < bytes; ++i) kept += rec[i] == 0xA5;
+    printf("traces: %u triangles tested, %.1f %% of the vertex records' bytes untouched\n", (unsigned)r.triangles_tested, 100.0 * kept / bytes);
+    ck_assert(r.hit);
+    ck_assert_int_lt(r.triangles_tested, mesh.triangle_count / 100);
+    ck_assert_msg(kept >= bytes * 9 / 10, "%zu of %zu bytes untouched", kept, bytes);
+    /* the same query again through the same workspace (records of the first, a new epoch) */
+    ck_assert(scc_query_mesh_ws(&spikes.base, &mm, &p, &ws, again, 64, &r2));
+    ck_assert(r2.hit == r.hit && r2.toi == r.toi && r2.toi_lower == r.toi_lower && r2.evals == r.evals && r2.contacts_found == r.contacts_found);
+    ck_assert(memcmp(out, again, (size_t)r.contacts_written * sizeof *out) == 0);
+    scc_ws_release(&ws);
+    scc_bsh_destroy((scc_bsh*)mesh.bsh, &k_alloc);
+}
+END_TEST
+
+/* Narrow-phase tests per triangle, counted by the mesh query's probe (test_pending_dropped). */
+static void count_tests(void* user, uint32_t triangle, int begin)
+{
+    if (begin) ((int*)user)[triangle] += 1;
+}
+
+/* Triangles wait for FWGSS (mesh_query.c, pending): three triangles of the 100K scene's step 2 (35101,
+ * 6138 and the spike-apex one, 70699) from 0.025 s, tested in this order (no broad phase). 35101's
+ * contact (0.027438 s) ends the interval of the next pre-checks; 6138's then proves no contact before
+ * 0.0272 s, later than the apex triangle's contact (0.02708 s) plus the window, so it waits and is
+ * dropped: it must be tested once (the pre-check), neither searched by FWGSS nor checked (before: both,
+ * two tests, 1,472 evaluations against 1,226), and the answer must lie in the certified bracket. The
+ * pre-check's bound rises that far by the certified search's conservative advancement (certified.c):
+ * without it, 6138 is searched too. */
+START_TEST(test_pending_dropped)
+{
+    scc_vec3 vv[9];
+    uint32_t f[9];
+    scc_mesh mesh;
+    soup_mesh(k_step2 + 2, 3, vv, f, &mesh); /* 35101, 6138, 70699 */
+    scc_sdf_spike_grid spikes;
+    scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
+    scc_rigid body = spike_scene_body();
+    scc_mesh_motion mm = { &mesh, &body, NULL, NULL, NULL, 0.025, body.t0 + DT, NULL, NULL };
+    static scc_contact out[64];
+    scc_query_summary c, r;
+    scc_params pc = params_of(SDFCCD_METHOD_CERTIFIED);
+    ck_assert(scc_query_mesh(&spikes.base, &mm, &pc, &k_alloc, out, 64, &c));
+    scc_params pf = params_of(SDFCCD_METHOD_FWGSS);
+    pf.broad_phase = 0; /* every triangle on [t0, ..] in index order */
+    int tests[3] = { 0, 0, 0 };
+    scc_workspace ws;
+    scc_ws_init(&ws, &k_alloc);
+    ck_assert(scc_query_mesh_probed(&spikes.base, &mm, &pf, &ws, out, 64, &r, count_tests, tests, NULL));
+    scc_ws_release(&ws);
+    printf("pending: certified [%.10f, %.10f]; FWGSS %.10f (%lld evaluations); tests per triangle %d %d %d\n", c.toi_lower, c.toi, r.toi,
+           (long long)r.evals, tests[0], tests[1], tests[2]);
+    ck_assert(c.hit && r.hit);
+    ck_assert_msg(r.toi <= c.toi && r.toi >= c.toi_lower, "FWGSS toi %.10f outside the certified bracket [%.10f, %.10f]", r.toi, c.toi_lower, c.toi);
+    ck_assert_int_ge(tests[2], 1);
+    ck_assert_int_eq(tests[1], 1);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("fall");
@@ -310,6 +470,9 @@ int main(void)
     tcase_add_test(tc, test_spike_apex_triangle);
     tcase_add_test(tc, test_deferred_checks);
     tcase_add_test(tc, test_precheck_clears);
+    tcase_add_test(tc, test_clear_over_tip);
+    tcase_add_test(tc, test_traces_lazily);
+    tcase_add_test(tc, test_pending_dropped);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }
