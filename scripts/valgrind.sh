@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 b="${1:-build}"
 [ -f "$b/CMakeCache.txt" ] || cmake -S . -B "$b" -DCMAKE_BUILD_TYPE=Release >/dev/null
-tests="test_api test_sdf test_ccd test_hardening test_destroy test_solvers test_grid_cdf test_extract test_mesh_distance test_guard test_contacts test_soft test_soft_step test_cases test_sampled test_bend test_stretch"
+tests="test_api test_sdf test_ccd test_hardening test_destroy test_solvers test_grid_cdf test_extract test_mesh_distance test_guard test_guard_world test_contacts test_soft test_soft_step test_cases test_sampled test_bend test_stretch"
 cmake --build "$b" -j2 --target $tests >/dev/null
 for t in $tests; do
   echo "== valgrind: $t"
