@@ -28,5 +28,5 @@ for e in $only; do
   "$bench" "$e" --dataset "$out/dataset" $mode --baseline > "$out/$e.csv.tmp"
   mv "$out/$e.csv.tmp" "$out/$e.csv"
 done
-"$build/samples/sdfccd_bench_report" "$out"
+run_report "$out"
 echo "report: $out/report.md" >&2

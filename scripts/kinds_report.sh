@@ -21,5 +21,5 @@ mv "$out/kinds.csv.tmp" "$out/kinds.csv"
 "$bench" kinds_front --dataset "$out/dataset" > "$out/kinds_front.csv.tmp"
 mv "$out/kinds_front.csv.tmp" "$out/kinds_front.csv"
 echo "$note; $(date -u '+%Y-%m-%d %H:%M UTC')" > "$out/kinds_machine.txt"
-"$build/samples/sdfccd_bench_report" "$out"
+run_report "$out"
 echo "report: $out/report.md" >&2

@@ -35,3 +35,17 @@ commit_stamp() {
   fi
   echo "$c"
 }
+
+# run_report OUTDIR: sdfccd_bench_report OUTDIR, keeping report section 9, which grid_report.sh pastes
+# and the generator does not write (the report is otherwise made anew from OUTDIR's CSVs).
+run_report() {
+  local out="$1" kept
+  kept="$(mktemp)"
+  [ -f "$out/report.md" ] && awk '/^## 9\. /{f=1} f' "$out/report.md" > "$kept"
+  "$build/samples/sdfccd_bench_report" "$out"
+  if [ -s "$kept" ] && ! grep -q '^## 9\. ' "$out/report.md"; then
+    printf '\n' >> "$out/report.md"
+    cat "$kept" >> "$out/report.md"
+  fi
+  rm -f "$kept"
+}
