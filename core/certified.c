@@ -887,21 +887,15 @@ int scc_certified_clear(const scc_sdf* sdf, const scc_tri_motion* m, double ta, 
     return certified_search(sdf, m, ta, tb, p, &hooks, INFINITY, none, 0.0, budget, NULL, out);
 }
 
-/* Whether a grid may be sharp where the triangle goes over [ta, tb] near the contact level (ours):
- * some cell its swept box touches has a bound on |grad phi| above SCC_VERIFY_GRID_MIN_LIPSCHITZ
- * and values reaching `margin` (the largest of its Bernstein coefficients). A grid samples the
- * distance to its surface (|grad| = 1); its cubic cells overshoot where the sampled field has a
- * crease (a box's edge, a spike's tip or valley: bounds of 2.7-3.5 on the data set's concave-box
- * and spike grids) and little on a smooth shape (the 64^3 torus grid of Table 4: at most 1.89
- * along the bunny's triangles), where the check would only add cost (Table 4's bunny 94.7 -> 637
- * evaluations per triangle without this test). A cell whose values all lie below the contact
- * level is one no contact can be first in (the triangle crosses the level before it gets there)
- * and where every sample already reports a contact: a crease there, such as the torus tube's
- * centre circle, is no reason to doubt FWGSS (the 32^3 torus grid's swept boxes touch those cells
- * on every query). */
-static int grid_sharp_along(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, double margin)
+/* Whether a grid may be sharp where the triangle goes over [ta, tb] (ours): the largest bound on
+ * |grad phi| of the cells its swept box touches exceeds SCC_VERIFY_GRID_MIN_LIPSCHITZ. A grid
+ * samples the distance to its surface (|grad| = 1); its cubic cells overshoot where the sampled
+ * field has a crease (a box's edge, a spike's tip or valley: bounds of 2.7-3.5 on the data set's
+ * concave-box and spike grids) and little on a smooth shape (the 64^3 torus grid of Table 4: at
+ * most 1.89 along the bunny's triangles), where the check would only add cost (Table 4's bunny
+ * 94.7 -> 637 evaluations per triangle without this test). */
+static int grid_sharp_along(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb)
 {
-    const scc_grid* g = (const scc_grid*)sdf;
     scc_tri_state st;
     scc_tri_state_at(m, ta, &st);
     const double r = scc_tri_speed_bound(m) * (tb - ta);
@@ -912,47 +906,7 @@ static int grid_sharp_along(const scc_sdf* sdf, const scc_tri_motion* m, double 
     }
     box.lo = scc_sub(box.lo, scc_v3(r, r, r));
     box.hi = scc_add(box.hi, scc_v3(r, r, r));
-    if (!scc_vfinite(box.lo) || !scc_vfinite(box.hi)) return 1;
-    const int leaves = box.lo.x < g->lo.x || box.lo.y < g->lo.y || box.lo.z < g->lo.z || box.hi.x > g->hi.x || box.hi.y > g->hi.y || box.hi.z > g->hi.z;
-    /* scc_grid_lipschitz_in's bound for a box leaving the domain is hypot(1, L): the cell bound that exceeds the threshold */
-    const double thr = leaves ? sqrt(SCC_VERIFY_GRID_MIN_LIPSCHITZ * SCC_VERIFY_GRID_MIN_LIPSCHITZ - 1.0) : SCC_VERIFY_GRID_MIN_LIPSCHITZ;
-    if (!(scc_sdf_lipschitz(sdf, &box) > SCC_VERIFY_GRID_MIN_LIPSCHITZ)) return 0; /* no sharp cell at all (the bound as before) */
-    if (g->lipschitz_max > thr && g->hole_source) return 1; /* cells without values: keep the box bound's answer */
-    const double lo[3] = { g->lo.x, g->lo.y, g->lo.z }, ih[3] = { g->inv_h.x, g->inv_h.y, g->inv_h.z };
-    const double bl[3] = { box.lo.x, box.lo.y, box.lo.z }, bh[3] = { box.hi.x, box.hi.y, box.hi.z };
-    uint32_t a[3], b[3];
-    for (int d = 0; d < 3; ++d) {
-        const double x0 = floor((bl[d] - lo[d]) * ih[d]), x1 = floor((bh[d] - lo[d]) * ih[d]), top = (double)g->res[d] - 1.0;
-        a[d] = (uint32_t)fmin(fmax(x0, 0.0), top);
-        b[d] = (uint32_t)fmin(fmax(x1, 0.0), top);
-    }
-    const scc_grid_field* fd = &g->fields[0];
-    const uint32_t nbx = (g->res[0] + 3) / 4, nby = (g->res[1] + 3) / 4;
-    const double half_diag = 0.5 * scc_len(g->h);
-    for (uint32_t K = a[2] / 4; K <= b[2] / 4; ++K)
-        for (uint32_t J = a[1] / 4; J <= b[1] / 4; ++J)
-            for (uint32_t I = a[0] / 4; I <= b[0] / 4; ++I) {
-                if (g->block_lipschitz && !((double)g->block_lipschitz[I + (uint64_t)nbx * (J + (uint64_t)nby * K)] > thr)) continue;
-                for (uint32_t k = K * 4 > a[2] ? K * 4 : a[2]; k <= b[2] && k < K * 4 + 4; ++k)
-                    for (uint32_t j = J * 4 > a[1] ? J * 4 : a[1]; j <= b[1] && j < J * 4 + 4; ++j)
-                        for (uint32_t i = I * 4 > a[0] ? I * 4 : a[0]; i <= b[0] && i < I * 4 + 4; ++i) {
-                            const uint64_t l = i + (uint64_t)g->res[0] * (j + (uint64_t)g->res[1] * k);
-                            const uint32_t c = fd->map[l];
-                            if (c == SCC_GRID_NO_CELL || !((double)g->cell_lipschitz[c] > thr)) continue;
-                            const uint32_t ijk[3] = { i, j, k };
-                            double v[32], bz[64], top = -INFINITY;
-                            gather_cell(g, fd, c, ijk, v);
-                            /* first the Lipschitz bound from the corners (every point is within half
-                             * the diagonal of one), then the Bernstein coefficients */
-                            for (int q = 0; q < 8; ++q) top = v[q] > top ? v[q] : top;
-                            if (top + (double)g->cell_lipschitz[c] * half_diag < margin) continue;
-                            top = -INFINITY;
-                            cell_bernstein_of(v, bz);
-                            for (int q = 0; q < 64; ++q) top = bz[q] > top ? bz[q] : top;
-                            if (!(top < margin)) return 1;
-                        }
-            }
-    return 0;
+    return scc_sdf_lipschitz(sdf, &box) > SCC_VERIFY_GRID_MIN_LIPSCHITZ;
 }
 
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
@@ -977,6 +931,6 @@ int scc_fwgss_check(const scc_sdf* sdf, const scc_tri_motion* m, double ta, doub
     if (budget > cap) budget = cap;
     if (budget > SCC_VERIFY_MAX_EVALS) budget = SCC_VERIFY_MAX_EVALS;
     if (budget <= 0) return 1;
-    if (sdf->kind == SCC_SDF_GRID && !grid_sharp_along(sdf, m, ta, tb, p->margin)) return 1;
+    if (sdf->kind == SCC_SDF_GRID && !grid_sharp_along(sdf, m, ta, tb)) return 1;
     return verify_search(sdf, m, ta, tb, p, alloc, budget, io);
 }
