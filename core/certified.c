@@ -906,7 +906,12 @@ static int grid_sharp_along(const scc_sdf* sdf, const scc_tri_motion* m, double 
     }
     box.lo = scc_sub(box.lo, scc_v3(r, r, r));
     box.hi = scc_add(box.hi, scc_v3(r, r, r));
-    return scc_sdf_lipschitz(sdf, &box) > SCC_VERIFY_GRID_MIN_LIPSCHITZ;
+    /* the gate as it was set: a box leaving the domain compared as hypot(1, L), the bound
+     * scc_grid_lipschitz_in gave there before it took max(1, L) for grids positive outside */
+    const scc_grid* g = (const scc_grid*)sdf;
+    const int leaves = box.lo.x < g->lo.x || box.lo.y < g->lo.y || box.lo.z < g->lo.z || box.hi.x > g->hi.x || box.hi.y > g->hi.y || box.hi.z > g->hi.z;
+    const double L = scc_sdf_lipschitz(sdf, &box);
+    return (leaves && g->outside_positive ? sqrt(1.0 + L * L) : L) > SCC_VERIFY_GRID_MIN_LIPSCHITZ;
 }
 
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,

@@ -673,7 +673,12 @@ double scc_grid_lipschitz_in(const scc_sdf* self, const scc_aabb* box)
                 }
     }
 #undef GLOBAL_BOUND
-    return leaves ? sqrt(1.0 + L * L) : L;
+    /* Outside the domain phi = sqrt(d^2 + phi_q^2) (phi_q >= 0, always so when outside_positive):
+     * its gradient is (d n + phi_q g_t) / phi with n the unit offset along the clamped axes and g_t
+     * grad phi(q) along the others, orthogonal, so |grad| <= max(1, |g_t|) <= max(1, L); only
+     * phi_q - d (a boundary cutting the shape) has |grad| up to hypot(1, L). */
+    if (!leaves) return L;
+    return g->outside_positive ? fmax(1.0, L) : sqrt(1.0 + L * L);
 }
 
 scc_aabb scc_grid_fit_domain(scc_aabb box)
