@@ -115,6 +115,26 @@ static sdfccd_GuardWorldResult run1(fixture* f, const sdfccd_GuardSdf* sdfs, int
     return r;
 }
 
+/* A world with more bodies than the references one call may hold at once (32 on a thread): 48 boxes
+ * side by side moved through the wall are each rolled back, as one box alone is. */
+START_TEST(test_many_bodies)
+{
+    fixture f = setup();
+    enum { N = 48 };
+    const sdfccd_GuardSdf wall = wall_sdf(f.wall, at(0, 0, 0), at(0, 0, 0));
+    const sdfccd_GuardPart part = part_of(f.box, sdfccd_pose_identity());
+    sdfccd_GuardRigidBody bodies[N];
+    sdfccd_GuardWorldResult r[N];
+    for (int i = 0; i < N; ++i) {
+        const double x = -0.9 + 1.8 * i / (N - 1);
+        bodies[i] = body_of(&part, 1, at(x, 0, 0.5), at(x, 0, -0.5), 0.2);
+    }
+    ck_assert_msg(sdfccd_guard_world(f.ws, &wall, 1, bodies, N, 0.0, DT, &f.gp, NULL, NULL, r) == SDFCCD_OK, "%s", sdfccd_last_error());
+    for (int i = 0; i < N; ++i) ck_assert_msg(r[i].rolled_back == 1 && r[i].failures == 0, "body %d not rolled back", i);
+    teardown(&f);
+}
+END_TEST
+
 /* The time a box falling from centre z0 to z1 over the step brings its bottom to `top` - TOL/2. */
 static double half_level_time(double z0, double z1, double top)
 {
@@ -447,6 +467,7 @@ int main(void)
     tcase_add_test(tc, test_still_pair_costs_nothing);
     tcase_add_test(tc, test_sdf_of_a_body);
     tcase_add_test(tc, test_bad_input);
+    tcase_add_test(tc, test_many_bodies);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -190,6 +190,24 @@ static sdfccd_Status sdf_motion(const sdfccd_GuardSdf* s, int32_t i, double t0, 
     return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_guard_world: sdfs[%d]: its two poses give no motion over [%g, %g]", (int)i, t0, t1);
 }
 
+/* Whether a handle is live, without keeping the reference: a world has more handles than the
+ * per-thread list of references a call may hold, and each check takes its own. */
+static int live_sdf(sdfccd_SdfId id)
+{
+    const int mark = sdfccd__hold_mark();
+    const int ok = sdfccd__sdf_acquire(id) != NULL;
+    sdfccd__hold_release_to(mark);
+    return ok;
+}
+
+static int live_mesh(sdfccd_MeshId id)
+{
+    const int mark = sdfccd__hold_mark();
+    const int ok = sdfccd__mesh_acquire(id) != NULL;
+    sdfccd__hold_release_to(mark);
+    return ok;
+}
+
 static sdfccd_Status check_world(sdfccd_Workspace* ws, const sdfccd_GuardSdf* sdfs, int32_t sdf_count, const sdfccd_GuardRigidBody* bodies,
                                  int32_t body_count, double t0, double t1, const sdfccd_GuardParams* params, sdfccd_GuardWorldResult* results)
 {
@@ -213,7 +231,7 @@ static sdfccd_Status check_world(sdfccd_Workspace* ws, const sdfccd_GuardSdf* sd
         if (s->body < -1 || s->body >= body_count)
             return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: sdfs[%d].body = %d (must be -1 or a body index < %d)", fn, (int)i, (int)s->body,
                                  (int)body_count);
-        if (!sdfccd__sdf_acquire(s->sdf)) return SDFCCD_INVALID_HANDLE;
+        if (!live_sdf(s->sdf)) return SDFCCD_INVALID_HANDLE;
     }
     for (int32_t i = 0; i < body_count; ++i) {
         const sdfccd_GuardRigidBody* b = &bodies[i];
@@ -228,7 +246,7 @@ static sdfccd_Status check_world(sdfccd_Workspace* ws, const sdfccd_GuardSdf* sd
                 snprintf(w, sizeof w, "bodies[%d].parts", (int)i);
                 return check_pose(&b->parts[k].offset, w, k, "offset");
             }
-            if (!sdfccd__mesh_acquire(b->parts[k].mesh)) return SDFCCD_INVALID_HANDLE;
+            if (!live_mesh(b->parts[k].mesh)) return SDFCCD_INVALID_HANDLE;
         }
     }
     return SDFCCD_OK;
