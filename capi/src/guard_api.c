@@ -9,6 +9,19 @@
 #include <stdio.h>
 #include <string.h>
 
+/* The answer of a check that found nothing before t1 (the safe pose is the end pose when given). */
+static sdfccd_GuardResult clear_result(double t1, const sdfccd_Pose* end)
+{
+    sdfccd_GuardResult g;
+    memset(&g, 0, sizeof g);
+    g.state = SDFCCD_GUARD_CLEAR;
+    g.toi = t1;
+    g.fraction = 1.0;
+    g.min_gap_start = INFINITY;
+    if (end) g.safe_pose = *end;
+    return g;
+}
+
 sdfccd_Status sdfccd_guard_body(sdfccd_Workspace* ws, const sdfccd_GuardPair* pairs, int32_t count, double t0, double t1,
                                 const sdfccd_GuardParams* params, sdfccd_GuardBodyResult* out)
 {
@@ -20,10 +33,7 @@ sdfccd_Status sdfccd_guard_body(sdfccd_Workspace* ws, const sdfccd_GuardPair* pa
     sdfccd_GuardBodyResult r;
     memset(&r, 0, sizeof r);
     r.index = -1;
-    r.first.state = SDFCCD_GUARD_CLEAR;
-    r.first.toi = t1;
-    r.first.fraction = 1.0;
-    r.first.min_gap_start = INFINITY;
+    r.first = clear_result(t1, NULL);
     for (int32_t i = 0; i < count; ++i) {
         const sdfccd_GuardPair* p = &pairs[i];
         sdfccd_GuardResult g;
@@ -295,11 +305,7 @@ static sdfccd_Status guard_world(sdfccd_Workspace* ws, const sdfccd_GuardSdf* sd
         r->sdf = r->part = -1;
         r->pose = bodies[i].end;
         r->state = bodies[i].state;
-        r->guard.state = SDFCCD_GUARD_CLEAR;
-        r->guard.toi = t1;
-        r->guard.fraction = 1.0;
-        r->guard.safe_pose = bodies[i].end;
-        r->guard.min_gap_start = INFINITY;
+        r->guard = clear_result(t1, &bodies[i].end);
     }
     const double pad = params->tolerance;
     for (int32_t i = 0; i < body_count; ++i) {
