@@ -482,7 +482,7 @@ static void section_cost(FILE* md, const char* dir, const table* t)
                 "both; shuriken, 3 pairs: 52.6 -> 50.1 and 50.6 -> 47.5). Tried in the same session and dropped (medians "
                 "of 7 to 15 same-run pairs of the triangle; all but the last change the last bits, so the searches' paths): "
                 "the whole series by Estrin's scheme with the turn to mid-interval folded into each point's offset (no angle sum per "
-                "sample): 2 to 7 %% less with the built-in torus, none with the callback (instructions per evaluation rise "
+                "sample): 2 to 7 %% less with the built-in torus, 0 to 2 %% with the callback (instructions per evaluation rise "
                 "by 3 and 8), the torus set's figures as good or better, but on the per-kind set a box case 0.65 ms late "
                 "(box-0066) or, with the sine formed as d x (sin d / d) first, grid-concave-box-0283 at 239,180 evaluations "
                 "instead of 18,132 (that kind's mean 3,887.9 -> 4,318.5); the fold alone: 2 %% less with the built-in "
