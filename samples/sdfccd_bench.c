@@ -459,7 +459,7 @@ typedef struct torus_cb { int repeat; } torus_cb;
 
 /* The torus at (px, p.y, p.z), px passed through an empty asm statement that may change it, which
  * keeps the compiler from folding the repeats (no instruction; the volatile variable used before
- * stored and reloaded the point, about 7 cycles in the chain of every call). */
+ * stored and reloaded the point, a store-to-load round trip in the chain of every call). */
 static inline double torus_at(double px, sdfccd_Vec3 p, sdfccd_Vec3* g)
 {
 #if defined(__GNUC__) || defined(__clang__)

@@ -478,7 +478,7 @@ static void section_cost(FILE* md, const char* dir, const table* t)
                 "column). The callback's dispatch is about the difference of the first and the built-in torus's columns (the same "
                 "torus, called through the public callback with its point passed on the stack by the C ABI, against inline): "
                 "about 6 ns on the triangle. The callback's guard against folding its repeats is an empty asm statement since this column came "
-                "in; it was a volatile variable, which stored and reloaded the point in every call, about 7 cycles in the "
+                "in; it was a volatile variable, which stored and reloaded the point in every call, a store-to-load round trip in the "
                 "chain that counted as motion + solver + dispatch (same run, the library unchanged, triangle, medians of 11 "
                 "pairs: 47.4 -> 44.2 ns per evaluation, 44.4 -> 40.8 ns motion + solver + dispatch, the built-in torus 38.3 "
                 "both; shuriken, 3 pairs: 52.6 -> 50.1 and 50.6 -> 47.5). Tried in the same session and dropped (medians "
