@@ -448,25 +448,51 @@ static void exp_batch(const options* o)
 /* Cost per SDF evaluation inside a query, split by a differential measurement through the public
  * ABI: the torus as a user (callback) SDF that evaluates the field `repeat` times per call. The
  * query time grows by (repeat - 1) x evaluations x field cost, which gives the field's cost; the
- * rest of the time per evaluation is the motion, the solver and the dispatch.
- * SDFCCD_BENCH_MESH=triangle|shuriken runs one mesh only; SDFCCD_BENCH_COST_ONLY=0|1|2 runs one
- * pass of one variant only (the callback x1, x5, the built-in torus: for callgrind). */
+ * rest of the time per evaluation is the motion, the solver and the dispatch. The five evaluations
+ * of one call are independent, so that difference is the field's throughput; a fourth variant chains
+ * them (each one's point depends on the one before's value), which gives the field's latency, as the
+ * solver sees it (each sample waits for the one before).
+ * SDFCCD_BENCH_MESH=triangle|shuriken runs one mesh only; SDFCCD_BENCH_COST_ONLY=0|1|2|3 runs one
+ * pass of one variant only (the callback x1, x5, the built-in torus, the callback x5 chained: for
+ * callgrind). */
 typedef struct torus_cb { int repeat; } torus_cb;
 
+/* The torus at (px, p.y, p.z), px passed through an empty asm statement that may change it, which
+ * keeps the compiler from folding the repeats (no instruction; the volatile variable used before
+ * stored and reloaded the point, a store-to-load round trip in the chain of every call). */
+static inline double torus_at(double px, sdfccd_Vec3 p, sdfccd_Vec3* g)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    __asm__ volatile("" : "+x"(px));
+#else
+    volatile double pv = px;
+    px = pv;
+#endif
+    double q = sqrt(px * px + p.y * p.y);
+    double dx = q - 0.1, d = sqrt(dx * dx + p.z * p.z);
+    if (g) {
+        double s = d > 0 ? 1.0 / d : 0.0, r = q > 0 ? dx / q : 0.0;
+        *g = (sdfccd_Vec3){ p.x * r * s, p.y * r * s, p.z * s };
+    }
+    return d - 0.05;
+}
+
+/* `repeat` independent evaluations (the processor overlaps them: the field's throughput). */
 static double torus_eval(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 {
     const torus_cb* t = user;
     double phi = 0.0;
-    for (int k = 0; k < t->repeat; ++k) {
-        volatile double px = p.x; /* keep the compiler from folding the repeats */
-        double q = sqrt(px * px + p.y * p.y);
-        double dx = q - 0.1, d = sqrt(dx * dx + p.z * p.z);
-        phi = d - 0.05;
-        if (g) {
-            double s = d > 0 ? 1.0 / d : 0.0, r = q > 0 ? dx / q : 0.0;
-            *g = (sdfccd_Vec3){ p.x * r * s, p.y * r * s, p.z * s };
-        }
-    }
+    for (int k = 0; k < t->repeat; ++k) phi = torus_at(p.x, p, g);
+    return phi;
+}
+
+/* `repeat` chained evaluations: each one's point depends on the one before's value (x + 0 * phi, one
+ * multiply and one add more in the chain), as a solver's next sample does (the field's latency). */
+static double torus_eval_chained(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
+{
+    const torus_cb* t = user;
+    double phi = 0.0;
+    for (int k = 0; k < t->repeat; ++k) phi = torus_at(p.x + 0.0 * phi, p, g);
     return phi;
 }
 
@@ -488,11 +514,11 @@ static void exp_cost(const options* o)
     CHECK(sdfccd_create_workspace(&ws));
     sdfccd_QueryParams p = config_params(CFG_NEW, 0);
     sdfccd_Contact contacts[16];
-    torus_cb cb[2] = { { 1 }, { 5 } };
-    sdfccd_SdfId sdf[2];
-    for (int k = 0; k < 2; ++k) {
+    torus_cb cb[3] = { { 1 }, { 5 }, { 5 } }; /* the third chained */
+    sdfccd_SdfId sdf[3];
+    for (int k = 0; k < 3; ++k) {
         sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
-        d.eval = torus_eval;
+        d.eval = k == 2 ? torus_eval_chained : torus_eval;
         d.user = &cb[k];
         d.bounds = (sdfccd_Aabb){ { -0.15, -0.15, -0.05 }, { 0.15, 0.15, 0.05 } };
         d.smooth = 1; /* as the built-in torus: no kink guard, no certified check */
@@ -500,17 +526,18 @@ static void exp_cost(const options* o)
     }
     const int only_k = getenv("SDFCCD_BENCH_COST_ONLY") ? atoi(getenv("SDFCCD_BENCH_COST_ONLY")) : -1;
     int R = o->quick >= 2 || only_k >= 0 ? 1 : (o->quick ? 5 : 15); /* the fastest of the repeats: more of them find a quieter moment on a shared machine */
-    printf("mesh,queries,evals_per_query,ns_per_evaluation,ns_field,ns_motion_solver_dispatch,ns_per_evaluation_builtin_torus\n");
+    printf("mesh,queries,evals_per_query,ns_per_evaluation,ns_field,ns_motion_solver_dispatch,ns_per_evaluation_builtin_torus,"
+           "ns_field_latency,ns_rest_after_field_latency\n");
     const char* only = getenv("SDFCCD_BENCH_MESH"); /* one mesh only (a shorter run) */
     for (int mesh = 0; mesh < 2; ++mesh) {
         if (only && strcmp(only, k_mesh_name[mesh]) != 0) continue;
         int n = ds.n_per_mesh;
-        double best[3] = { INFINITY, INFINITY, INFINITY };
+        double best[4] = { INFINITY, INFINITY, INFINITY, INFINITY };
         long long evals = 0;
         for (int rep = 0; rep < R; ++rep)
-            for (int k = 0; k < 3; ++k) { /* interleaved: callback x1, callback x5, the built-in torus */
+            for (int k = 0; k < 4; ++k) { /* interleaved: callback x1, callback x5, the built-in torus, callback x5 chained */
                 if (only_k >= 0 && k != only_k) continue;
-                sdfccd_SdfId f = k < 2 ? sdf[k] : ds.torus;
+                sdfccd_SdfId f = k < 2 ? sdf[k] : k == 2 ? ds.torus : sdf[2];
                 long long e = 0;
                 double t0 = clock_us();
                 for (int i = 0; i < n; ++i) {
@@ -522,9 +549,11 @@ static void exp_cost(const options* o)
                 if (k == 0) evals = e;
             }
         double per = best[0] * 1e3 / (double)evals, field = (best[1] - best[0]) * 1e3 / (4.0 * (double)evals);
-        printf("%s,%d,%.1f,%.1f,%.1f,%.1f,%.1f\n", k_mesh_name[mesh], n, (double)evals / n, per, field, per - field, best[2] * 1e3 / (double)evals);
+        double latency = (best[3] - best[0]) * 1e3 / (4.0 * (double)evals);
+        printf("%s,%d,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", k_mesh_name[mesh], n, (double)evals / n, per, field, per - field,
+               best[2] * 1e3 / (double)evals, latency, per - latency);
     }
-    for (int k = 0; k < 2; ++k) sdfccd_destroy_sdf(sdf[k]);
+    for (int k = 0; k < 3; ++k) sdfccd_destroy_sdf(sdf[k]);
     sdfccd_destroy_workspace(ws);
     free_dataset(&ds);
 }
