@@ -318,7 +318,7 @@ Status Bridge::registerWith(btCollisionWorld* world)
         d->registerCollisionCreateFunc(s.first, s.second, m_impl->fn[0].get());
         d->registerClosestPointsCreateFunc(s.first, s.second, m_impl->fn[1].get());
     }
-    softRegister(m_impl, d);
+    softRegister(m_impl);
     m_impl->dispatcher = d;
     guardAttach(m_impl, world);
     softAttach(m_impl, world);

@@ -135,7 +135,7 @@ void guardDetach(BridgeImpl* impl);
 // soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones; their
 // algorithm (w0: the soft body or the SDF) made by the bridge's create function.
 struct SoftState;
-void softRegister(BridgeImpl* impl, btCollisionDispatcher* d);
+void softRegister(BridgeImpl* impl);
 btCollisionAlgorithm* softAlgorithm(BridgeImpl* impl, const btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* w0);
 void softAttach(BridgeImpl* impl, btCollisionWorld* world);
 void softUnregister(BridgeImpl* impl);

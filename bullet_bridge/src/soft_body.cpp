@@ -85,8 +85,7 @@ struct GuardingSolver : btDefaultSoftBodySolver {
 } // namespace
 
 struct SoftState {
-    BridgeImpl* impl = nullptr;
-    btCollisionDispatcher* dispatcher = nullptr;
+    BridgeImpl* impl = nullptr; // its dispatcher: the one the pairs are registered with (NULL: none)
     SoftBodyStats stats;
     sdfccd_SoftStats totals = { 0, 0, 0 }; // the C functions' counters (face queries, errors, evaluations)
     std::map<std::pair<const void*, const void*>, SoftRecord> records;
@@ -350,7 +349,7 @@ GuardingSolver::~GuardingSolver()
 
 void GuardingSolver::solveConstraints(btScalar dt)
 {
-    if (!state || !state->dispatcher) return btDefaultSoftBodySolver::solveConstraints(dt);
+    if (!state || !state->impl->dispatcher) return btDefaultSoftBodySolver::solveConstraints(dt);
     btSoftBodyArray& softs = state->world->getSoftBodyArray(); // Bullet's solver's loop, with the contact planes held
     for (int i = 0; i < softs.size(); ++i)
         if (softs[i]->isActive() && !softs[i]->isStaticObject()) solveHeld(state, softs[i]);
@@ -390,10 +389,10 @@ void installSolver(btSoftRigidDynamicsWorld* world, btSoftBodySolver* solver, bo
 
 } // namespace
 
-void softRegister(BridgeImpl* impl, btCollisionDispatcher* d)
+void softRegister(BridgeImpl* impl)
 {
     impl->soft.reset(new SoftState);
-    impl->soft->impl = impl, impl->soft->dispatcher = d;
+    impl->soft->impl = impl;
 }
 
 btCollisionAlgorithm* softAlgorithm(BridgeImpl* impl, const btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* w0)
@@ -433,9 +432,8 @@ void softDetach(SoftState* st)
 void softUnregister(BridgeImpl* impl)
 {
     SoftState* st = softOf(impl);
-    if (!st || !st->dispatcher) return;
+    if (!st || !impl->dispatcher) return;
     softDetach(st);
-    st->dispatcher = nullptr;
     st->records.clear();
 }
 
@@ -460,7 +458,7 @@ int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tole
 {
     if (!world || !(tolerance > 0) || !std::isfinite(tolerance)) return -1;
     detail::SoftState* st = detail::softOf(BridgeAccess::of(bridge));
-    if (!st || !st->dispatcher || st->dispatcher != world->getDispatcher()) return -1;
+    if (!st || !st->impl->dispatcher || st->impl->dispatcher != world->getDispatcher()) return -1;
     if (st->world == world && st->guarded_this_step) { // the automatic guard already checked this step
         st->guarded_this_step = false;
         return 0;
