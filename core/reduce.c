@@ -322,3 +322,22 @@ static size_t reduce(const void* set, size_t n, scc_reduce_get_fn* get, double t
     }
     return r.m;
 }
+
+void scc_match_points(const scc_vec3* previous, size_t m, const scc_vec3* points, size_t n, double tol2, int32_t* match,
+                      unsigned char* used)
+{
+    for (size_t j = 0; j < m; ++j) used[j] = 0;
+    for (size_t i = 0; i < n; ++i) {
+        long best = -1;
+        double best_d2 = tol2;
+        for (size_t j = 0; j < m; ++j) {
+            const double d2 = scc_len2(scc_sub(previous[j], points[i]));
+            if (!used[j] && d2 < best_d2) {
+                best_d2 = d2;
+                best = (long)j;
+            }
+        }
+        if (best >= 0) used[best] = 1;
+        match[i] = (int32_t)best;
+    }
+}

@@ -73,4 +73,11 @@ size_t scc_reduce_kept(const void* set, size_t n, scc_reduce_get_fn* get, double
 size_t scc_cover(const void* set, size_t n, scc_reduce_get_fn* get, const int32_t* chosen, size_t chosen_count, double tilt,
                  double depth, double tol, size_t k, int32_t* out);
 
+/* Warm starting by place (the persistence an engine's manifold gives a point that stays where it
+ * was): for each of the n points in order, the nearest of the m previous points not matched yet whose
+ * squared distance is below tol2 (strictly; equal distances: the lower index), else -1, into
+ * match[i]. `used` (m bytes) is scratch. O(n m). */
+void scc_match_points(const scc_vec3* previous, size_t m, const scc_vec3* points, size_t n, double tol2, int32_t* match,
+                      unsigned char* used);
+
 #endif

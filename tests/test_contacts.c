@@ -1839,6 +1839,127 @@ START_TEST(test_hold_bad_input)
 }
 END_TEST
 
+/* ---- warm starting by place (sdfccd_match_contacts) ---- */
+
+static double dist2(sdfccd_Vec3 a, sdfccd_Vec3 b)
+{
+    return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z);
+}
+
+/* Known sets: the nearest previous point within the distance, each previous point at most once, in
+ * the order of the new points; the distance is strict; equal distances go to the lower index. */
+START_TEST(test_match_known)
+{
+    const sdfccd_Vec3 prev[3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } };
+    /* 0.9 -> 1; 0.05 -> 0; far away -> none; 1.05 is near 1, which 0.9 took -> none */
+    const sdfccd_Vec3 pts[4] = { { 0.9, 0, 0 }, { 0.05, 0, 0 }, { 5, 5, 5 }, { 1.05, 0, 0 } };
+    int32_t m[4] = { 9, 9, 9, 9 };
+    ck_assert_int_eq(sdfccd_match_contacts(prev, 3, pts, 4, 0.2, m), SDFCCD_OK);
+    ck_assert_int_eq(m[0], 1);
+    ck_assert_int_eq(m[1], 0);
+    ck_assert_int_eq(m[2], -1);
+    ck_assert_int_eq(m[3], -1);
+    /* the nearest, not the first within the distance */
+    const sdfccd_Vec3 prev2[2] = { { 0.15, 0, 0 }, { 0.05, 0, 0 } }, origin[1] = { { 0, 0, 0 } };
+    ck_assert_int_eq(sdfccd_match_contacts(prev2, 2, origin, 1, 0.2, m), SDFCCD_OK);
+    ck_assert_int_eq(m[0], 1);
+    /* strictly closer than the distance: 0.5 away with distance 0.5 (exact in binary) is no match */
+    const sdfccd_Vec3 half[1] = { { 0.5, 0, 0 } };
+    ck_assert_int_eq(sdfccd_match_contacts(half, 1, origin, 1, 0.5, m), SDFCCD_OK);
+    ck_assert_int_eq(m[0], -1);
+    ck_assert_int_eq(sdfccd_match_contacts(half, 1, origin, 1, 0.5000001, m), SDFCCD_OK);
+    ck_assert_int_eq(m[0], 0);
+    /* greedy in the new points' order: the first takes the previous point although the second is nearer */
+    const sdfccd_Vec3 two[2] = { { 0.1, 0, 0 }, { 0.01, 0, 0 } };
+    ck_assert_int_eq(sdfccd_match_contacts(origin, 1, two, 2, 0.2, m), SDFCCD_OK);
+    ck_assert_int_eq(m[0], 0);
+    ck_assert_int_eq(m[1], -1);
+    /* equally near previous points (0.25 each way, exact): the lower index */
+    const sdfccd_Vec3 tie[2] = { { 0.25, 0, 0 }, { -0.25, 0, 0 } };
+    ck_assert_int_eq(sdfccd_match_contacts(tie, 2, origin, 1, 1.0, m), SDFCCD_OK);
+    ck_assert_int_eq(m[0], 0);
+    /* no previous set, or distance 0: nothing matches */
+    ck_assert_int_eq(sdfccd_match_contacts(NULL, 0, pts, 4, 0.2, m), SDFCCD_OK);
+    for (int i = 0; i < 4; ++i) ck_assert_int_eq(m[i], -1);
+    ck_assert_int_eq(sdfccd_match_contacts(prev, 3, prev, 3, 0.0, m), SDFCCD_OK);
+    for (int i = 0; i < 3; ++i) ck_assert_int_eq(m[i], -1);
+    /* a resting set (the same points, another order) matches itself */
+    const sdfccd_Vec3 again[3] = { prev[2], prev[0], prev[1] };
+    ck_assert_int_eq(sdfccd_match_contacts(prev, 3, again, 3, 0.02, m), SDFCCD_OK);
+    ck_assert_int_eq(m[0], 2);
+    ck_assert_int_eq(m[1], 0);
+    ck_assert_int_eq(m[2], 1);
+}
+END_TEST
+
+/* Seeded random sets (up to 5000 previous points: the allocated scratch too) against the rule
+ * checked point by point by brute force: a match is within the distance, no previous point is
+ * matched twice, and no previous point free at point i's turn is nearer than its match (or, for
+ * an unmatched point, within the distance at all); equal distances go to the lower index. */
+START_TEST(test_match_random_property)
+{
+    enum { NMAX = 40, MMAX = 5000 };
+    static sdfccd_Vec3 prev[MMAX], pts[NMAX];
+    static int32_t m[NMAX];
+    static int taken[MMAX];
+    unsigned seed = 777u;
+    for (int trial = 0; trial < 60; ++trial) {
+        const int n = 1 + trial % NMAX, mc = trial == 59 ? MMAX : 1 + (trial * 7) % 30;
+        const double grid = trial % 3 == 0 ? 0.125 : 0.0; /* on a coarse grid: exact ties */
+        for (int j = 0; j < mc + n; ++j) {
+            double c[3];
+            for (int k = 0; k < 3; ++k) {
+                seed = seed * 1664525u + 1013904223u;
+                c[k] = (seed >> 8) / 16777216.0;
+                if (grid > 0) c[k] = grid * floor(c[k] / grid);
+            }
+            sdfccd_Vec3 v = { c[0], c[1], c[2] };
+            if (j < mc) prev[j] = v;
+            else pts[j - mc] = v;
+        }
+        const double d = 0.1 + 0.05 * (trial % 5);
+        ck_assert_int_eq(sdfccd_match_contacts(prev, mc, pts, n, d, m), SDFCCD_OK);
+        memset(taken, 0, sizeof taken);
+        for (int i = 0; i < n; ++i) {
+            if (m[i] >= 0) {
+                ck_assert_int_lt(m[i], mc);
+                ck_assert(!taken[m[i]]);
+                ck_assert(dist2(prev[m[i]], pts[i]) < d * d);
+            }
+            const double mine = m[i] >= 0 ? dist2(prev[m[i]], pts[i]) : d * d;
+            for (int j = 0; j < mc; ++j) {
+                if (taken[j] || j == m[i]) continue;
+                const double o = dist2(prev[j], pts[i]);
+                ck_assert_msg(!(o < mine) && !(o == mine && m[i] >= 0 && j < m[i]),
+                              "trial %d point %d: previous %d (d2 %g) beats %d (d2 %g)", trial, i, j, o, (int)m[i], mine);
+            }
+            if (m[i] >= 0) taken[m[i]] = 1;
+        }
+    }
+}
+END_TEST
+
+START_TEST(test_match_bad_input)
+{
+    const sdfccd_Vec3 p[2] = { { 0, 0, 0 }, { 1, 0, 0 } };
+    sdfccd_Vec3 nan_p[1] = { { 0, NAN, 0 } };
+    int32_t m[2] = { 7, 7 };
+    ck_assert_int_eq(sdfccd_match_contacts(p, 2, p, 2, 0.1, NULL), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(NULL, 2, p, 2, 0.1, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(p, 2, NULL, 2, 0.1, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(p, -1, p, 2, 0.1, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(p, 2, p, -1, 0.1, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(p, 2, p, 2, -0.1, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(p, 2, p, 2, NAN, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(p, 2, p, 2, INFINITY, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(nan_p, 1, p, 2, 0.1, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_int_eq(sdfccd_match_contacts(p, 2, nan_p, 1, 0.1, m), SDFCCD_INVALID_ARGUMENT);
+    ck_assert(strlen(sdfccd_last_error()) > 0);
+    ck_assert_int_eq(m[0], 7); /* not written on error */
+    ck_assert_int_eq(m[1], 7);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("contacts");
@@ -1887,6 +2008,9 @@ int main(void)
     tcase_add_test(tc, test_cover_normals_and_same_place);
     tcase_add_test(tc, test_cover_random_property);
     tcase_add_test(tc, test_cover_bad_input);
+    tcase_add_test(tc, test_match_known);
+    tcase_add_test(tc, test_match_random_property);
+    tcase_add_test(tc, test_match_bad_input);
     suite_add_tcase(s, tc);
     TCase* tq = tcase_create("mesh query");
     test_add_memory_fixture(tq);

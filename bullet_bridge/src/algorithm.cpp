@@ -127,10 +127,11 @@ struct BridgeImpl::CreateFunc : public btCollisionAlgorithmCreateFunc {
     {
         bool mesh_is_body1 = false;
         btCollisionDispatcher* d = dynamic_cast<btCollisionDispatcher*>(ci.m_dispatcher1);
+        const int t0 = w0->getCollisionShape()->getShapeType(), t1 = w1->getCollisionShape()->getShapeType();
+        if (!closest && (t0 == SOFTBODY_SHAPE_PROXYTYPE || t1 == SOFTBODY_SHAPE_PROXYTYPE)) return softAlgorithm(bridge, ci, w0);
         if (!bridge->orient(w0, w1, mesh_is_body1)) {
             // Not ours after all (a GImpact compound, an SdfShape without a valid handle): what
             // the slot held before us.
-            const int t0 = w0->getCollisionShape()->getShapeType(), t1 = w1->getCollisionShape()->getShapeType();
             if (!closest && (t0 == GIMPACT_SHAPE_PROXYTYPE || t1 == GIMPACT_SHAPE_PROXYTYPE))
                 return bridge->gimpact_fn.CreateCollisionAlgorithm(ci, w0, w1);
             if (!d) return nullptr;
@@ -223,6 +224,8 @@ std::vector<std::pair<int, int>> slots(const Config& cfg)
     if (cfg.convex_shapes)
         for (int t = 0; t < CONCAVE_SHAPES_START_HERE; ++t) both(t, cfg.sdf_shape_type);
     both(cfg.sdf_shape_type, cfg.sdf_shape_type);
+    both(SOFTBODY_SHAPE_PROXYTYPE, cfg.sdf_shape_type); // soft bodies: contacts only (closest points stay Bullet's)
+    if (cfg.handle_bt_sdf_shape && cfg.sdf_shape_type != SDF_SHAPE_PROXYTYPE) both(SOFTBODY_SHAPE_PROXYTYPE, SDF_SHAPE_PROXYTYPE);
     return s;
 }
 
@@ -315,7 +318,7 @@ Status Bridge::registerWith(btCollisionWorld* world)
         d->registerCollisionCreateFunc(s.first, s.second, m_impl->fn[0].get());
         d->registerClosestPointsCreateFunc(s.first, s.second, m_impl->fn[1].get());
     }
-    softRegister(m_impl, d);
+    softRegister(m_impl);
     m_impl->dispatcher = d;
     guardAttach(m_impl, world);
     softAttach(m_impl, world);

@@ -35,13 +35,15 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
     const btCollisionObject* mo = mw->getCollisionObject();
     const btCollisionObject* so = sw->getCollisionObject();
     const int n = std::min(count, first + per * (manifold_count - 1));
-    // The last step's points of every manifold of the pair.
+    // The last step's points of every manifold of the pair, and their places on the mesh body.
     std::vector<btManifoldPoint>& old = w.old_points;
     std::vector<char>& matched = w.matched;
     old.clear();
+    w.old_places.clear();
     for (int m = 0; m < manifold_count; ++m)
         for (int i = 0; i < manifolds[m]->getNumContacts(); ++i) {
             old.push_back(manifolds[m]->getContactPoint(i));
+            w.old_places.push_back(v3(old.back().m_localPointA));
         }
     matched.assign(old.size(), 0);
     const int primary_old = manifolds[0]->getNumContacts();
@@ -51,6 +53,7 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
     const int flags = mo->getCollisionFlags() | so->getCollisionFlags();
     std::vector<btManifoldPoint>& pts = w.new_points;
     pts.resize((size_t)n);
+    w.new_places.resize((size_t)n);
     for (int k = 0; k < n; ++k) {
         const sdfccd_ContactPoint& c = cps[k];
         const bool speculative = c.gap > margin; // an impact later in the step: restitution 0
@@ -71,29 +74,25 @@ void writeManifolds(btPersistentManifold* const* manifolds, int manifold_count, 
         pt.m_index0 = (int)c.triangle; // the mesh triangle (or compound child: see mw->m_index)
         pt.m_partId1 = sw->m_partId;
         pt.m_index1 = sw->m_index;
-        // The same material point as a point of the last step keeps its warm start and lifetime
-        // (btPersistentManifold::getCacheEntry / replaceContactPoint).
-        int best = -1;
-        btScalar best_d2 = match * match;
-        for (size_t j = 0; j < old.size(); ++j) {
-            const btScalar d2 = (old[j].m_localPointA - pt.m_localPointA).length2();
-            if (!matched[j] && d2 < best_d2) {
-                best_d2 = d2;
-                best = (int)j;
-            }
-        }
-        if (best >= 0) {
-            matched[best] = 1;
-            pt.m_appliedImpulse = old[best].m_appliedImpulse;
-            pt.m_prevRHS = old[best].m_prevRHS;
-            pt.m_appliedImpulseLateral1 = old[best].m_appliedImpulseLateral1;
-            pt.m_appliedImpulseLateral2 = old[best].m_appliedImpulseLateral2;
-            pt.m_userPersistentData = old[best].m_userPersistentData;
-            pt.m_lifeTime = old[best].m_lifeTime + 1;
-        }
         pts[k] = pt;
+        w.new_places[(size_t)k] = v3(pt.m_localPointA);
         if (speculative) stats.speculative_contacts++;
         else stats.ordinary_contacts++;
+    }
+    // The same material point as a point of the last step keeps its warm start and lifetime
+    // (btPersistentManifold::getCacheEntry / replaceContactPoint).
+    w.match.assign((size_t)n, -1);
+    sdfccd_match_contacts(w.old_places.data(), (int32_t)old.size(), w.new_places.data(), n, (double)match, w.match.data());
+    for (int k = 0; k < n; ++k) {
+        const int best = w.match[(size_t)k];
+        if (best < 0) continue;
+        matched[best] = 1;
+        pts[k].m_appliedImpulse = old[best].m_appliedImpulse;
+        pts[k].m_prevRHS = old[best].m_prevRHS;
+        pts[k].m_appliedImpulseLateral1 = old[best].m_appliedImpulseLateral1;
+        pts[k].m_appliedImpulseLateral2 = old[best].m_appliedImpulseLateral2;
+        pts[k].m_userPersistentData = old[best].m_userPersistentData;
+        pts[k].m_lifeTime = old[best].m_lifeTime + 1;
     }
     // Points that did not persist are dropped as refreshContactPoints drops them (their user data
     // released through the contact-destroyed callback).

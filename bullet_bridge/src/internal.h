@@ -79,9 +79,12 @@ private:
     std::unordered_map<const btCollisionShape*, sdfccd_SdfId> m_bt_sdfs;
 };
 
-// A pair's manifold points, last step and this one (reused: no allocation once grown).
+// A pair's manifold points, last step and this one (reused: no allocation once grown), their
+// places on the mesh body (m_localPointA) and the old point each new one continues (-1: none).
 struct PairScratch {
     std::vector<btManifoldPoint> old_points, new_points;
+    std::vector<sdfccd_Vec3> old_places, new_places;
+    std::vector<int32_t> match;
     std::vector<char> matched; // old points that persist
 };
 
@@ -129,8 +132,11 @@ void reportGImpactMisuse(const btTriangleCallback* callback, const btCollisionSh
 // removed by unregister().
 void guardAttach(BridgeImpl* impl, btCollisionWorld* world);
 void guardDetach(BridgeImpl* impl);
-// soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones.
-void softRegister(BridgeImpl* impl, btCollisionDispatcher* d);
+// soft_body.cpp: the (btSoftBody, SDF) pairs, registered and restored with the rigid ones; their
+// algorithm (w0: the soft body or the SDF) made by the bridge's create function.
+struct SoftState;
+void softRegister(BridgeImpl* impl);
+btCollisionAlgorithm* softAlgorithm(BridgeImpl* impl, const btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* w0);
 void softAttach(BridgeImpl* impl, btCollisionWorld* world);
 void softUnregister(BridgeImpl* impl);
 void softForget(BridgeImpl* impl);
@@ -198,6 +204,8 @@ public:
     btCollisionWorld* batch_world = nullptr;
     std::vector<sdfccd_Workspace*> batch_ws;
     std::unordered_map<detail::ObjectPair, detail::PairResult, detail::ObjectPairHash> batch_cache;
+
+    std::shared_ptr<detail::SoftState> soft; // soft_body.cpp (deleted where it is complete)
 
     struct CreateFunc;
     std::unique_ptr<CreateFunc> fn[2]; // contact points, closest points

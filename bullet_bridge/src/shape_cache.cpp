@@ -2,9 +2,6 @@
 // sdfccd Bullet bridge: Bullet shapes as sdfccd meshes and SDF handles (see internal.h).
 #include "internal.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include <BulletCollision/CollisionShapes/btShapeHull.h>
 #include <BulletCollision/Gimpact/btGImpactShape.h>
 
@@ -59,18 +56,11 @@ sdfccd_RigidMotion motionOf(const btCollisionObject* co, const btTransform& wrap
 
 namespace {
 
-// Appends triangle (a, b, c) unless it has (almost) no area, so the library's triangle numbers
-// are ours.
+// Appends triangle (a, b, c). Zero-area ones are dropped by sdfccd_create_mesh (drop_degenerate,
+// the core's one zero-area rule), which numbers the others in order: its triangle numbers are then
+// the ones of the shape's triangles left.
 void pushTriangle(MeshEntry& e, uint32_t a, uint32_t b, uint32_t c)
 {
-    const double* va = &e.vertices[3 * (size_t)a];
-    const double* vb = &e.vertices[3 * (size_t)b];
-    const double* vc = &e.vertices[3 * (size_t)c];
-    const double u[3] = { vb[0] - va[0], vb[1] - va[1], vb[2] - va[2] };
-    const double w[3] = { vc[0] - va[0], vc[1] - va[1], vc[2] - va[2] };
-    const double n[3] = { u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0] };
-    const double s = std::max(u[0] * u[0] + u[1] * u[1] + u[2] * u[2], w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    if (!(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-10 * s)) return;
     e.indices.push_back(a);
     e.indices.push_back(b);
     e.indices.push_back(c);

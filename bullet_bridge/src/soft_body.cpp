@@ -7,7 +7,6 @@
 
 #include <cmath>
 #include <map>
-#include <mutex>
 #include <set>
 #include <typeinfo>
 
@@ -56,8 +55,6 @@ struct SoftRecord {
     }
 };
 
-struct SoftState;
-
 class SoftSdfAlgorithm : public btCollisionAlgorithm
 {
 public:
@@ -76,16 +73,6 @@ private:
     bool m_swapped;
 };
 
-struct SoftCreateFunc : btCollisionAlgorithmCreateFunc {
-    SoftState* state = nullptr;
-    btCollisionAlgorithm* CreateCollisionAlgorithm(btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper*,
-                                                   const btCollisionObjectWrapper*) override
-    {
-        void* mem = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(SoftSdfAlgorithm));
-        return new (mem) SoftSdfAlgorithm(ci, state, m_swapped);
-    }
-};
-
 // Bullet's CPU solver (a copy of the world's btDefaultSoftBodySolver) with the contact planes held in
 // its solve and the guard after it, in every internal step. The world owns it.
 struct GuardingSolver : btDefaultSoftBodySolver {
@@ -95,11 +82,10 @@ struct GuardingSolver : btDefaultSoftBodySolver {
     SoftState* state; // NULL once the bridge is gone: a plain solver
 };
 
+} // namespace
+
 struct SoftState {
-    BridgeImpl* impl = nullptr;
-    SoftCreateFunc fn[2]; // (soft, sdf) and (sdf, soft)
-    std::vector<std::pair<int, int>> slots;
-    btCollisionDispatcher* dispatcher = nullptr;
+    BridgeImpl* impl = nullptr; // its dispatcher: the one the pairs are registered with (NULL: none)
     SoftBodyStats stats;
     sdfccd_SoftStats totals = { 0, 0, 0 }; // the C functions' counters (face queries, errors, evaluations)
     std::map<std::pair<const void*, const void*>, SoftRecord> records;
@@ -138,15 +124,12 @@ struct SoftState {
     }
 };
 
-std::mutex g_soft_mutex;
-std::map<const BridgeImpl*, std::unique_ptr<SoftState>> g_soft;
+namespace {
 
-SoftState* softOf(const BridgeImpl* impl)
-{
-    std::lock_guard<std::mutex> lock(g_soft_mutex);
-    auto it = g_soft.find(impl);
-    return it == g_soft.end() ? nullptr : it->second.get();
-}
+SoftState* softOf(const BridgeImpl* impl) { return impl->soft.get(); }
+
+// Bullet's rule for a node's velocity after its position solve: (x - q) / dt, damped by kDP.
+double velocityScale(const btSoftBody* psb) { return psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0; }
 
 // A node's RContact against the SDF body: the terms of Bullet's own collision handler (impulse
 // matrix, anchor, ima dt, friction) from sdfccd_soft_node_contact(), hardness kKHR or kCHR.
@@ -255,8 +238,7 @@ void solveHeld(SoftState* st, btSoftBody* psb)
     const bool split = passes > 1 && psb->m_cfg.viterations <= 0 && psb->m_cfg.diterations <= 0 && psb->m_clusters.size() == 0;
     if (count > 0 && split) psb->m_cfg.piterations = 1;
     std::vector<double> push(count, 0.0); // per plane, over the passes
-    // Bullet's rule for the velocity after its position solve: (x - q) / dt, damped by kDP.
-    const double vc = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
+    const double vc = velocityScale(psb);
     const size_t nn = (size_t)psb->m_nodes.size();
     st->x.resize(nn), st->v.resize(nn), st->inverse_mass.resize(nn);
     for (int k = 0; k < (count > 0 && split ? passes : 1); ++k) {
@@ -294,9 +276,7 @@ int guardRecord(SoftState* st, SoftRecord& rec, double tol)
     st->guarded.resize((size_t)nn);
     int32_t moved = 0;
     const double dt = psb->m_sst.sdt > 0 ? psb->m_sst.sdt : 1.0;
-    // Bullet's rule for the velocity after its position solve: (x - q) / dt, damped by kDP.
-    const double vc = psb->m_sst.sdt > 0 ? (1.0 - psb->m_cfg.kDP) / psb->m_sst.sdt : 0.0;
-    if (sdfccd_soft_guard(rec.sdf, &F0, &F, &body, tol, dt, vc, &st->impl->cfg.query, rec.node_certs.data(), rec.face_certs.data(),
+    if (sdfccd_soft_guard(rec.sdf, &F0, &F, &body, tol, dt, velocityScale(psb), &st->impl->cfg.query, rec.node_certs.data(), rec.face_certs.data(),
                           st->guarded.data(), &moved, &st->totals) != SDFCCD_OK) {
         ++st->totals.query_errors;
         return 0;
@@ -369,7 +349,7 @@ GuardingSolver::~GuardingSolver()
 
 void GuardingSolver::solveConstraints(btScalar dt)
 {
-    if (!state || !state->dispatcher) return btDefaultSoftBodySolver::solveConstraints(dt);
+    if (!state || !state->impl->dispatcher) return btDefaultSoftBodySolver::solveConstraints(dt);
     btSoftBodyArray& softs = state->world->getSoftBodyArray(); // Bullet's solver's loop, with the contact planes held
     for (int i = 0; i < softs.size(); ++i)
         if (softs[i]->isActive() && !softs[i]->isStaticObject()) solveHeld(state, softs[i]);
@@ -407,29 +387,18 @@ void installSolver(btSoftRigidDynamicsWorld* world, btSoftBodySolver* solver, bo
     for (int i = 0; i < softs.size(); ++i) softs[i]->setSoftBodySolver(solver);
 }
 
-// Both orders of each (soft body, SDF) slot to `a` (soft first) and `b`, or to the configuration's own.
-void setSlots(SoftState* st, btCollisionAlgorithmCreateFunc* a, btCollisionAlgorithmCreateFunc* b)
-{
-    btCollisionConfiguration* cc = st->dispatcher->getCollisionConfiguration();
-    for (const auto& s : st->slots) {
-        st->dispatcher->registerCollisionCreateFunc(s.first, s.second, a ? a : cc->getCollisionAlgorithmCreateFunc(s.first, s.second));
-        st->dispatcher->registerCollisionCreateFunc(s.second, s.first, b ? b : cc->getCollisionAlgorithmCreateFunc(s.second, s.first));
-    }
-}
-
 } // namespace
 
-void softRegister(BridgeImpl* impl, btCollisionDispatcher* d)
+void softRegister(BridgeImpl* impl)
 {
-    std::unique_ptr<SoftState> st(new SoftState);
-    st->impl = impl, st->dispatcher = d;
-    st->fn[0].state = st->fn[1].state = st.get();
-    st->fn[1].m_swapped = true;
-    st->slots.push_back(std::make_pair((int)SOFTBODY_SHAPE_PROXYTYPE, impl->cfg.sdf_shape_type));
-    if (impl->cfg.handle_bt_sdf_shape) st->slots.push_back(std::make_pair((int)SOFTBODY_SHAPE_PROXYTYPE, (int)SDF_SHAPE_PROXYTYPE));
-    setSlots(st.get(), &st->fn[0], &st->fn[1]);
-    std::lock_guard<std::mutex> lock(g_soft_mutex);
-    g_soft[impl] = std::move(st);
+    impl->soft.reset(new SoftState);
+    impl->soft->impl = impl;
+}
+
+btCollisionAlgorithm* softAlgorithm(BridgeImpl* impl, const btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* w0)
+{
+    void* mem = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(SoftSdfAlgorithm));
+    return new (mem) SoftSdfAlgorithm(ci, softOf(impl), w0->getCollisionShape()->getShapeType() != SOFTBODY_SHAPE_PROXYTYPE);
 }
 
 void softAttach(BridgeImpl* impl, btCollisionWorld* cw)
@@ -463,10 +432,8 @@ void softDetach(SoftState* st)
 void softUnregister(BridgeImpl* impl)
 {
     SoftState* st = softOf(impl);
-    if (!st || !st->dispatcher) return;
+    if (!st || !impl->dispatcher) return;
     softDetach(st);
-    setSlots(st, nullptr, nullptr);
-    st->dispatcher = nullptr;
     st->records.clear();
 }
 
@@ -474,8 +441,6 @@ void softForget(BridgeImpl* impl)
 {
     SoftState* st = softOf(impl);
     if (st && st->wrapper) st->wrapper->state = nullptr; // the world still holds it: make it a plain solver
-    std::lock_guard<std::mutex> lock(g_soft_mutex);
-    g_soft.erase(impl);
 }
 
 } // namespace detail
@@ -493,7 +458,7 @@ int guardSoftBodies(Bridge& bridge, btSoftRigidDynamicsWorld* world, double tole
 {
     if (!world || !(tolerance > 0) || !std::isfinite(tolerance)) return -1;
     detail::SoftState* st = detail::softOf(BridgeAccess::of(bridge));
-    if (!st || !st->dispatcher || st->dispatcher != world->getDispatcher()) return -1;
+    if (!st || !st->impl->dispatcher || st->impl->dispatcher != world->getDispatcher()) return -1;
     if (st->world == world && st->guarded_this_step) { // the automatic guard already checked this step
         st->guarded_this_step = false;
         return 0;

@@ -523,6 +523,29 @@ sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points, int32_t c
     return SDFCCD_OK;
 }
 
+sdfccd_Status sdfccd_match_contacts(const sdfccd_Vec3* previous, int32_t previous_count, const sdfccd_Vec3* points, int32_t count,
+                                    double distance, int32_t* out_match)
+{
+    static const char fn[] = "sdfccd_match_contacts";
+    sdfccd_Status st;
+    if ((st = sdfccd__check_points(fn, points, count, out_match, "out_match"))) return st;
+    if (previous_count < 0) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: previous_count = %d < 0", fn, (int)previous_count);
+    if (previous_count > 0 && !previous) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: previous is NULL", fn);
+    for (int32_t j = 0; j < previous_count; ++j)
+        if ((st = sdfccd__check_vec(previous[j], "sdfccd_match_contacts: a previous point"))) return st;
+    if (!isfinite(distance) || !(distance >= 0.0))
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: distance = %g is not finite and >= 0", fn, distance);
+    if (count == 0) return SDFCCD_OK;
+    unsigned char stack_used[4096];
+    unsigned char* used = previous_count <= (int32_t)sizeof stack_used ? stack_used : (unsigned char*)sdfccd__alloc((size_t)previous_count);
+    if (!used) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: no memory for %d previous points", fn, (int)previous_count);
+    /* (sdfccd_Vec3 and scc_vec3 are both three doubles x, y, z) */
+    scc_match_points((const scc_vec3*)previous, (size_t)previous_count, (const scc_vec3*)points, (size_t)count, distance * distance,
+                     out_match, used);
+    if (used != stack_used) sdfccd__free(used, (size_t)previous_count);
+    return SDFCCD_OK;
+}
+
 sdfccd_Status sdfccd_guard_step_rigid(sdfccd_Workspace* ws, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, sdfccd_MeshId mesh,
                                       const sdfccd_RigidMotion* executed, double t0, double t1, const sdfccd_GuardParams* params,
                                       sdfccd_GuardResult* out)

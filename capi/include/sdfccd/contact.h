@@ -267,6 +267,20 @@ SDFCCD_API sdfccd_Status sdfccd_cover_contacts(const sdfccd_ContactPoint* points
                                                int32_t chosen_count, double tilt, double depth, double same_place_distance,
                                                int32_t* out_indices, int32_t capacity, int32_t* out_count);
 
+/** Warm starting by place: which point of a pair's previous contact set each new point continues,
+ * so that it keeps its accumulated impulses and lifetime (what an engine's persistent manifold does
+ * for a point that stays where it was, as Bullet's btPersistentManifold::getCacheEntry does). For
+ * each of the `count` `points` in order, out_match[i] is the index of the nearest of the
+ * `previous_count` `previous` points not matched to an earlier point, among those closer than
+ * `distance` (m; strictly), or -1 when there is none; of equally near ones, the lower index. Give
+ * both sets in the same frame, one that moves with the body (Bullet: the points' positions in
+ * body A's frame, m_localPointA), so that a resting point matches itself. A pure function (no
+ * handle, no allocation up to 4096 previous points). O(count x previous_count).
+ * Errors (nothing written): ::SDFCCD_INVALID_ARGUMENT for a negative count, a NULL array with a
+ * count > 0, `distance` not finite and >= 0, a non-finite point; ::SDFCCD_OUT_OF_MEMORY. */
+SDFCCD_API sdfccd_Status sdfccd_match_contacts(const sdfccd_Vec3* previous, int32_t previous_count, const sdfccd_Vec3* points,
+                                               int32_t count, double distance, int32_t* out_match);
+
 /** sdfccd_reduce_contacts() for the points of a step, some of which may only reach the surface late in
  * it: after the first point every score (distance, area) is multiplied by
  * exp(-(gap - first gap) / depth_scale), so a point about to touch wins over a far one that spreads
