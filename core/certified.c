@@ -684,7 +684,8 @@ static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const
  * positive outside). */
 #define GRID_GRAD_BLOCKS 512
 static int grid_gradient_bound(const scc_grid* g, const scc_tri_state* st, const region* r, const corners* cx, scc_vec3 c, double phi_c,
-                               double rho, double accel, int64_t* evals, double* out_bound, double* out_space, double* out_time)
+                               double rho, double accel, int64_t* evals, double* out_bound, double* out_space, double* out_time,
+                               double* out_points)
 {
     if (!g->block_grad) return 0;
     const double cc[3] = { c.x, c.y, c.z }, lo[3] = { g->lo.x, g->lo.y, g->lo.z }, hi[3] = { g->hi.x, g->hi.y, g->hi.z };
@@ -723,16 +724,23 @@ static int grid_gradient_bound(const scc_grid* g, const scc_tri_state* st, const
         const double m = scc_fmax(fabs(glo[d]), fabs(ghi[d]));
         gabs2 += m * m;
     }
-    /* phi_q at q(c): the search's own sample inside the domain, else one evaluation */
+    /* phi_q at q(c): the search's own sample inside the domain; outside, from phi(c) = sqrt(d^2 +
+     * phi_q^2) where that leaves phi_q clearly positive (less the rounding of phi and d, about 1e-15
+     * phi^2: a clamped dip, phi_q < 0, gives phi = d), else one evaluation */
     double base = phi_c;
-    if (!inside_c) {
+    double d2 = 0.0;
+    for (int d = 0; d < 3; ++d) d2 += (cc[d] - qc[d]) * (cc[d] - qc[d]);
+    const double vq2 = phi_c * phi_c - d2 - 1e-14 * phi_c * phi_c;
+    if (!inside_c && vq2 > 0.0 && isfinite(vq2)) {
+        base = sqrt(vq2);
+    } else if (!inside_c) {
         base = scc_sdf_eval(&g->base, scc_v3(qc[0], qc[1], qc[2]), NULL);
         ++*evals;
         if (!(base == base)) return 0;
     }
     /* the six points (corners at the region's start and end) relative to c */
     const double dt = r->tb - r->ta;
-    double fmin_all = INFINITY, fmin_start = INFINITY;
+    double fmin_all = INFINITY, fmin_start = INFINITY, fw[6];
     for (int w = 0; w < 6; ++w) {
         const int i = w % 3;
         const scc_vec3 x = w < 3 ? cx->x[i] : scc_add(cx->x[i], scc_scale(cx->v[i], dt));
@@ -746,9 +754,16 @@ static int grid_gradient_bound(const scc_grid* g, const scc_tri_state* st, const
         }
         fmin_all = scc_fmin(fmin_all, f);
         if (w < 3) fmin_start = scc_fmin(fmin_start, f);
+        fw[w] = f;
     }
-    const double gabs = sqrt(gabs2), curve = gabs * 0.5 * accel * dt * dt;
-    *out_bound = base + fmin_all - curve - (1e-12 * rho * (1.0 + gabs) + 1e-15);
+    const double gabs = sqrt(gabs2), curve = gabs * 0.5 * accel * dt * dt, round = 1e-12 * rho * (1.0 + gabs) + 1e-15;
+    *out_bound = base + fmin_all - curve - round;
+    if (out_points) {
+        /* the same bound at the witness samples: the corners at the start (exact positions) and at
+         * the end, and the centroid at the end (F is concave: at least the mean of the corners') */
+        for (int w = 0; w < 6; ++w) out_points[w] = base + fw[w] - (w < 3 ? 0.0 : curve) - round;
+        out_points[6] = base + (fw[3] + fw[4] + fw[5]) / 3.0 - curve - round;
+    }
     if (beyond[0] || beyond[1] || beyond[2]) {
         /* every point outside: phi = sqrt(d^2 + phi_q^2) with both bounded */
         const double dlo = off_domain_distance(g, st, r, c, rho, accel);
@@ -779,7 +794,7 @@ int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const dou
     if (local == 2) {
         const corners cx = corners_of(&st, &r);
         return grid_gradient_bound(ctx.g, &st, &r, &cx, c, scc_sdf_eval(sdf, c, NULL), rs + rt, scc_tri_accel_bound(m), &evals, out_bound, &space,
-                                   &time);
+                                   &time, NULL);
     }
     return grid_region_bound(&ctx, &st, &r, c, rs + rt, rs, rt, scc_tri_accel_bound(m), -INFINITY, local, &evals, out_bound, &space, &time);
 }
@@ -884,6 +899,10 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         double slack_space = rs, slack_time = rt;
         int done = 0, corners_done = 0;
         double cut = 0.0; /* > 0: [ta, ta + cut] is proven clear (conservative advancement) */
+        /* on a grid, lower bounds of phi at the witness samples (grid_gradient_bound): a sample
+         * proven above the margin cannot be a witness and is not taken (the answer is the same) */
+        double point_lb[7];
+        int have_point_lb = 0;
         /* an ancestor's box holds the region too, so its convexity is inherited (sub-regions skip the test) */
         const int convex = !grid && (r.convex || convex_on(sdf, &box));
         r.convex = convex;
@@ -930,7 +949,8 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             /* a grid: the gradient-interval bound of the blocks (grid_gradient_bound), then, where
              * that does not prune, the smallest of the per-cell first-order bounds (grid_region_bound) */
             double bound = -INFINITY, gs = rs, gt = rt, b2, s2, t2;
-            if (grid_gradient_bound(grid->g, &st, &r, &cx, c, phi, rho, accel, &evals, &b2, &s2, &t2)) {
+            if (grid_gradient_bound(grid->g, &st, &r, &cx, c, phi, rho, accel, &evals, &b2, &s2, &t2, point_lb)) {
+                have_point_lb = 1;
                 bound = b2;
                 gs = s2;
                 gt = t2;
@@ -952,6 +972,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         const int sample = !(isfinite(seed_t) && hi == seed_t) || r.depth % WITNESS_EVERY == 0; /* unseeded or past the seed: always */
         for (int i = 0; i < 3 && !done && sample && !corners_done; ++i) {
             scc_vec3 g;
+            if (have_point_lb && point_lb[i] > p->margin) continue;
             if (sample_at(&cache, sdf, &st, r.ta, r.u[i], r.v[i], &g, &evals) <= p->margin) {
                 hi = lo = r.ta;
                 hit_b[0] = r.u[i]; hit_b[1] = r.v[i]; hit_b[2] = 1.0 - r.u[i] - r.v[i];
@@ -964,6 +985,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             double su[4] = { cu, r.u[0], r.u[1], r.u[2] }, sv[4] = { cv, r.v[0], r.v[1], r.v[2] };
             for (int i = 0; i < 4; ++i) {
                 scc_vec3 g;
+                if (have_point_lb && point_lb[i == 0 ? 6 : 2 + i] > p->margin) continue;
                 if (sample_at(&cache, sdf, &se, r.tb, su[i], sv[i], &g, &evals) <= p->margin) {
                     hi = r.tb;
                     hit_b[0] = su[i]; hit_b[1] = sv[i]; hit_b[2] = 1.0 - su[i] - sv[i];
