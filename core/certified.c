@@ -740,7 +740,7 @@ static int grid_gradient_bound(const scc_grid* g, const scc_tri_state* st, const
     }
     /* the six points (corners at the region's start and end) relative to c */
     const double dt = r->tb - r->ta;
-    double fmin_all = INFINITY, fmin_start = INFINITY, fw[6];
+    double fmin_all = INFINITY, fmin_start = INFINITY, fw[6], rate = 0.0;
     for (int w = 0; w < 6; ++w) {
         const int i = w % 3;
         const scc_vec3 x = w < 3 ? cx->x[i] : scc_add(cx->x[i], scc_scale(cx->v[i], dt));
@@ -755,6 +755,18 @@ static int grid_gradient_bound(const scc_grid* g, const scc_tri_state* st, const
         fmin_all = scc_fmin(fmin_all, f);
         if (w < 3) fmin_start = scc_fmin(fmin_start, f);
         fw[w] = f;
+        if (w < 3) {
+            /* how fast the bound can fall along corner i's velocity (each term is superadditive) */
+            const double vi[3] = { cx->v[i].x, cx->v[i].y, cx->v[i].z };
+            double fall = 0.0;
+            for (int d = 0; d < 3; ++d) {
+                if (beyond[d]) continue;
+                double t = scc_fmin(glo[d] * vi[d], ghi[d] * vi[d]);
+                if (straddle[d] || qc[d] != cc[d]) t = scc_fmin(t, 0.0);
+                fall -= t;
+            }
+            rate = scc_fmax(rate, fall);
+        }
     }
     const double gabs = sqrt(gabs2), curve = gabs * 0.5 * accel * dt * dt, round = 1e-12 * rho * (1.0 + gabs) + 1e-15;
     *out_bound = base + fmin_all - curve - round;
@@ -763,6 +775,9 @@ static int grid_gradient_bound(const scc_grid* g, const scc_tri_state* st, const
          * the end, and the centroid at the end (F is concave: at least the mean of the corners') */
         for (int w = 0; w < 6; ++w) out_points[w] = base + fw[w] - (w < 3 ? 0.0 : curve) - round;
         out_points[6] = base + (fw[3] + fw[4] + fw[5]) / 3.0 - curve - round;
+        /* over [ta, ta + s] the bound is at least min of out_points[0..2] - rate s - q s^2 */
+        out_points[7] = rate;
+        out_points[8] = 0.5 * gabs * accel;
     }
     if (beyond[0] || beyond[1] || beyond[2]) {
         /* every point outside: phi = sqrt(d^2 + phi_q^2) with both bounded */
@@ -901,7 +916,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         double cut = 0.0; /* > 0: [ta, ta + cut] is proven clear (conservative advancement) */
         /* on a grid, lower bounds of phi at the witness samples (grid_gradient_bound): a sample
          * proven above the margin cannot be a witness and is not taken (the answer is the same) */
-        double point_lb[7];
+        double point_lb[9];
         int have_point_lb = 0;
         /* an ancestor's box holds the region too, so its convexity is inherited (sub-regions skip the test) */
         const int convex = !grid && (r.convex || convex_on(sdf, &box));
@@ -964,6 +979,14 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             if (bound > phi - L * rho) {
                 slack_space = gs;
                 slack_time = gt;
+            }
+            if (have_point_lb) {
+                /* conservative advancement from the gradient intervals, as for convex fields above */
+                const double b0 = scc_fmin(point_lb[0], scc_fmin(point_lb[1], point_lb[2])) - p->margin;
+                if (b0 > 0.0) {
+                    const double sc = 0.99 * 2.0 * b0 / (point_lb[7] + sqrt(point_lb[7] * point_lb[7] + 4.0 * point_lb[8] * b0));
+                    if (sc >= 0.5 * (r.tb - r.ta) && sc < r.tb - r.ta) cut = sc;
+                }
             }
         }
         /* Unresolved: look for witnesses at the corners at ta (a contact there is exact: nothing
