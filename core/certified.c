@@ -106,7 +106,7 @@ static scc_vec3 corner(const scc_tri_state* st, double u, double v)
  * point x of the region lies in one of the cells B touches, and for that cell, with c_Q the point of
  * Q nearest c (so |x - c_Q| <= |x - c| <= rho and the segment from c_Q to x stays in B and Q),
  *   phi(x) = phi_Q(x) >= phi_Q(c_Q) + g_Q(c_Q).(x - c_Q) - M_Q rho^2 / 2,
- * M_Q a bound on phi_Q's Hessian over Q's part of B. The smallest of these over the cells bounds
+ * M_Q a bound on how much phi_Q bends down over Q's part of B (cell_bend_bound). The smallest of these over the cells bounds
  * phi over the region, and no gradient jump enters. Unlike the Lipschitz ball (phi(c) - L rho),
  * sliding along the surface costs only the curvature term, so the certified check of FWGSS
  * (scc_fwgss_verify) closes on grids (data set: a median of 1.2K-7K evaluations) where the cells'
@@ -118,7 +118,7 @@ typedef struct cell_poly {
     uint64_t l;   /* full-grid cell index (UINT64_MAX: empty slot) */
     double v[32]; /* node values, slot order */
     double b[64]; /* Bernstein coefficients on [-1,1]^3, s = i + 4j + 16k */
-    double hess;  /* bound on the Hessian's norm over the cell (< 0: the cell has no values) */
+    double hess;  /* how much phi bends down over the cell, cell_bend_bound (< 0: the cell has no values) */
     double bmin;  /* the least Bernstein coefficient less rounding: phi >= bmin on the cell */
     double vabs;  /* the largest |node value|: the scale of the rounding in the coefficients */
     double lo[3], c0[3]; /* cell's lower corner, 2 / h: local coordinates xi = c0 (x - lo) - 1 */
@@ -166,43 +166,6 @@ static void cell_bernstein_of(const double v[32], double b[64])
     memcpy(b, f, sizeof f);
 }
 
-/* Bound on the Hessian's operator norm of a tensor-cubic over a box with sides h: the largest
- * |coefficient| of each second derivative's Bernstein form (d2/dx_d2: 6/h_d^2 times second
- * differences; mixed: 9/(h_d h_e) times mixed differences), then the smaller of the Frobenius norm
- * and the largest row sum. */
-static double cell_hessian_bound(const double b[64], const double h[3])
-{
-    static const int stride[3] = { 1, 4, 16 };
-    double H[3][3];
-    for (int d = 0; d < 3; ++d)
-        for (int e = d; e < 3; ++e) {
-            int lim[3] = { 4, 4, 4 };
-            lim[d] -= d == e ? 2 : 1;
-            if (e != d) lim[e] -= 1;
-            const int sd = stride[d], se = stride[e];
-            double m = 0.0;
-            for (int k = 0; k < lim[2]; ++k)
-                for (int j = 0; j < lim[1]; ++j)
-                    for (int i = 0; i < lim[0]; ++i) {
-                        const int s = i + 4 * j + 16 * k;
-                        const double x = fabs(b[s + sd + se] - b[s + sd] - b[s + se] + b[s]);
-                        m = x > m ? x : m;
-                    }
-            /* pure: b[s + 2 sd] - 2 b[s + sd] + b[s]; mixed: the mixed difference (the same expression) */
-            H[d][e] = H[e][d] = d == e ? 6.0 * m / (h[d] * h[d]) : 9.0 * m / (h[d] * h[e]);
-        }
-    double fro = 0.0, row = 0.0;
-    for (int d = 0; d < 3; ++d) {
-        double r = 0.0;
-        for (int e = 0; e < 3; ++e) {
-            fro += H[d][e] * H[d][e];
-            r += H[d][e];
-        }
-        row = r > row ? r : row;
-    }
-    return scc_fmin(sqrt(fro), row);
-}
-
 /* The smallest eigenvalue of a symmetric 3x3 matrix (the trigonometric closed form). */
 static double sym3_min_eigenvalue(const double A[3][3])
 {
@@ -222,15 +185,17 @@ static double sym3_min_eigenvalue(const double A[3][3])
 
 /* Bound on how much a tensor-cubic bends down over a box with sides h (ours): K >= 0 with
  * phi(y) >= phi(x) + grad phi(x).(y - x) - K |y - x|^2 / 2 for x, y in the box, i.e. K >= -lambda_min
- * of the Hessian there. Each second derivative's Bernstein coefficients (as cell_hessian_bound)
- * enclose it: the Hessian lies in an interval matrix with midpoint C and radius R, and by Weyl's
- * inequality lambda_min >= lambda_min(C) - |R|_2 >= lambda_min(C) - |R|_F. Where the field curves
- * up (a convex part of the surface: the outside of a torus) K is about the interpolation error,
- * where the Hessian's norm (cell_hessian_bound) is the curvature. */
+ * of the Hessian there. Each second derivative's Bernstein coefficients enclose it (d2/dx_d2: 6/h_d^2
+ * times second differences; mixed: 9/(h_d h_e) times mixed differences), so the Hessian lies in an
+ * interval matrix with midpoint C and radius R: K is the smaller of a bound on its operator norm (the
+ * largest |coefficient| per entry, then the smaller of the Frobenius norm and the largest row sum)
+ * and, by Weyl's inequality lambda_min >= lambda_min(C) - |R|_2 >= lambda_min(C) - |R|_F, of
+ * -lambda_min. Where the field curves up (a convex part of the surface: the outside of a torus) the
+ * latter is about the interpolation error, where the norm is the curvature. */
 static double cell_bend_bound(const double b[64], const double h[3])
 {
     static const int stride[3] = { 1, 4, 16 };
-    double C[3][3], rad2 = 0.0, scale = 0.0;
+    double C[3][3], H[3][3], rad2 = 0.0, scale = 0.0;
     for (int d = 0; d < 3; ++d)
         for (int e = d; e < 3; ++e) {
             int lim[3] = { 4, 4, 4 };
@@ -241,19 +206,31 @@ static double cell_bend_bound(const double b[64], const double h[3])
             for (int k = 0; k < lim[2]; ++k)
                 for (int j = 0; j < lim[1]; ++j)
                     for (int i = 0; i < lim[0]; ++i) {
+                        /* pure: b[s + 2 sd] - 2 b[s + sd] + b[s]; mixed: the mixed difference (the same expression) */
                         const int s = i + 4 * j + 16 * k;
                         const double x = b[s + sd + se] - b[s + sd] - b[s + se] + b[s];
                         lo = x < lo ? x : lo;
                         hi = x > hi ? x : hi;
                     }
+            const double m = fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi);
+            H[d][e] = H[e][d] = d == e ? 6.0 * m / (h[d] * h[d]) : 9.0 * m / (h[d] * h[e]);
             const double f = d == e ? 6.0 / (h[d] * h[d]) : 9.0 / (h[d] * h[e]);
             const double mid = 0.5 * (lo + hi) * f, r = 0.5 * (hi - lo) * f, w = d == e ? 1.0 : 2.0;
             C[d][e] = C[e][d] = mid;
             rad2 += w * r * r;
             scale += w * (fabs(mid) + r) * (fabs(mid) + r);
         }
+    double fro = 0.0, row = 0.0;
+    for (int d = 0; d < 3; ++d) {
+        double r = 0.0;
+        for (int e = 0; e < 3; ++e) {
+            fro += H[d][e] * H[d][e];
+            r += H[d][e];
+        }
+        row = r > row ? r : row;
+    }
     const double lmin = sym3_min_eigenvalue(C) - sqrt(rad2) - 1e-9 * sqrt(scale); /* less rounding in the closed form */
-    return lmin < 0.0 ? -lmin : 0.0;
+    return scc_fmin(scc_fmin(sqrt(fro), row), lmin < 0.0 ? -lmin : 0.0);
 }
 
 /* Re-expresses the cubic with Bernstein coefficients p[0], p[st], p[2 st], p[3 st] on [-1,1] on
@@ -510,7 +487,7 @@ static const cell_poly* cell_poly_at(grid_bound_ctx* ctx, const uint32_t ijk[3])
         cell_bernstein_of(e->v, e->b);
     }
     const double h[3] = { g->h.x, g->h.y, g->h.z }, lo[3] = { g->lo.x, g->lo.y, g->lo.z };
-    e->hess = scc_fmin(cell_hessian_bound(e->b, h), cell_bend_bound(e->b, h));
+    e->hess = cell_bend_bound(e->b, h);
     e->vabs = 0.0;
     for (int k = 0; k < 32; ++k) e->vabs = scc_fmax(e->vabs, fabs(e->v[k]));
     e->bmin = INFINITY;
@@ -647,7 +624,7 @@ static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const
                         for (int s = 0; s < 64; ++s)
                             if ((s / stride) % 4 == 0) reexpress_cubic(b + s, stride, xa[d], xb[d]);
                     }
-                    extra = scc_fmin(extra, 0.5 * (1.0 + 1e-9) * scc_fmin(cell_hessian_bound(b, hs), cell_bend_bound(b, hs)) * rho * rho);
+                    extra = scc_fmin(extra, 0.5 * (1.0 + 1e-9) * cell_bend_bound(b, hs) * rho * rho);
                     /* the coefficients on the box's part enclose phi's range there as well */
                     double bl = INFINITY;
                     for (int s = 0; s < 64; ++s) bl = scc_fmin(bl, b[s]);
