@@ -527,9 +527,9 @@ static double off_domain_distance(const scc_grid* g, const scc_tri_state* st, co
  * q's clamped coordinates in the linear part: a constant on an axis where the box lies beyond the
  * domain, x's coordinate less the box's overhang where it straddles a face. When the box lies beyond
  * the domain, d (convex: its first-order bound) adds to that: phi >= sqrt(d_lo^2 + max(0, bound)^2). */
-static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const region* r, scc_vec3 c, double rho, double rs, double rt,
-                             double accel, double margin, int force_local, int64_t* evals, double* out_bound, double* out_space,
-                             double* out_time)
+static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const region* r, const corners* cx, scc_vec3 c, double rho,
+                             double rs, double rt, double accel, double margin, int force_local, int64_t* evals, double* out_bound,
+                             double* out_space, double* out_time)
 {
     const scc_grid* g = ctx->g;
     const double cc[3] = { c.x, c.y, c.z }, lo[3] = { g->lo.x, g->lo.y, g->lo.z }, hi[3] = { g->hi.x, g->hi.y, g->hi.z };
@@ -605,7 +605,7 @@ static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const
                     const double l0 = e->lo[d] + (xa[d] + 1.0) / e->c0[d] - q, l1 = e->lo[d] + (xb[d] + 1.0) / e->c0[d] - q;
                     lin_box += scc_fmin(gqa[d] * l0, gqa[d] * l1);
                 }
-                const first_order f = first_order_terms(st, r, c, scc_v3(ge[0], ge[1], ge[2]), accel);
+                const first_order f = first_order_of(cx, r->tb - r->ta, c, scc_v3(ge[0], ge[1], ge[2]), accel);
                 const double lin = scc_fmax(offset + f.lin - f.curve, lin_box);
                 const double base = val + lin - (1e-12 * rho * (1.0 + scc_len(gq)) + 1e-15);
                 double range = e->bmin;
@@ -621,8 +621,10 @@ static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const
                             xb[d] = mid + 5e-7;
                         }
                         hs[d] = 0.5 * h[d] * (xb[d] - xa[d]);
-                        for (int s = 0; s < 64; ++s)
-                            if ((s / stride) % 4 == 0) reexpress_cubic(b + s, stride, xa[d], xb[d]);
+                        /* the 16 lines along axis d start where its digit is 0 */
+                        const int s1 = d == 0 ? 4 : 1, s2 = d == 2 ? 4 : 16;
+                        for (int q = 0; q < 4; ++q)
+                            for (int p = 0; p < 4; ++p) reexpress_cubic(b + p * s1 + q * s2, stride, xa[d], xb[d]);
                     }
                     extra = scc_fmin(extra, 0.5 * (1.0 + 1e-9) * cell_bend_bound(b, hs) * rho * rho);
                     /* the coefficients on the box's part enclose phi's range there as well */
@@ -659,7 +661,7 @@ static int grid_region_bound(grid_bound_ctx* ctx, const scc_tri_state* st, const
  * motion costs only the spread of the gradient. Returns 0 when it does not apply (a block of the
  * box without values, more than GRID_GRAD_BLOCKS blocks, or leaving the domain of a grid not
  * positive outside). */
-#define GRID_GRAD_BLOCKS 512
+#define GRID_GRAD_BLOCKS 128
 static int grid_gradient_bound(const scc_grid* g, const scc_tri_state* st, const region* r, const corners* cx, scc_vec3 c, double phi_c,
                                double rho, double accel, int64_t* evals, double* out_bound, double* out_space, double* out_time,
                                double* out_points)
@@ -783,12 +785,13 @@ int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const dou
     const double rt = scc_tri_speed_bound(m) * (tb - ta);
     double space, time;
     int64_t evals = 0;
+    const corners cx = corners_of(&st, &r);
     if (local == 2) {
-        const corners cx = corners_of(&st, &r);
         return grid_gradient_bound(ctx.g, &st, &r, &cx, c, scc_sdf_eval(sdf, c, NULL), rs + rt, scc_tri_accel_bound(m), &evals, out_bound, &space,
                                    &time, NULL);
     }
-    return grid_region_bound(&ctx, &st, &r, c, rs + rt, rs, rt, scc_tri_accel_bound(m), -INFINITY, local, &evals, out_bound, &space, &time);
+    return grid_region_bound(&ctx, &st, &r, &cx, c, rs + rt, rs, rt, scc_tri_accel_bound(m), -INFINITY, local, &evals, out_bound, &space,
+                             &time);
 }
 
 /* The region store of a check of FWGSS (scc_fwgss_verify) starts in a buffer on the stack (ours): a
@@ -947,7 +950,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
                 gs = s2;
                 gt = t2;
             }
-            if (bound <= p->margin && grid_region_bound(grid, &st, &r, c, rho, rs, rt, accel, p->margin, 0, &evals, &b2, &s2, &t2) && b2 > bound) {
+            if (bound <= p->margin && grid_region_bound(grid, &st, &r, &cx, c, rho, rs, rt, accel, p->margin, 0, &evals, &b2, &s2, &t2) && b2 > bound) {
                 bound = b2;
                 gs = s2;
                 gt = t2;
