@@ -131,11 +131,12 @@ int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p);
  * phi(x) >= phi(c) + g.(x - c) - K |x - c|^2 / 2 for every x within rad of c, g the gradient
  * scc_sdf_eval gives at c (0 where phi is convex); INFINITY when unknown. */
 double scc_sdf_bend_bound(const scc_sdf* sdf, scc_vec3 c, double rad);
-/* The lower bound of phi that the check uses on a grid, for tests: over the sub-triangle with weights
+/* The lower bounds of phi that the check uses on a grid, for tests: over the sub-triangle with weights
  * (u[i], v[i], 1 - u[i] - v[i]) of motion m over [ta, tb]; `local` 1: every cell's Hessian bound over
- * its part of the region's box (0: the whole cell's where the box lies inside it). Returns 0 when the
- * bound does not apply (not a grid, the box leaves the domain, spans more than 3 cells per axis or
- * touches a cell without values). */
+ * its part of the region's box (0: the whole cell's where the box lies inside it); 2: the bound from
+ * the gradient intervals of the blocks the box touches instead. Returns 0 when the bound does not
+ * apply (not a grid, the box leaves the domain of a grid not positive outside it, spans more than 3
+ * cells per axis (512 blocks in all) or touches a cell without values). */
 int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const double u[3], const double v[3], double ta, double tb, int local,
                           double* out_bound);
 

@@ -70,8 +70,10 @@ void scc_grid_destroy(scc_grid* g)
     scc_free(&al, g->hole_source, (size_t)g->n_cells * sizeof(uint32_t));
     scc_free(&al, g->blocks, (size_t)g->block_count * sizeof(double));
     scc_free(&al, g->block_lipschitz, (size_t)((g->res[0] + 3) / 4) * ((g->res[1] + 3) / 4) * ((g->res[2] + 3) / 4) * sizeof(float));
+    scc_free(&al, g->block_grad, scc_grid_grad_block_count(g) * 6 * sizeof(float));
     scc_free(&al, g->vertex_block, (size_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1) * sizeof(uint32_t));
     scc_free(&al, g->axis_coef, 2 * ((size_t)g->res[0] + g->res[1] + g->res[2]) * sizeof(double));
+    scc_free(&al, g->bernstein, 32 * 64 * sizeof(double));
     scc_free(&al, g->fields, (size_t)g->field_count * sizeof *g->fields);
     scc_free(&al, g, sizeof *g);
 }
@@ -88,8 +90,10 @@ size_t scc_grid_memory(const scc_grid* g)
     if (g->hole_source) b += (size_t)g->n_cells * sizeof(uint32_t);
     b += (size_t)g->block_count * sizeof(double);
     if (g->block_lipschitz) b += (size_t)((g->res[0] + 3) / 4) * ((g->res[1] + 3) / 4) * ((g->res[2] + 3) / 4) * sizeof(float);
+    if (g->block_grad) b += scc_grid_grad_block_count(g) * 6 * sizeof(float);
     if (g->vertex_block) b += (size_t)(g->res[0] + 1) * (g->res[1] + 1) * (g->res[2] + 1) * sizeof(uint32_t);
     if (g->axis_coef) b += 2 * ((size_t)g->res[0] + g->res[1] + g->res[2]) * sizeof(double);
+    if (g->bernstein) b += 32 * 64 * sizeof(double);
     return b;
 }
 

@@ -60,6 +60,9 @@ typedef struct scc_grid {
 
     /* Derived data for field 0 (scc_grid_finalize). */
     float* block_lipschitz;    /* max of the cell bounds per block of 4^3 cells (cells without values: 1) */
+    float* block_grad;         /* per block of SCC_GRID_GRAD_BLOCK^3 cells, 6 floats: the least then the largest value of each
+                                  component of grad phi over its cells (their Bernstein enclosures,
+                                  rounded outward); -inf / +inf when a cell of the block has no values */
     float* cell_lipschitz;     /* per stored cell of field 0: bound on |grad phi| inside it, or -1
                                   when the cell touches a not-sampled node (then it has no value) */
     uint32_t* hole_source;     /* n_cells entries when some cell has no value, else NULL: for a cell
@@ -77,6 +80,8 @@ typedef struct scc_grid {
     uint64_t block_count;      /* doubles in blocks */
     uint32_t* vertex_block;    /* narrow band built in-tree: per grid vertex, its block in `blocks`
                                   (only vertices of kept cells have one); NULL when dense */
+    double* bernstein;         /* (scc_grid_finalize) 32 x 64: row k holds node slot k's share of each of a
+                                  cell's 64 tensor Bernstein coefficients (scc_cell_bernstein, transposed) */
     double* axis_coef;         /* (scc_grid_finalize) per axis d, per cell m along it, the pair
                                   c0 = 2/(hi-lo), c1 = (hi+lo)/(hi-lo) of the cell's interval exactly as
                                   Discregrid and Bullet compute them per query: 2 (res[0]+res[1]+res[2])
@@ -85,6 +90,14 @@ typedef struct scc_grid {
                                   evaluation goes from the cell straight to its 8 blocks */
     scc_allocator allocator;   /* what freed the arrays (copied at creation) */
 } scc_grid;
+
+/* Cells per axis of a block of block_grad, and the blocks per axis. */
+#define SCC_GRID_GRAD_BLOCK 2
+static inline uint32_t scc_grid_grad_blocks(const scc_grid* g, int d) { return (g->res[d] + SCC_GRID_GRAD_BLOCK - 1) / SCC_GRID_GRAD_BLOCK; }
+static inline size_t scc_grid_grad_block_count(const scc_grid* g)
+{
+    return (size_t)scc_grid_grad_blocks(g, 0) * scc_grid_grad_blocks(g, 1) * scc_grid_grad_blocks(g, 2);
+}
 
 /* A task runner: runs task(ctx, i) for every i in [0, count), possibly in parallel, and
  * returns when all are done. `stage` tells progress reporters which phase runs

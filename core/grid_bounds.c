@@ -42,6 +42,27 @@ static float round_up_float(double v)
     return f;
 }
 
+static float round_down_float(double v)
+{
+    float f = (float)v;
+    if ((double)f > v) f = nextafterf(f, -INFINITY);
+    return f;
+}
+
+/* Widens block q's gradient intervals (block_grad) by a cell's: lo[d], hi[d] per component. */
+static void widen_block_grad(scc_grid* g, uint64_t l, const double lo[3], const double hi[3])
+{
+    uint32_t ijk[3];
+    cell_ijk(g, l, ijk);
+    const uint32_t nbx = scc_grid_grad_blocks(g, 0), nby = scc_grid_grad_blocks(g, 1), B = SCC_GRID_GRAD_BLOCK;
+    float* bg = g->block_grad + 6 * (ijk[0] / B + (uint64_t)nbx * (ijk[1] / B + (uint64_t)nby * (ijk[2] / B)));
+    for (int d = 0; d < 3; ++d) {
+        const float a = round_down_float(lo[d]), b = round_up_float(hi[d]);
+        if (a < bg[d]) bg[d] = a;
+        if (b > bg[3 + d]) bg[3 + d] = b;
+    }
+}
+
 static void cell_bound_task(void* vctx, uint32_t task)
 {
     finalize_ctx* ctx = vctx;
@@ -53,14 +74,23 @@ static void cell_bound_task(void* vctx, uint32_t task)
     const double c0[3] = { 2.0 / g->h.x, 2.0 / g->h.y, 2.0 / g->h.z };
     for (uint64_t l = begin; l < end; ++l) {
         const uint32_t c = fd->map[l];
-        if (c == SCC_GRID_NO_CELL) continue;
+        if (c == SCC_GRID_NO_CELL) {
+            const double inf[3] = { INFINITY, INFINITY, INFINITY }, minf[3] = { -INFINITY, -INFINITY, -INFINITY };
+            widen_block_grad(g, l, minf, inf);
+            continue;
+        }
         double v[32];
         uint32_t ijk[3];
         cell_ijk(g, l, ijk);
         gather_cell(g, fd, c, ijk, v);
         int hole = 0;
         for (int a = 0; a < 32; ++a) hole |= v[a] == SCC_GRID_NO_VALUE;
-        if (hole) { g->cell_lipschitz[c] = -1.0f; continue; }
+        if (hole) {
+            const double inf[3] = { INFINITY, INFINITY, INFINITY }, minf[3] = { -INFINITY, -INFINITY, -INFINITY };
+            g->cell_lipschitz[c] = -1.0f;
+            widen_block_grad(g, l, minf, inf);
+            continue;
+        }
         /* Bernstein coefficients of phi on the cell (degree 3 per axis), then those of each
          * partial derivative by differences: d/dxi of a cubic Bernstein form on [-1,1] has the
          * degree-2 coefficients 1.5 (b[i+1] - b[i]) along that axis. */
@@ -69,10 +99,10 @@ static void cell_bound_task(void* vctx, uint32_t task)
             const double* row = ctx->bt->by_node[k];
             for (int s = 0; s < 64; ++s) b[s] += row[s] * v[k];
         }
-        double sum2 = 0.0;
+        double sum2 = 0.0, glo[3], ghi[3];
         for (int d = 0; d < 3; ++d) {
             const int stride = d == 0 ? 1 : (d == 1 ? 4 : 16);
-            double bmax = 0.0;
+            double bmax = 0.0, emin = INFINITY, emax = -INFINITY;
             for (int s = 0; s < 64; ++s) {
                 if ((s / stride) % 4 != 0) continue;
                 /* degree-2 coefficients along d, elevated back to degree 3 (convex combinations,
@@ -82,9 +112,16 @@ static void cell_bound_task(void* vctx, uint32_t task)
                 const double q[4] = { e0, (e0 + 2.0 * e1) / 3.0, (2.0 * e1 + e2) / 3.0, e2 };
                 for (int m = 0; m < 4; ++m)
                     if (fabs(q[m]) > bmax) bmax = fabs(q[m]);
+                emin = fmin(emin, fmin(e0, fmin(e1, e2)));
+                emax = fmax(emax, fmax(e0, fmax(e1, e2)));
             }
             sum2 += (c0[d] * bmax) * (c0[d] * bmax);
+            /* the component's range (the degree-2 coefficients enclose it), widened for rounding */
+            const double pad = 1e-9 * c0[d] * bmax + 1e-300;
+            glo[d] = c0[d] * emin - pad;
+            ghi[d] = c0[d] * emax + pad;
         }
+        widen_block_grad(g, l, glo, ghi);
         /* Small relative margin for rounding in the sums above. */
         g->cell_lipschitz[c] = round_up_float(sqrt(sum2) * (1.0 + 1e-9) + 1e-300);
     }
@@ -196,7 +233,16 @@ static scc_grid_status compute_cell_bounds(scc_grid* g, const bern_tables* bt, s
 {
     g->cell_lipschitz = scc_alloc(&g->allocator, (size_t)g->fields[0].cell_count * sizeof(float));
     if (g->fields[0].cell_count && !g->cell_lipschitz) return SCC_GRID_OUT_OF_MEMORY;
-    finalize_ctx ctx = { g, bt, 2048 };
+    const uint64_t nblocks = scc_grid_grad_block_count(g);
+    g->block_grad = scc_alloc(&g->allocator, (size_t)nblocks * 6 * sizeof(float));
+    if (!g->block_grad) return SCC_GRID_OUT_OF_MEMORY;
+    for (uint64_t q = 0; q < nblocks; ++q)
+        for (int d = 0; d < 3; ++d) {
+            g->block_grad[6 * q + d] = INFINITY;
+            g->block_grad[6 * q + 3 + d] = -INFINITY;
+        }
+    /* tasks of whole layers of blocks (block_grad is written without locks) */
+    finalize_ctx ctx = { g, bt, (uint64_t)g->res[0] * g->res[1] * SCC_GRID_GRAD_BLOCK * (SCC_GRID_GRAD_BLOCK == 1 ? 4 : 2) };
     const uint32_t tasks = (uint32_t)((g->n_cells + ctx.chunk - 1) / ctx.chunk);
     const int cancelled = run_tasks(parallel_for, parallel_user, SCC_GRID_STAGE_CELLS, tasks, cell_bound_task, &ctx);
     return cancelled ? SCC_GRID_CANCELLED : SCC_GRID_OK;
@@ -399,6 +445,13 @@ scc_grid_status scc_grid_finalize(scc_grid* g, double band, scc_parallel_for_fn*
     if (st == SCC_GRID_OK) {
         g->outside_positive = boundary_cells_pass(g, nodes_nonnegative, bt);
         fill_sdf_interface(g, g->outside_positive || boundary_cells_pass(g, bernstein_nonnegative, bt));
+    }
+    /* kept for the certified check's per-cell Taylor bounds (certified.c), which would otherwise
+     * rebuild each cell's Bernstein form from 32 interpolations per query */
+    if (st == SCC_GRID_OK && !g->bernstein) {
+        g->bernstein = scc_alloc(a, sizeof bt->by_node);
+        if (!g->bernstein) st = SCC_GRID_OUT_OF_MEMORY;
+        else memcpy(g->bernstein, bt->by_node, sizeof bt->by_node);
     }
     scc_free(a, bt, sizeof *bt);
     return st;

@@ -4,6 +4,7 @@
  * 360 degrees in one step onto a box) and Fig. 11 (a triangle falling flat on a box face). */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include "test_util.h"
 
 #define DT (1.0 / 60.0)
@@ -200,14 +201,34 @@ END_TEST
  * with the tube's top or bottom in one of these, which its certified check corrects), and the
  * check stays affordable: outside the grid's tight domain scc_grid_lipschitz_in bounds |grad phi|
  * by max(1, L), where hypot(1, L) made the check split ~2x more (1,550 evaluations per query). */
+/* The torus (R 0.1 m, r 0.05 m) and its 32^3 grid fitted to its box. */
+static void torus_grid32(sdfccd_SdfId* torus, sdfccd_SdfId* grid)
+{
+    ck_assert_int_eq(sdfccd_create_torus(0.1, 0.05, torus), SDFCCD_OK);
+    sdfccd_GridDef gd = sdfccd_default_grid_def();
+    gd.resolution[0] = gd.resolution[1] = gd.resolution[2] = 32;
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(*torus, &gd, grid), SDFCCD_OK);
+}
+
+/* FWGSS (with its check) and the certified search on one triangle of the grid: the same hit, and
+ * FWGSS's TOI within 1 us of the certified bracket; returns FWGSS's result. */
+static sdfccd_QueryResult fwgss_agrees(sdfccd_SdfId grid, const sdfccd_Vec3 tri[3], const sdfccd_RigidMotion* m, int i)
+{
+    const sdfccd_QueryParams pf = params_for(SDFCCD_METHOD_FWGSS), pc = params_for(SDFCCD_METHOD_CERTIFIED);
+    sdfccd_QueryResult rf, rc;
+    ck_assert_int_eq(sdfccd_query_triangle(grid, NULL, tri, m, 0.0, DT, &pf, NULL, 0, &rf), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_query_triangle(grid, NULL, tri, m, 0.0, DT, &pc, NULL, 0, &rc), SDFCCD_OK);
+    ck_assert_int_eq(rf.hit, rc.hit);
+    if (rc.hit)
+        ck_assert_msg(rf.toi <= rc.toi + 1e-6 && rf.toi >= rc.toi_lower - 1e-6, "case %d: FWGSS toi %.9g, certified [%.9g, %.9g]", i, rf.toi,
+                      rc.toi_lower, rc.toi);
+    return rf;
+}
+
 START_TEST(test_torus_grid_check_cheap)
 {
     sdfccd_SdfId torus, grid;
-    ck_assert_int_eq(sdfccd_create_torus(0.1, 0.05, &torus), SDFCCD_OK);
-    sdfccd_GridDef gd = sdfccd_default_grid_def();
-    gd.resolution[0] = gd.resolution[1] = gd.resolution[2] = 32;
-    ck_assert_int_eq(sdfccd_create_grid_from_sdf(torus, &gd, &grid), SDFCCD_OK);
-    const sdfccd_QueryParams pf = params_for(SDFCCD_METHOD_FWGSS), pc = params_for(SDFCCD_METHOD_CERTIFIED);
+    torus_grid32(&torus, &grid);
     const int n = 24;
     long long evals = 0;
     int hits = 0;
@@ -217,16 +238,43 @@ START_TEST(test_torus_grid_check_cheap)
         const sdfccd_Vec3 s = { 0.3 * rc * cos(ph), 0.3 * rc * sin(ph), 0.3 * zc }, aim = { 0.1 * cos(th), 0.1 * sin(th), 0.0 };
         const sdfccd_Vec3 tri[3] = { s, { s.x + 0.02, s.y, s.z + 0.005 }, { s.x, s.y + 0.015, s.z - 0.01 } };
         sdfccd_RigidMotion m = translating((sdfccd_Vec3){ (aim.x - s.x) / DT, (aim.y - s.y) / DT, (aim.z - s.z) / DT });
-        sdfccd_QueryResult rf, rc2;
-        ck_assert_int_eq(sdfccd_query_triangle(grid, NULL, tri, &m, 0.0, DT, &pf, NULL, 0, &rf), SDFCCD_OK);
-        ck_assert_int_eq(sdfccd_query_triangle(grid, NULL, tri, &m, 0.0, DT, &pc, NULL, 0, &rc2), SDFCCD_OK);
-        ck_assert_int_eq(rf.hit, rc2.hit);
-        if (rc2.hit) ck_assert_msg(rf.toi <= rc2.toi + 1e-6, "case %d: FWGSS toi %.9g after the certified %.9g", i, rf.toi, rc2.toi);
+        const sdfccd_QueryResult rf = fwgss_agrees(grid, tri, &m, i);
         evals += (long long)rf.sdf_evaluations;
         hits += rf.hit;
     }
     ck_assert_int_eq(hits, n);
+    if (getenv("SDFCCD_TEST_VERBOSE")) fprintf(stderr, "aimed: %.1f evaluations per query\n", (double)evals / n);
     ck_assert_msg(evals <= 1000LL * n, "%.1f evaluations per query on the smooth torus grid", (double)evals / n);
+    sdfccd_destroy_sdf(grid);
+    sdfccd_destroy_sdf(torus);
+}
+END_TEST
+
+/* Triangles falling onto the top of the 32^3 torus grid's tube, whose contact lies on the grid's
+ * domain boundary (the domain is fitted to the torus's box): the check of FWGSS must still agree
+ * with the certified search, and its regions leaving the domain must be bounded by the first-order
+ * form outside it (phi = sqrt(d^2 + phi_q^2), certified.c) and across cells by the blocks' gradient
+ * intervals rather than by the Lipschitz ball, which cannot slide along the top face (12,946
+ * evaluations per query with the ball there; 2,947 now). */
+START_TEST(test_torus_grid_top_check_cheap)
+{
+    sdfccd_SdfId torus, grid;
+    torus_grid32(&torus, &grid);
+    const int n = 24;
+    long long evals = 0;
+    for (int i = 0; i < n; ++i) {
+        /* 15 cm above the tube's top circle, tilted, aimed 5 cm below the top (the tube's centre
+         * circle: the path reaches its cells, so the check runs) while sliding sideways */
+        const double ph = 2.39996 * i, rr = 0.1 + 0.004 * ((i % 5) - 2), tilt = 0.003 * ((i % 3) - 1);
+        const sdfccd_Vec3 s = { rr * cos(ph), rr * sin(ph), 0.2 };
+        const sdfccd_Vec3 tri[3] = { { s.x - 0.01, s.y - 0.006, s.z + tilt }, { s.x + 0.01, s.y - 0.004, s.z }, { s.x, s.y + 0.011, s.z - tilt } };
+        sdfccd_RigidMotion m = translating((sdfccd_Vec3){ 0.02 * cos(1.7 * i) / DT, 0.02 * sin(1.7 * i) / DT, -0.2 / DT });
+        const sdfccd_QueryResult rf = fwgss_agrees(grid, tri, &m, i);
+        ck_assert(rf.hit);
+        evals += (long long)rf.sdf_evaluations;
+    }
+    if (getenv("SDFCCD_TEST_VERBOSE")) fprintf(stderr, "top: %.1f evaluations per query\n", (double)evals / n);
+    ck_assert_msg(evals <= 5000LL * n, "%.1f evaluations per query on the torus grid's top", (double)evals / n);
     sdfccd_destroy_sdf(grid);
     sdfccd_destroy_sdf(torus);
 }
@@ -442,6 +490,7 @@ int main(void)
     test_add_memory_fixture(fail);
     tcase_add_test(fail, test_torus_tunnel_twice);
     tcase_add_test(fail, test_torus_grid_check_cheap);
+    tcase_add_test(fail, test_torus_grid_top_check_cheap);
     tcase_add_test(fail, test_pyramid_spin_360);
     tcase_add_test(fail, test_flat_triangle_subdivision);
     suite_add_tcase(s, fail);

@@ -20,14 +20,21 @@ static double phi_at(const scc_sdf* sdf, const scc_tri_motion* m, double u, doub
     return scc_sdf_eval(sdf, scc_tri_point_at(m, b, t, NULL), NULL);
 }
 
+static void check_grid_id(sdfccd_SdfId id, const char* path, unsigned seed);
+
 static void check_grid(const char* path, unsigned seed)
 {
     sdfccd_SdfId id;
     ck_assert_int_eq(sdfccd_load_grid(path, &id), SDFCCD_OK);
+    check_grid_id(id, path, seed);
+}
+
+static void check_grid_id(sdfccd_SdfId id, const char* path, unsigned seed)
+{
     const scc_grid* g = test_grid_of(id);
     const scc_sdf* sdf = &g->base;
     test_rng rng = { seed };
-    int applied = 0, tight = 0, small = 0;
+    int applied = 0, tight = 0, small = 0, applied_grad = 0, outside = 0;
     double worst_gap = INFINITY;
     for (int trial = 0; trial < 400; ++trial) {
         /* a point near the surface (a few Newton steps from a random point of the domain) */
@@ -84,10 +91,20 @@ static void check_grid(const char* path, unsigned seed)
                     const double pu = u[2] + a * (u[0] - u[2]) + b * (u[1] - u[2]), pv = v[2] + a * (v[0] - v[2]) + b * (v[1] - v[2]);
                     lowest = fmin(lowest, phi_at(sdf, &m, pu, pv, ta + dt * k / 10.0));
                 }
-        for (int local = 0; local < 2; ++local) {
+        for (int local = 0; local < 3; ++local) {
             double bound;
             if (!scc_grid_region_bound(sdf, &m, u, v, ta, tb, local, &bound)) continue;
-            applied++;
+            if (local == 2) applied_grad++;
+            else applied++;
+            if (local == 2) {
+                /* regions reaching outside the domain: phi there is sqrt(d^2 + phi_q^2) */
+                scc_tri_state st;
+                scc_tri_state_at(&m, ta, &st);
+                for (int i = 0; i < 3; ++i) {
+                    const scc_vec3 p = st.x[i];
+                    outside += p.x < g->lo.x || p.y < g->lo.y || p.z < g->lo.z || p.x > g->hi.x || p.y > g->hi.y || p.z > g->hi.z;
+                }
+            }
             ck_assert_msg(bound <= lowest + 1e-12, "%s trial %d (local %d): bound %.9g above the sampled minimum %.9g", path, trial, local, bound,
                           lowest);
             worst_gap = fmin(worst_gap, lowest - bound);
@@ -101,23 +118,37 @@ static void check_grid(const char* path, unsigned seed)
                     extent = fmax(extent, scc_dist(scc_tri_point_at(&m, bi, ta, NULL), scc_tri_point_at(&m, bj, ta, NULL)));
                 }
             extent += scc_tri_speed_bound(&m) * dt;
-            if (local && extent < 5e-3 && fabs(lowest) < extent) {
+            if (local == 1 && extent < 5e-3 && fabs(lowest) < extent) {
                 small++;
                 tight += lowest - bound <= 0.1 * extent;
             }
         }
     }
-    printf("%s: the bound applied to %d regions, never above the sampled minimum (closest %.3g m); %d of %d small regions near the surface "
-           "bounded within a tenth of their extent\n",
-           path, applied, worst_gap, tight, small);
+    printf("%s: the bound applied to %d regions, the gradient-interval bound to %d (%d corners outside the domain), never above the sampled "
+           "minimum (closest %.3g m); %d of %d small regions near the surface bounded within a tenth of their extent\n",
+           path, applied, applied_grad, outside, worst_gap, tight, small);
     fflush(stdout);
     ck_assert_int_gt(applied, 200);
+    ck_assert_int_gt(applied_grad, 200);
     ck_assert_int_gt(small, 40);
     ck_assert_msg(tight * 10 >= small * 8, "%s: only %d of %d small regions bounded within a tenth of their extent", path, tight, small);
     sdfccd_destroy_sdf(id);
 }
 
 START_TEST(test_concave_box_grid) { check_grid(SDFCCD_DATA_DIR "/sdf/concave_box_r32.cdf", 20261126u); }
+END_TEST
+
+/* The 32^3 grid of a torus fitted to its box: the surface touches the domain's faces, so regions
+ * near it reach outside the domain, where the bounds take phi = sqrt(d^2 + phi_q^2). */
+START_TEST(test_torus_grid)
+{
+    sdfccd_SdfId torus, grid;
+    ck_assert_int_eq(sdfccd_create_torus(0.1, 0.05, &torus), SDFCCD_OK);
+    sdfccd_GridDef gd = sdfccd_default_grid_def();
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(torus, &gd, &grid), SDFCCD_OK);
+    check_grid_id(grid, "torus 32^3", 20261127u);
+    sdfccd_destroy_sdf(torus);
+}
 END_TEST
 
 START_TEST(test_spike_grid) { check_grid(SDFCCD_DATA_DIR "/../samples/report/dataset_kinds/spikes.cdf", 20261127u); }
@@ -130,6 +161,7 @@ int main(void)
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, test_concave_box_grid);
     tcase_add_test(tc, test_spike_grid);
+    tcase_add_test(tc, test_torus_grid);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }
