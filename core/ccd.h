@@ -99,8 +99,10 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
  * proven more than max(SCC_VERIFY_TOL_FRACTION x time_tol, SCC_VERIFY_TOL) before it (3e-8 s at the
  * default time_tol: at 1e-7 s the 100K scaling scene's TOI was 1.5e-8 s after the certified bracket;
  * at 3e-8 s it is inside, at 1K, 10K and 100K), or after SCC_VERIFY_FACTOR x FWGSS's
- * evaluations + SCC_VERIFY_BASE_EVALS (at most SCC_VERIFY_MAX_EVALS; then the answer stands, unless an
- * earlier contact was witnessed). An earlier contact found replaces it, bracketed to the certified
+ * evaluations + SCC_VERIFY_BASE_EVALS (at most SCC_VERIFY_MAX_EVALS). A search stopped at a cap short of
+ * the witness is followed by scc_fwgss_probe from its unresolved region and run again seeded with the
+ * contact found (at most SCC_VERIFY_PROBES times); the answer stands unless an earlier contact was
+ * witnessed. An earlier contact found replaces it, bracketed to the certified
  * time tolerance. Returns 0 on allocation failure. */
 #define SCC_VERIFY_TOL 1e-8
 #define SCC_VERIFY_TOL_FRACTION 0.3
