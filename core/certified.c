@@ -905,16 +905,16 @@ static int verify_search(const scc_sdf* sdf, const scc_tri_motion* m, double ta,
             io->iterations = iterations;
             io->toi_lower = io->toi;
             if (io->state == SCC_NOT_CONVERGED) io->state = io->toi <= ta ? SCC_PENETRATING : SCC_HIT;
-            return 1;
+        } else if (c.state != SCC_NOT_CONVERGED && io->hit && io->state == SCC_NOT_CONVERGED) {
+            io->state = SCC_HIT; /* proven: no contact more than tol before the witness */
         }
-        if (c.state != SCC_NOT_CONVERGED && io->hit && io->state == SCC_NOT_CONVERGED) io->state = SCC_HIT; /* proven: no contact more than tol before the witness */
         /* Stopped at a cap with [lower bound, witness) unproven (ours): the search proves clearance
          * well but finds a thin contact (a box's corner entering a face the triangle slides over)
          * only by sampling its region's corners, which may never fall inside it. FWGSS's spatial
          * steps minimise phi over the whole triangle at one time: probed from the unresolved region
          * forward in time (scc_fwgss_probe), they find such a contact, and the search runs again
-         * seeded with it. */
-        const double t_hi = io->hit ? seed_t : tb;
+         * seeded with it. Likewise below an earlier witness the search found before its cap. */
+        const double t_hi = io->hit ? io->toi : tb;
         if (c.state != SCC_NOT_CONVERGED || round >= SCC_VERIFY_PROBES || !(c.toi_lower < t_hi - tol) || budget <= 0) return 1;
         scc_tri_hit w;
         scc_fwgss_probe(sdf, m, ta, tb, p, c.toi_lower, t_hi, low_b, tol, budget, &w);
