@@ -99,8 +99,10 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
  * proven more than max(SCC_VERIFY_TOL_FRACTION x time_tol, SCC_VERIFY_TOL) before it (3e-8 s at the
  * default time_tol: at 1e-7 s the 100K scaling scene's TOI was 1.5e-8 s after the certified bracket;
  * at 3e-8 s it is inside, at 1K, 10K and 100K), or after SCC_VERIFY_FACTOR x FWGSS's
- * evaluations + SCC_VERIFY_BASE_EVALS (at most SCC_VERIFY_MAX_EVALS; then the answer stands, unless an
- * earlier contact was witnessed). An earlier contact found replaces it, bracketed to the certified
+ * evaluations + SCC_VERIFY_BASE_EVALS (at most SCC_VERIFY_MAX_EVALS). A search stopped at a cap short of
+ * the witness is followed by scc_fwgss_probe from its unresolved region and run again seeded with the
+ * contact found (at most SCC_VERIFY_PROBES times); the answer stands unless an earlier contact was
+ * witnessed. An earlier contact found replaces it, bracketed to the certified
  * time tolerance. Returns 0 on allocation failure. */
 #define SCC_VERIFY_TOL 1e-8
 #define SCC_VERIFY_TOL_FRACTION 0.3
@@ -109,8 +111,16 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
 #define SCC_VERIFY_GRID_BASE_EVALS 65536 /* grids (their bound is certified.c's per-cell Taylor form) */
 #define SCC_VERIFY_GRID_MIN_LIPSCHITZ 2.25 /* grids are checked where their cells' gradient bound along the path exceeds this */
 #define SCC_VERIFY_MAX_EVALS 1000000
+#define SCC_VERIFY_PROBES 2 /* rounds of scc_fwgss_probe when the check stops at a cap short of FWGSS's witness */
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                      const scc_allocator* alloc, scc_tri_hit* io);
+/* A search for a contact in (t_lo, t_hi) near the weights b (fwgss.c; the check's fallback when it stops
+ * at a cap with its lower bound t_lo more than tol before t_hi): the minimum of phi over the triangle by
+ * FWGSS's spatial steps at t_lo + tol / 2, then at times 4x further each, up to t_hi; a contact found
+ * is moved back to where the triangle enters (FWGSS's kink probe). At most max_evals evaluations; out
+ * is a hit at the earliest contact found, or no hit. */
+void scc_fwgss_probe(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, double t_lo, double t_hi,
+                     const double b[3], double tol, int64_t max_evals, scc_tri_hit* out);
 /* scc_fwgss_verify, and with `force` also where FWGSS's own no-contact proof held (io a no-hit made
  * from a contact after tb: the check then proves [ta, tb] clear or finds a contact there). */
 int scc_fwgss_check(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,

@@ -543,22 +543,25 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
     return 1;
 }
 
+/* Whether a witness earlier than `before` is recorded (hit_t is the interval's end while there is none). */
+static int witnessed_before(const scc_fw_state* s, double before) { return s->hit && s->hit_t < before; }
+
 /* Whether the triangle touches at time t (a witness there): spatial steps (at most `steps` per
  * start) from the weights b, then from each vertex; s->b is kept. */
 static int contact_at_time(scc_fw_state* s, double t, const double b[3], int steps)
 {
     const double keep[3] = { s->b[0], s->b[1], s->b[2] };
     const double before = s->hit ? s->hit_t : INFINITY;
-    for (int k = 0; k < 4 && !(s->hit_t < before); ++k) {
+    for (int k = 0; k < 4 && !witnessed_before(s, before); ++k) {
         for (int j = 0; j < 3; ++j) s->b[j] = k == 0 ? b[j] : (double)(j == k - 1);
         for (int i = 0; i < steps && s->evals < s->p->max_evals; ++i) {
             double gap;
             const double step = spatial_step(s, t, &gap);
-            if (gap <= 0.0 || step <= s->dist_tol || s->hit_t < before) break;
+            if (gap <= 0.0 || step <= s->dist_tol || witnessed_before(s, before)) break;
         }
     }
     for (int j = 0; j < 3; ++j) s->b[j] = keep[j];
-    return s->hit_t < before;
+    return witnessed_before(s, before);
 }
 
 /* Where the gradient jumps or bends sharply (ours, issue 20): the descents alternate a search in
@@ -595,6 +598,29 @@ static void refine_late(scc_fw_state* s)
         for (int j = 0; j < 3; ++j) b[j] = s->hit_b[j];
         if (!contact_at_time(s, t, b, KINK_PROBE_STEPS)) lo = t;
     }
+}
+
+/* The check's fallback (ours; ccd.h): contact_at_time forward from t_lo by factors of four, then
+ * refine_late back to where the triangle enters. */
+void scc_fwgss_probe(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, double t_lo, double t_hi,
+                     const double b[3], double tol, int64_t max_evals, scc_tri_hit* out)
+{
+    scc_params q = *p;
+    q.max_evals = max_evals;
+    scc_fw_state s;
+    scc_fw_begin(&s, sdf, m, &q, ta, tb);
+    s.kinked = 1; /* golden-section spatial searches: the field's gradient may jump */
+    const double speed = scc_tri_speed_bound(m);
+    if (p->fwgss_speed_tol && speed > 0.0) s.dist_tol = speed * p->time_tol;
+    /* nothing before t_lo is in contact (the certified search proved it); only a contact before t_hi is of use */
+    s.ts = scc_fmax(t_lo, ta);
+    s.te = scc_fmin(t_hi, tb);
+    for (double d = 0.5 * tol; s.ts + d < s.te && s.evals < max_evals; d *= 4.0)
+        if (contact_at_time(&s, s.ts + d, b, KINK_PROBE_STEPS)) {
+            refine_late(&s);
+            break;
+        }
+    scc_fw_finish(&s, 1, 0, out);
 }
 
 /* Whether phi bends sharply at the earliest witness: its gradient there and 1 mm away (along two

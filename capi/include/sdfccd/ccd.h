@@ -152,7 +152,9 @@ typedef struct sdfccd_QueryParams {
     int32_t fwgss_verify;          /**< FWGSS: where fwgss_kink_guard applies to an analytic field with gradient jumps
                                         or to a grid, the answer is checked by the certified search seeded with FWGSS's
                                         witness (an earlier contact found replaces it; at most 128x FWGSS's evaluations
-                                        + 16384, grids + 65536). 0 = no check (the guard's searches instead), as before issue 20.
+                                        + 16384, grids + 65536; a check stopped short of the witness is followed by
+                                        FWGSS's spatial steps from the stretch it left unproven, and runs again from a
+                                        contact they find). 0 = no check (the guard's searches instead), as before issue 20.
                                         Default 1. The Bullet bridge sets 0: a triangle resting at its contact level
                                         keeps the check busy at every step, and its guarantee backs the answer. */
 } sdfccd_QueryParams;
