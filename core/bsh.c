@@ -332,7 +332,7 @@ static int march(trav* tr, uint32_t i, uint32_t s, double to, double pause, doub
     scc_vec3 B = centre_at(tr, i, sg->tb, &sg->q[2], &sg->p[2]);
     double span = sg->tb - sg->ta;
     double pad = scc_dist(M, scc_scale(scc_add(A, B), 0.5));
-    pad = fmax(pad, centre_accel_bound(tr, i) * span * span * 0.125);
+    pad = scc_fmax(pad, centre_accel_bound(tr, i) * span * span * 0.125);
     double R = node_radius(tr, i) + pad;
     R += 1e-12 * (1.0 + R);
     double tol = rel_tol * R + 1e-9;
@@ -577,7 +577,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
 
     /* Segments: no more than min(pi, max_rotation) of relative rotation each. */
     double w = (mm->body && !moving ? scc_len(mm->body->w) : 0.0) + (mm->sdf ? scc_len(mm->sdf->w) : 0.0);
-    double limit = p->max_rotation > 0.0 ? fmin(p->max_rotation, SCC_PI) : SCC_PI;
+    double limit = p->max_rotation > 0.0 ? scc_fmin(p->max_rotation, SCC_PI) : SCC_PI;
     double angle = w * fabs(t_end - mm->t0);
     uint32_t nseg = 1;
     if (angle > limit) {
@@ -660,7 +660,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
             const int ord = ordered && it.key > mm->t0;
             const double pause = ord && heap.n ? heap.a[0].key : INFINITY;
             const double rel_tol = !ord ? MARCH_TOL : bsh->nodes[it.node].is_leaf ? MARCH_TOL_LEAF_ORDERED : MARCH_TOL_INNER_ORDERED;
-            const int r = march(&tr, it.node, s, fmin(seg[s].tb, te), pause, rel_tol, &it.key, &it.sub);
+            const int r = march(&tr, it.node, s, scc_fmin(seg[s].tb, te), pause, rel_tol, &it.key, &it.sub);
             if (r == MARCH_STALLED) it.seg = s, it.sub = 0; /* a candidate at it.key */
             if (r != MARCH_CLEAR) ok = item_heap_push(&heap, it);
             continue;
@@ -709,7 +709,7 @@ int scc_bsh_traverse(const scc_bsh* bsh, const scc_bsh_moving_node* moving, cons
         for (uint32_t k = 0; k < 2 && ok; ++k) {
             item c = { it.key, n->first + k, s | SEG_MARCHING, 0, 0 };
             if (later) { ok = item_heap_push(&heap, c); continue; }
-            if (march(&tr, c.node, s, fmin(seg[s].tb, te), INFINITY, MARCH_TOL, &c.key, &c.sub) != MARCH_STALLED) continue;
+            if (march(&tr, c.node, s, scc_fmin(seg[s].tb, te), INFINITY, MARCH_TOL, &c.key, &c.sub) != MARCH_STALLED) continue;
             c.seg = s;
             c.sub = 0;
             ok = item_heap_push(&heap, c);

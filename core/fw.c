@@ -79,17 +79,6 @@ void scc_fw_start_vertex(scc_fw_state* s)
     s->b[0] = order[0] == 0; s->b[1] = order[0] == 1; s->b[2] = order[0] == 2;
 }
 
-int scc_fw_support(const scc_tri_state* st, scc_vec3 g)
-{
-    int s = 0;
-    double best = scc_dot(g, st->x[0]);
-    for (int j = 1; j < 3; ++j) {
-        double d = scc_dot(g, st->x[j]);
-        if (d < best) { best = d; s = j; }
-    }
-    return s;
-}
-
 void scc_fw_finish(scc_fw_state* s, int converged, int64_t iterations, scc_tri_hit* out)
 {
     out->iterations = iterations;

@@ -176,6 +176,18 @@ static inline void scc_fw_path_init(const scc_fw_state* s, const double b[3], sc
     out->kd = scc_dot(s->axis, out->r);
 }
 
+/* scc_fw_path_init(s, s->b, out) right after scc_fw_point(s, s->b, ..) (scc_fw_eval): the offset terms
+ * are the ones that call left in the point cache, computed from the same weights (the same bits). */
+static inline void scc_fw_path_of_current(const scc_fw_state* s, scc_fw_path* out)
+{
+    out->b[0] = s->b[0]; out->b[1] = s->b[1]; out->b[2] = s->b[2];
+    out->motion = !s->fast ? 0 : (s->wlen != 0.0 ? 2 : 1);
+    if (!s->fast) return;
+    out->r = s->pt_r;
+    out->kr = s->pt_kr;
+    out->kd = s->pt_kd;
+}
+
 /* scc_fw_point(s, path->b, t, NULL), the same bits. A path is sampled at a new time nearly always (99 %
  * in the data set's vertex traces), so the angle is computed without looking at the cache first. */
 static inline scc_vec3 scc_fw_path_point(scc_fw_state* s, const scc_fw_path* path, double t)
@@ -270,8 +282,23 @@ void scc_fw_begin(scc_fw_state* s, const scc_sdf* sdf, const scc_tri_motion* m, 
 void scc_fw_start_vertex(scc_fw_state* s);
 /* The three vertices ordered by the Section 4.4 score (most promising first). */
 void scc_fw_start_order(scc_fw_state* s, int order[3]);
-/* Index of the vertex of `st` minimising grad . vertex (Eq. 15). */
-int scc_fw_support(const scc_tri_state* st, scc_vec3 g);
+/* Index of the vertex minimising grad . vertex (Eq. 15), given the three products d[j] = g . x[j]
+ * (the first on ties). */
+static inline int scc_fw_support_of(const double d[3])
+{
+    int s = 0;
+    for (int j = 1; j < 3; ++j)
+        if (d[j] < d[s]) s = j;
+    return s;
+}
+
+/* Index of the vertex of `st` minimising grad . vertex (Eq. 15). Inline: a spatial step takes it
+ * at every iteration. */
+static inline int scc_fw_support(const scc_tri_state* st, scc_vec3 g)
+{
+    const double d[3] = { scc_dot(g, st->x[0]), scc_dot(g, st->x[1]), scc_dot(g, st->x[2]) };
+    return scc_fw_support_of(d);
+}
 /* Fills `out` from the solver state once the iterations end. */
 void scc_fw_finish(scc_fw_state* s, int converged, int64_t iterations, scc_tri_hit* out);
 

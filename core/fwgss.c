@@ -221,13 +221,13 @@ static double spatial_step(scc_fw_state* s, double tn, double* out_gap)
     int have_dir = 0, interior = 0;
     if (s->b[0] > 0.0 && s->b[1] > 0.0 && s->b[2] > 0.0) interior = have_dir = interior_direction(&st, gn, s->b, bb);
     if (!have_dir) {
-        int sv = scc_fw_support(&st, gn);
+        /* grad . vertex once for both: the support vertex and the away vertex */
+        const double d[3] = { scc_dot(gn, st.x[0]), scc_dot(gn, st.x[1]), scc_dot(gn, st.x[2]) };
+        int sv = scc_fw_support_of(d);
         int av = sv;
         double best = -INFINITY;
-        for (int j = 0; j < 3; ++j) {
-            double d = scc_dot(gn, st.x[j]);
-            if (s->b[j] > 0.0 && d > best) { best = d; av = j; }
-        }
+        for (int j = 0; j < 3; ++j)
+            if (s->b[j] > 0.0 && d[j] > best) { best = d[j]; av = j; }
         if (av != sv) {
             for (int j = 0; j < 3; ++j) bb[j] = s->b[j];
             bb[sv] += s->b[av];
@@ -262,7 +262,7 @@ static int descend(scc_fw_state* s, double t, int64_t* io_iterations)
         scc_gss_result ls;
         time_ctx tc;
         tc.s = s;
-        scc_fw_path_init(s, s->b, &tc.path);
+        scc_fw_path_of_current(s, &tc.path); /* the point scc_fw_eval has just taken */
         if (phi <= p->margin && p->fwgss_secant && t > s->ts) {
             ls = crossing_by_secant(&tc, s->ts, t, phi - p->margin, p);
         } else if (phi <= p->margin) {

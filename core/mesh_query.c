@@ -206,7 +206,7 @@ static int take_answer(mesh_ctx* c, scc_query_summary* s, const scc_contact* loc
 {
     /* Touching at a candidate time after t0 is a hit there, not a penetration at the query's start. */
     if (s->state == SCC_PENETRATING && ta > c->in.mm->t0) s->state = SCC_HIT;
-    c->lower = fmin(c->lower, s->toi_lower);
+    c->lower = scc_fmin(c->lower, s->toi_lower);
     if (!s->hit) {
         c->any_not_converged |= s->state == SCC_NOT_CONVERGED;
         return 1;
@@ -238,7 +238,7 @@ static int precheck(mesh_ctx* c, const scc_tri_motion* m, double ta, double tb, 
     tp->max_evals -= h.evals;
     if (!h.hit && h.state == SCC_NO_HIT) { /* the same answer as a search that found nothing on [ta, tb] */
         c->sum->triangles_tested += 1;
-        c->lower = fmin(c->lower, tb);
+        c->lower = scc_fmin(c->lower, tb);
         c->pre_cleared += 1;
         return 1;
     }
@@ -265,7 +265,7 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta, int rounds)
         tp.margin = mm->tri_margin[t];
     }
     scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
-    double tb = fmin(mm->t1, fmin(c->best, c->provisional) + p->toi_window);
+    double tb = scc_fmin(mm->t1, scc_fmin(c->best, c->provisional) + p->toi_window);
     scc_tri_motion m;
     scc_mesh_triangle_motion(mm, t, &m);
     if (c->traces) scc_triangle_traces(c->traces, mm->mesh, t, c->in.ws->trace_epoch, m.trace);
@@ -311,7 +311,7 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta, int rounds)
         if (!scc_array_reserve(c->in.ws->alloc, &data, &c->cap_deferred, sizeof *c->deferred, c->n_deferred + 1, 32)) return 0;
         c->deferred = data;
         c->deferred[c->n_deferred++] = (deferred_tri){ raw, ta, tb, tp.margin, t };
-        if (raw.hit) c->provisional = fmin(c->provisional, raw.toi);
+        if (raw.hit) c->provisional = scc_fmin(c->provisional, raw.toi);
         return 1;
     }
     return take_answer(c, &s, local, ta, p->toi_window);
@@ -329,7 +329,7 @@ static int finish_deferred(mesh_ctx* c)
     scc_contact local[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     for (size_t i = 0; i < c->n_deferred; ++i) {
         const deferred_tri* d = &c->deferred[i];
-        const double limit = fmin(c->best, c->provisional) + tp.toi_window;
+        const double limit = scc_fmin(c->best, c->provisional) + tp.toi_window;
         if (d->ta > limit) continue; /* its contacts start after the window (ta is a proven lower bound) */
         tp.margin = d->margin;
         tp.max_evals = budget_left(c);
@@ -339,7 +339,7 @@ static int finish_deferred(mesh_ctx* c)
         if (c->traces) scc_triangle_traces(c->traces, mm->mesh, d->triangle, c->in.ws->trace_epoch, m.trace);
         scc_query_summary s;
         if (c->probe) c->probe(c->probe_user, d->triangle, 1);
-        const int ok = scc_triangle_finish_deferred(c->in.sdf, &m, d->ta, fmin(d->tb, limit), &tp, c->in.ws->alloc, d->triangle, d->raw, local,
+        const int ok = scc_triangle_finish_deferred(c->in.sdf, &m, d->ta, scc_fmin(d->tb, limit), &tp, c->in.ws->alloc, d->triangle, d->raw, local,
                                                     1 + SCC_MAX_SUBDIVISION_CONTACTS, &s);
         if (c->probe) c->probe(c->probe_user, d->triangle, 0);
         if (!ok) return 0;
@@ -361,10 +361,10 @@ static int drain_pending(mesh_ctx* c, double upto)
         const pending_tri w = c->pending[k];
         if (w.lower > upto) break;
         c->pending[k] = c->pending[--c->n_pending];
-        const double tb = fmin(c->in.mm->t1, fmin(c->best, c->provisional) + c->in.p->toi_window);
+        const double tb = scc_fmin(c->in.mm->t1, scc_fmin(c->best, c->provisional) + c->in.p->toi_window);
         if (w.lower >= tb) { /* its contacts start after the window */
             c->sum->triangles_tested += 1;
-            c->lower = fmin(c->lower, w.lower);
+            c->lower = scc_fmin(c->lower, w.lower);
             continue;
         }
         /* the pre-check again where the interval has shrunk since, else FWGSS */
@@ -381,9 +381,9 @@ static int visit_candidate(void* user, uint32_t triangle, double t_candidate, do
     /* The candidate time is a proven lower bound of the triangle's contacts, so the narrow phase
      * searches from there. FW (the paper's Section 4.2 baseline) keeps the whole interval: it is a
      * local method whose step sizes scale with the interval. */
-    double ta = c->in.p->method == SCC_METHOD_FW ? mm->t0 : fmax(mm->t0, t_candidate);
+    double ta = c->in.p->method == SCC_METHOD_FW ? mm->t0 : scc_fmax(mm->t0, t_candidate);
     if (!test_triangle(c, triangle, ta, 0)) return 0;
-    *io_t_end = fmin(*io_t_end, fmin(mm->t1, fmin(c->best, c->provisional) + c->in.p->toi_window));
+    *io_t_end = scc_fmin(*io_t_end, scc_fmin(mm->t1, scc_fmin(c->best, c->provisional) + c->in.p->toi_window));
     if (c->budget_exhausted) *io_t_end = -INFINITY; /* stops the traversal */
     return 1;
 }
@@ -553,8 +553,8 @@ int scc_query_mesh_probed(const scc_sdf* sdf, const scc_mesh_motion* mm, const s
     }
     sum->hit = isfinite(best);
     sum->toi = sum->hit ? best : mm->t1;
-    if (c.budget_exhausted) lower = fmin(lower, mm->t0); /* triangles left untested prove nothing */
-    sum->toi_lower = fmin(lower, sum->toi); /* certified: no triangle touches before this */
+    if (c.budget_exhausted) lower = scc_fmin(lower, mm->t0); /* triangles left untested prove nothing */
+    sum->toi_lower = scc_fmin(lower, sum->toi); /* certified: no triangle touches before this */
     sum->state = sum->hit ? (c.budget_exhausted ? SCC_NOT_CONVERGED : best_state)
                           : (any_not_converged ? SCC_NOT_CONVERGED : SCC_NO_HIT);
     sum->contacts_found = (int)buf.n;

@@ -88,7 +88,7 @@ static sdfccd_Status check_magnitude(sdfccd_Vec3 v, const char* what)
 {
     sdfccd_Status st;
     if ((st = sdfccd__check_vec(v, what))) return st;
-    double m = fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
+    double m = scc_fmax(fabs(v.x), scc_fmax(fabs(v.y), fabs(v.z)));
     if (m > SDFCCD_MAX_QUERY_MAGNITUDE)
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s has a coordinate of magnitude %g, above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
                              what, m, SDFCCD_MAX_QUERY_MAGNITUDE);
@@ -135,7 +135,7 @@ sdfccd_Status sdfccd__check_total_rotation(const scc_rigid* body, const scc_rigi
 
 sdfccd_Status sdfccd__check_mesh_bounds(const sdfccd__mesh* m, const char* fn)
 {
-    double b = fmax(scc_maxc(scc_vabs(m->mesh.bounds.lo)), scc_maxc(scc_vabs(m->mesh.bounds.hi)));
+    double b = scc_fmax(scc_maxc(scc_vabs(m->mesh.bounds.lo)), scc_maxc(scc_vabs(m->mesh.bounds.hi)));
     if (!(b <= SDFCCD_MAX_QUERY_MAGNITUDE))
         return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "%s: the mesh has a vertex coordinate of magnitude %g, above SDFCCD_MAX_QUERY_MAGNITUDE (%g)",
                              fn, b, SDFCCD_MAX_QUERY_MAGNITUDE);
