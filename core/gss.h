@@ -81,12 +81,13 @@ SCC_GSS_INLINE scc_gss_result scc_gss_run(double a, double b, double fa, double 
     res.evals += 2;
     int it = 0, flat = 0;
     while (fabs(l3 - l0) > tol && it < max_iter) {
+        const double m01 = scc_fmin(f0, f1), m23 = scc_fmin(f2, f3); /* once for both tests */
         if (slope > 0.0) {
-            double m = scc_fmin(scc_fmin(f0, f1), scc_fmin(f2, f3));
+            double m = scc_fmin(m01, m23);
             if (m > 0.0 && fabs(l3 - l0) * slope <= m) { flat = 1; break; }
         }
         ++it;
-        if (scc_fmin(f0, f1) < scc_fmin(f2, f3)) {
+        if (m01 < m23) {
             a3 = a2; l3 = l2; f3 = f2;
             a2 = a1; l2 = l1; f2 = f1;
             a1 = r * a2 + rc * a0;
