@@ -25,7 +25,8 @@ static inline double scc_sdf_user_value(const scc_sdf_user* u, scc_vec3 p, scc_v
     struct sdfccd_Vec3 gp = { 0.0, 0.0, 1.0 };
     const double v = ((scc_user_eval_fn*)u->fn)(q, &gp, u->user);
     *g = scc_v3(gp.x, gp.y, gp.z);
-    if (!scc_vfinite(*g)) *g = scc_v3(0.0, 0.0, 1.0);
+    /* finite: x - x is 0 for a finite x and NaN for an infinite or NaN one (scc_vfinite in one test) */
+    if (!((gp.x - gp.x) + (gp.y - gp.y) + (gp.z - gp.z) == 0.0)) *g = scc_v3(0.0, 0.0, 1.0);
     return v;
 }
 
