@@ -133,6 +133,48 @@ START_TEST(test_field_calls_are_counted)
 }
 END_TEST
 
+/* A user's gradient with an infinite or NaN coordinate is never handed on: the solvers and the
+ * contacts get (0, 0, 1) in its place (scc_sdf_user_value), whichever coordinate is bad. The field is
+ * the half-space z <= 0, whose true gradient is that fallback, so the query still hits at the time
+ * the plane is reached. */
+static double bad_gradient_plane(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
+{
+    if (g) *g = *(const sdfccd_Vec3*)user;
+    return p.z;
+}
+
+START_TEST(test_user_gradient_not_finite)
+{
+    const sdfccd_Vec3 bad[4] = { { INFINITY, 0, 1 }, { 0, NAN, 1 }, { 0, 0, -INFINITY }, { NAN, NAN, NAN } };
+    for (int k = 0; k < 4; ++k) {
+        sdfccd_Vec3 grad = bad[k];
+        sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
+        d.eval = bad_gradient_plane;
+        d.user = &grad;
+        d.bounds = (sdfccd_Aabb){ { -10, -10, -10 }, { 10, 10, 0 } };
+        d.smooth = 1;
+        sdfccd_SdfId s;
+        ck_assert_int_eq(sdfccd_create_callback_sdf(&d, &s), SDFCCD_OK);
+        const sdfccd_Vec3 tri[3] = { { 0, 0, 1 }, { 0.5, 0, 1 }, { 0, 0.5, 1 } };
+        sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+        m.linear_velocity.z = -4.0; /* reaches the plane at t = 0.25 */
+        sdfccd_QueryParams p = sdfccd_default_query_params();
+        sdfccd_Contact c[8];
+        sdfccd_QueryResult r;
+        ck_assert_int_eq(sdfccd_query_triangle(s, NULL, tri, &m, 0, 1, &p, c, 8, &r), SDFCCD_OK);
+        ck_assert_int_eq(r.hit, 1);
+        ck_assert(fabs(r.toi - 0.25) < 1e-6);
+        ck_assert_int_gt(r.contact_count, 0);
+        for (int i = 0; i < r.contact_count; ++i) {
+            ck_assert_double_eq(c[i].normal.x, 0.0);
+            ck_assert_double_eq(c[i].normal.y, 0.0);
+            ck_assert_double_eq(c[i].normal.z, 1.0);
+        }
+        sdfccd_destroy_sdf(s);
+    }
+}
+END_TEST
+
 /* The budget is shared by the interval's segments: a rotation split into 1e6 segments (each of
  * which used to get the full per-call caps) stops at the budget with NOT_CONVERGED, for every
  * method; the same query with a large budget spends more, so the cap is what stopped it. */
@@ -799,6 +841,7 @@ int main(void)
     tcase_add_test(tc, test_huge_spin_rejected);
     tcase_add_test(tc, test_budget_shared_by_segments);
     tcase_add_test(tc, test_field_calls_are_counted);
+    tcase_add_test(tc, test_user_gradient_not_finite);
     tcase_add_test(tc, test_budget_shared_by_triangles);
     tcase_add_test(tc, test_overflowing_query_inputs_rejected);
     tcase_add_test(tc, test_query_argument_names);
