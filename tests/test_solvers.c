@@ -338,6 +338,42 @@ START_TEST(test_hypot_fast_path_identical)
 }
 END_TEST
 
+/* FWGSS takes a rigid triangle's speed bound as the largest of its vertices' bounds (fwgss.c,
+ * tri_speed_bound), which holds bit for bit because the bound is nondecreasing in a vertex's distance
+ * from the centre, rounding included: checked on random rigid motions, with and without a moving SDF. */
+START_TEST(test_rigid_speed_bound_is_vertex_max)
+{
+    test_rng rng = { 2026 };
+    for (int n = 0; n < 2000; ++n) {
+        scc_rigid body = { scc_v3(test_rng_uniform(&rng, -2, 2), test_rng_uniform(&rng, -2, 2), test_rng_uniform(&rng, -2, 2)),
+                           scc_quat_normalize((scc_quat){ test_rng_uniform(&rng, -1, 1), test_rng_uniform(&rng, -1, 1),
+                                                          test_rng_uniform(&rng, -1, 1), test_rng_uniform(&rng, -1, 1) }),
+                           scc_v3(test_rng_uniform(&rng, -1, 1), test_rng_uniform(&rng, -1, 1), test_rng_uniform(&rng, -1, 1)),
+                           scc_v3(test_rng_uniform(&rng, -5, 5), test_rng_uniform(&rng, -5, 5), test_rng_uniform(&rng, -5, 5)),
+                           scc_v3(test_rng_uniform(&rng, -30, 30), test_rng_uniform(&rng, -30, 30), test_rng_uniform(&rng, -30, 30)), 0.0 };
+        scc_rigid field = body;
+        field.v = scc_v3(test_rng_uniform(&rng, -3, 3), 0.5, -1.0);
+        field.w = scc_v3(0.2, test_rng_uniform(&rng, -9, 9), 1.0);
+        scc_tri_motion m;
+        memset(&m, 0, sizeof m);
+        m.kind = SCC_TRI_RIGID;
+        m.body = &body;
+        m.sdf = n % 2 ? &field : NULL;
+        m.t0 = 0.0;
+        m.t1 = test_rng_uniform(&rng, 1e-4, 0.1);
+        /* vertices at nearly equal distances from the centre half of the time: ties and near-ties */
+        const double scale = n % 4 < 2 ? 1e-9 : 1.0;
+        for (int i = 0; i < 3; ++i)
+            m.local[i] = scc_add(body.c_local, scc_v3(0.3 + scale * test_rng_uniform(&rng, -1, 1), scale * test_rng_uniform(&rng, -1, 1),
+                                                     scale * test_rng_uniform(&rng, -1, 1)));
+        double vmax = 0.0;
+        for (int i = 0; i < 3; ++i) vmax = scc_fmax(vmax, scc_vertex_speed_bound(&m, i));
+        const double tri = scc_tri_speed_bound(&m);
+        ck_assert_msg(memcmp(&tri, &vmax, sizeof tri) == 0, "case %d: triangle %.17g, vertices' largest %.17g", n, tri, vmax);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("solvers");
@@ -355,6 +391,7 @@ int main(void)
     tcase_add_test(d, test_dcd_box_separated);
     tcase_add_test(d, test_spike_grid_convex_in);
     tcase_add_test(d, test_hypot_fast_path_identical);
+    tcase_add_test(d, test_rigid_speed_bound_is_vertex_max);
     suite_add_tcase(s, d);
     return test_run_suite(s);
 }
