@@ -93,16 +93,23 @@ static double counted_sphere(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
     return l - 1.0;
 }
 
-START_TEST(test_field_calls_are_counted)
+/* A user field declared smooth, with the given function, user pointer and bounds. */
+static sdfccd_SdfId smooth_callback(sdfccd_SdfEvalFcn* eval, void* user, sdfccd_Aabb bounds)
 {
-    int64_t calls = 0;
     sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
-    d.eval = counted_sphere;
-    d.user = &calls;
-    d.bounds = (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } };
+    d.eval = eval;
+    d.user = user;
+    d.bounds = bounds;
     d.smooth = 1;
     sdfccd_SdfId s;
     ck_assert_int_eq(sdfccd_create_callback_sdf(&d, &s), SDFCCD_OK);
+    return s;
+}
+
+START_TEST(test_field_calls_are_counted)
+{
+    int64_t calls = 0;
+    const sdfccd_SdfId s = smooth_callback(counted_sphere, &calls, (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } });
     /* z = 1.0005 slides 0.5 mm over the top (the traces' steps shrink there); z = 0.5 hits */
     const double heights[2] = { 1.0005, 0.5 };
     for (int k = 0; k < 2; ++k) {
@@ -148,13 +155,7 @@ START_TEST(test_user_gradient_not_finite)
     const sdfccd_Vec3 bad[4] = { { INFINITY, 0, 1 }, { 0, NAN, 1 }, { 0, 0, -INFINITY }, { NAN, NAN, NAN } };
     for (int k = 0; k < 4; ++k) {
         sdfccd_Vec3 grad = bad[k];
-        sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
-        d.eval = bad_gradient_plane;
-        d.user = &grad;
-        d.bounds = (sdfccd_Aabb){ { -10, -10, -10 }, { 10, 10, 0 } };
-        d.smooth = 1;
-        sdfccd_SdfId s;
-        ck_assert_int_eq(sdfccd_create_callback_sdf(&d, &s), SDFCCD_OK);
+        const sdfccd_SdfId s = smooth_callback(bad_gradient_plane, &grad, (sdfccd_Aabb){ { -10, -10, -10 }, { 10, 10, 0 } });
         const sdfccd_Vec3 tri[3] = { { 0, 0, 1 }, { 0.5, 0, 1 }, { 0, 0.5, 1 } };
         sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
         m.linear_velocity.z = -4.0; /* reaches the plane at t = 0.25 */
