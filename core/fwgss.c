@@ -491,9 +491,9 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
 {
     clear_region stack[CLEAR_STACK];
     int n = 0;
-    stack[n] = (clear_region){ { 1, 0, 0 }, { 0, 1, 0 }, ta, 0.0, 0 };
-    stack[n].rad = region_radius_rigid(s, stack[n].u, stack[n].v);
-    ++n;
+    /* a region's radius (rad) is NaN until its first sample needs it: a proof that stops (budget, a
+     * witness) leaves regions on the stack whose radii were never used */
+    stack[n++] = (clear_region){ { 1, 0, 0 }, { 0, 1, 0 }, ta, NAN, 0 };
     const double margin = s->margin;
     while (n > 0) {
         clear_region r = stack[--n];
@@ -502,6 +502,7 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
         for (;;) {
             if (r.t >= tb) break;
             if (budget-- <= 0 || s->evals >= s->p->max_evals) return 0;
+            if (isnan(r.rad)) r.rad = region_radius_rigid(s, r.u, r.v);
             double rad = r.rad;
             scc_vec3 c;
             if (rad >= 0.0) {
@@ -532,11 +533,10 @@ static int prove_clear(scc_fw_state* s, double ta, double tb, double speed, int 
                 mu[i] = 0.5 * (r.u[i] + r.u[j]);
                 mv[i] = 0.5 * (r.v[i] + r.v[j]);
             }
-            stack[n++] = (clear_region){ { r.u[0], mu[0], mu[2] }, { r.v[0], mv[0], mv[2] }, r.t, 0.0, r.depth + 1 };
-            stack[n++] = (clear_region){ { mu[0], r.u[1], mu[1] }, { mv[0], r.v[1], mv[1] }, r.t, 0.0, r.depth + 1 };
-            stack[n++] = (clear_region){ { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] }, r.t, 0.0, r.depth + 1 };
-            stack[n++] = (clear_region){ { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] }, r.t, 0.0, r.depth + 1 };
-            for (int k = n - 4; k < n; ++k) stack[k].rad = region_radius_rigid(s, stack[k].u, stack[k].v);
+            stack[n++] = (clear_region){ { r.u[0], mu[0], mu[2] }, { r.v[0], mv[0], mv[2] }, r.t, NAN, r.depth + 1 };
+            stack[n++] = (clear_region){ { mu[0], r.u[1], mu[1] }, { mv[0], r.v[1], mv[1] }, r.t, NAN, r.depth + 1 };
+            stack[n++] = (clear_region){ { mu[2], mu[1], r.u[2] }, { mv[2], mv[1], r.v[2] }, r.t, NAN, r.depth + 1 };
+            stack[n++] = (clear_region){ { mu[0], mu[1], mu[2] }, { mv[0], mv[1], mv[2] }, r.t, NAN, r.depth + 1 };
             break;
         }
     }
