@@ -659,7 +659,7 @@ static int field_has_kinks(const scc_sdf* sdf) { return !sdf->smooth; }
  * bounds (scc_vertex_speed_bound), which a mesh query's vertex records hold for the vertex traces
  * (trace_begin), so they are computed once, not a second time for the triangle. */
 #if defined(__GNUC__) || defined(__clang__)
-__attribute__((noinline)) /* kept out of scc_fwgss: inlined there, it moved the register allocation of the vertex traces (callgrind: 200K instructions more) */
+__attribute__((noinline)) /* kept out of scc_fwgss: inlined there, it moved the vertex traces' register allocation (more instructions per sample) */
 #endif
 static double tri_speed_bound(const scc_tri_motion* m)
 {
