@@ -558,6 +558,117 @@ static void exp_cost(const options* o)
     free_dataset(&ds);
 }
 
+/* ---- the floor of a dependent sample (issue 20 item 4) ---- */
+
+/* The rotation's sine and cosine about a base angle, by a Taylor series in d^2 (Estrin's scheme for
+ * the eight highest terms, then Horner's), the same depth of arithmetic as the solver's per new time. */
+static inline void chain_sincos(double d, double* s, double* c)
+{
+    static const double ks[12] = { 0.0, 1.0 / 51090942171709440000.0, -1.0 / 121645100408832000.0, 1.0 / 355687428096000.0,
+                                   -1.0 / 1307674368000.0, 1.0 / 6227020800.0, -1.0 / 39916800.0, 1.0 / 362880.0,
+                                   -1.0 / 5040.0, 1.0 / 120.0, -1.0 / 6.0, 1.0 };
+    static const double kc[12] = { -1.0 / 1124000727777607680000.0, 1.0 / 2432902008176640000.0, -1.0 / 6402373705728000.0,
+                                   1.0 / 20922789888000.0, -1.0 / 87178291200.0, 1.0 / 479001600.0, -1.0 / 3628800.0,
+                                   1.0 / 40320.0, -1.0 / 720.0, 1.0 / 24.0, -0.5, 1.0 };
+    const double x = d * d, x2 = x * x, x4 = x2 * x2;
+    double r[2];
+    for (int lane = 0; lane < 2; ++lane) {
+        const double* k = lane ? kc : ks;
+        double acc = (k[7] + k[6] * x + (k[5] + k[4] * x) * x2) + (k[3] + k[2] * x + (k[1] + k[0] * x) * x2) * x4;
+        for (int j = 8; j < 12; ++j) acc = acc * x + k[j];
+        r[lane] = acc;
+    }
+    *s = r[0] * d;
+    *c = r[1];
+}
+
+/* One rotating point's path (centre g0 + v t, offset r turning about `axis` at w rad/s). */
+typedef struct chain_path { sdfccd_Vec3 g0, v, r, kr, axis; double kd, w, base_c, base_s; } chain_path;
+
+/* The point at time t: sine and cosine, the angle sum, Rodrigues' formula, the centre. */
+static inline sdfccd_Vec3 chain_point(const chain_path* q, double t)
+{
+    double sd, cd;
+    chain_sincos(q->w * (t - 0.008), &sd, &cd);
+    const double c = q->base_c * cd - q->base_s * sd, s = q->base_s * cd + q->base_c * sd, k = q->kd * (1.0 - c);
+    return (sdfccd_Vec3){ q->g0.x + q->v.x * t + q->r.x * c + q->kr.x * s + q->axis.x * k,
+                          q->g0.y + q->v.y * t + q->r.y * c + q->kr.y * s + q->axis.y * k,
+                          q->g0.z + q->v.z * t + q->r.z * c + q->kr.z * s + q->axis.z * k };
+}
+
+/* The time per sample of loops whose every sample depends on the one before's value, as a secant
+ * step's does, with nothing else in them: the floor such a sample costs on this machine, whatever
+ * solver issues it. The torus is the cost experiment's user callback (called through a pointer the
+ * compiler cannot see through), so these compare with section 5's columns:
+ *   field: the next point is the last one moved by 1e-12 x phi (the field's latency and the call);
+ *   spatial: a point on a segment, phi and its gradient, the slope, a secant step on the slope;
+ *   temporal: a point at a new time on a rotating path (as above), phi, a secant step in time;
+ *   temporal x2: two such chains that do not depend on each other, one sample of each per turn (the
+ *   time per sample when a solver keeps two searches in flight). */
+static void exp_chain(const options* o)
+{
+    (void)o;
+    torus_cb one = { 1 };
+    double (*volatile eval_ptr)(sdfccd_Vec3, sdfccd_Vec3*, void*) = torus_eval;
+    double (*const eval)(sdfccd_Vec3, sdfccd_Vec3*, void*) = eval_ptr;
+    const chain_path q[2] = {
+        { { 0.02, 0.1, 0.03 }, { 0.3, -1.0, 0.5 }, { 0.01, 0.02, -0.005 }, { 0.003, -0.01, 0.02 }, { 0.267, 0.534, 0.801 }, 0.004, 40.0, 0.955336, 0.295520 },
+        { { -0.1, 0.02, 0.01 }, { -0.5, 0.2, 1.0 }, { -0.02, 0.01, 0.01 }, { 0.01, 0.01, -0.02 }, { 0.801, 0.267, 0.534 }, -0.002, 25.0, 0.980067, 0.198669 },
+    };
+    const int n = o->quick ? 200000 : 1000000, passes = o->quick ? 5 : 15;
+    double best[4] = { INFINITY, INFINITY, INFINITY, INFINITY }, sink = 0.0;
+    for (int pass = 0; pass < passes; ++pass) {
+        double t0 = thread_cpu_us();
+        sdfccd_Vec3 x = { 0.12, 0.01, 0.02 };
+        for (int i = 0; i < n; ++i) {
+            const double f = eval(x, NULL, &one);
+            x.x = 0.12 + 1e-12 * f;
+            sink += f;
+        }
+        best[0] = fmin(best[0], thread_cpu_us() - t0);
+
+        t0 = thread_cpu_us();
+        const sdfccd_Vec3 a = { 0.1, 0.02, 0.04 }, d = { -0.03, 0.02, -0.01 };
+        double l = 0.3, l_prev = 0.1, s_prev = 0.5;
+        for (int i = 0; i < n; ++i) {
+            sdfccd_Vec3 g;
+            const double f = eval((sdfccd_Vec3){ a.x + d.x * l, a.y + d.y * l, a.z + d.z * l }, &g, &one);
+            const double slope = g.x * d.x + g.y * d.y + g.z * d.z;
+            const double next = l - slope * (l - l_prev) / (slope - s_prev);
+            l_prev = l;
+            s_prev = slope + 1e-3;
+            l = 0.3 + 1e-12 * next; /* the step's value kept in the chain, the segment's middle kept */
+            sink += f;
+        }
+        best[1] = fmin(best[1], thread_cpu_us() - t0);
+
+        t0 = thread_cpu_us();
+        double t = 0.005, lo = 0.0, hi = 0.0166, f_hi = -0.01;
+        for (int i = 0; i < n; ++i) {
+            const double f = eval(chain_point(&q[0], t), NULL, &one) - 1e-4;
+            const double next = hi - f_hi * (hi - lo) / (f_hi - f);
+            t = 0.005 + 1e-12 * next;
+            sink += f;
+        }
+        best[2] = fmin(best[2], thread_cpu_us() - t0);
+
+        t0 = thread_cpu_us();
+        double u[2] = { 0.005, 0.006 };
+        for (int i = 0; i < n / 2; ++i)
+            for (int j = 0; j < 2; ++j) {
+                const double f = eval(chain_point(&q[j], u[j]), NULL, &one) - 1e-4;
+                const double next = hi - f_hi * (hi - lo) / (f_hi - f);
+                u[j] = 0.005 + 0.001 * j + 1e-12 * next;
+                sink += f;
+            }
+        best[3] = fmin(best[3], thread_cpu_us() - t0);
+    }
+    static const char* name[4] = { "field", "spatial", "temporal", "temporal x2" };
+    printf("chain,samples,ns_per_sample\n");
+    for (int k = 0; k < 4; ++k) printf("%s,%d,%.1f\n", name[k], k == 3 ? n / 2 * 2 : n, best[k] * 1e3 / (double)(k == 3 ? n / 2 * 2 : n));
+    if (sink == 1234.5) fprintf(stderr, "-\n"); /* keeps the loops' values live */
+}
+
 /* Every answer of the data set, exactly (hexadecimal floats), for the methods whose results must not
  * change when the solver's code is made faster: FWGSS (defaults, and with subdivision), FW and DCD.
  * `diff` two runs to compare builds bit for bit.
@@ -738,6 +849,7 @@ static const experiment k_experiments[] = {
     { "kinds_front", exp_kinds_front, "speed versus accuracy per SDF kind: FWGSS restarts and trace, the paper's caps, FW, DCD, certified" },
     { "fingerprint", exp_fingerprint, "every answer of the data set in hexadecimal (FWGSS, with subdivision, FW, DCD): diff two builds bit for bit" },
     { "cost", exp_cost, "cost per SDF evaluation in a query: the field and the rest (motion, solver, dispatch), measured differentially" },
+    { "chain", exp_chain, "the time per sample of a chain of dependent samples (field, spatial, temporal; two temporal chains interleaved)" },
 };
 #define N_EXPERIMENTS ((int)(sizeof k_experiments / sizeof k_experiments[0]))
 
