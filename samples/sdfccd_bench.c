@@ -449,18 +449,19 @@ static void exp_batch(const options* o)
  * ABI: the torus as a user (callback) SDF that evaluates the field `repeat` times per call. The
  * query time grows by (repeat - 1) x evaluations x field cost, which gives the field's cost; the
  * rest of the time per evaluation is the motion, the solver and the dispatch. The five evaluations
- * of one call are independent, so that difference is the field's throughput; a fourth variant chains
+ * of one call are independent, so that difference is the field's throughput; a third variant chains
  * them (each one's point depends on the one before's value), which gives the field's latency, as the
- * solver sees it (each sample waits for the one before).
- * SDFCCD_BENCH_MESH=triangle|shuriken runs one mesh only; SDFCCD_BENCH_COST_ONLY=0|1|2|3 runs one
- * pass of one variant only (the callback x1, x5, the built-in torus, the callback x5 chained: for
- * callgrind). */
+ * solver sees it (each sample waits for the one before). Each is run with the callback in both of
+ * its forms (sdfccd_CallbackSdfDef::eval, the point as an sdfccd_Vec3, and ::eval_xyz, the point as
+ * three coordinates), beside the built-in torus.
+ * SDFCCD_BENCH_MESH=triangle|shuriken runs one mesh only; SDFCCD_BENCH_COST_ONLY=K runs one pass of
+ * variant K only (k_cost_variant's order: for callgrind). */
 typedef struct torus_cb { int repeat; } torus_cb;
 
-/* The torus at (px, p.y, p.z), px passed through an empty asm statement that may change it, which
+/* The torus at (px, y, z), px passed through an empty asm statement that may change it, which
  * keeps the compiler from folding the repeats (no instruction; the volatile variable used before
  * stored and reloaded the point, a store-to-load round trip in the chain of every call). */
-static inline double torus_at(double px, sdfccd_Vec3 p, sdfccd_Vec3* g)
+static inline double torus_at(double px, double y, double z, sdfccd_Vec3* g)
 {
 #if defined(__GNUC__) || defined(__clang__)
     __asm__ volatile("" : "+x"(px));
@@ -468,11 +469,11 @@ static inline double torus_at(double px, sdfccd_Vec3 p, sdfccd_Vec3* g)
     volatile double pv = px;
     px = pv;
 #endif
-    double q = sqrt(px * px + p.y * p.y);
-    double dx = q - 0.1, d = sqrt(dx * dx + p.z * p.z);
+    double q = sqrt(px * px + y * y);
+    double dx = q - 0.1, d = sqrt(dx * dx + z * z);
     if (g) {
         double s = d > 0 ? 1.0 / d : 0.0, r = q > 0 ? dx / q : 0.0;
-        *g = (sdfccd_Vec3){ p.x * r * s, p.y * r * s, p.z * s };
+        *g = (sdfccd_Vec3){ px * r * s, y * r * s, z * s };
     }
     return d - 0.05;
 }
@@ -482,7 +483,7 @@ static double torus_eval(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 {
     const torus_cb* t = user;
     double phi = 0.0;
-    for (int k = 0; k < t->repeat; ++k) phi = torus_at(p.x, p, g);
+    for (int k = 0; k < t->repeat; ++k) phi = torus_at(p.x, p.y, p.z, g);
     return phi;
 }
 
@@ -492,7 +493,24 @@ static double torus_eval_chained(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 {
     const torus_cb* t = user;
     double phi = 0.0;
-    for (int k = 0; k < t->repeat; ++k) phi = torus_at(p.x + 0.0 * phi, p, g);
+    for (int k = 0; k < t->repeat; ++k) phi = torus_at(p.x + 0.0 * phi, p.y, p.z, g);
+    return phi;
+}
+
+/* The same two with the point as three coordinates (sdfccd_SdfEvalXyzFcn). */
+static double torus_eval_xyz(double x, double y, double z, sdfccd_Vec3* g, void* user)
+{
+    const torus_cb* t = user;
+    double phi = 0.0;
+    for (int k = 0; k < t->repeat; ++k) phi = torus_at(x, y, z, g);
+    return phi;
+}
+
+static double torus_eval_xyz_chained(double x, double y, double z, sdfccd_Vec3* g, void* user)
+{
+    const torus_cb* t = user;
+    double phi = 0.0;
+    for (int k = 0; k < t->repeat; ++k) phi = torus_at(x + 0.0 * phi, y, z, g);
     return phi;
 }
 
@@ -505,6 +523,12 @@ static double thread_cpu_us(void)
     return ts.tv_sec * 1e6 + ts.tv_nsec * 1e-3;
 }
 
+/* The cost experiment's variants: the field called `repeat` times per evaluation, chained or not, in
+ * one of the callback's two forms; form -1 is the built-in torus. */
+typedef struct cost_variant { int form, repeat, chained; } cost_variant;
+static const cost_variant k_cost_variant[7] = { { 0, 1, 0 }, { 0, 5, 0 }, { -1, 1, 0 }, { 0, 5, 1 }, { 1, 1, 0 }, { 1, 5, 0 }, { 1, 5, 1 } };
+static const char* const k_cost_form[2] = { "eval", "eval_xyz" };
+
 static void exp_cost(const options* o)
 {
     double (*clock_us)(void) = getenv("SDFCCD_BENCH_CPU_TIME") && !atoi(getenv("SDFCCD_BENCH_CPU_TIME")) ? now_us : thread_cpu_us;
@@ -514,11 +538,19 @@ static void exp_cost(const options* o)
     CHECK(sdfccd_create_workspace(&ws));
     sdfccd_QueryParams p = config_params(CFG_NEW, 0);
     sdfccd_Contact contacts[16];
-    torus_cb cb[3] = { { 1 }, { 5 }, { 5 } }; /* the third chained */
-    sdfccd_SdfId sdf[3];
-    for (int k = 0; k < 3; ++k) {
+    enum { NV = 7 };
+    torus_cb cb[NV];
+    sdfccd_SdfId sdf[NV];
+    for (int k = 0; k < NV; ++k) {
+        const cost_variant* v = &k_cost_variant[k];
+        cb[k].repeat = v->repeat;
+        if (v->form < 0) {
+            sdf[k] = ds.torus;
+            continue;
+        }
         sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
-        d.eval = k == 2 ? torus_eval_chained : torus_eval;
+        if (v->form == 0) d.eval = v->chained ? torus_eval_chained : torus_eval;
+        else d.eval_xyz = v->chained ? torus_eval_xyz_chained : torus_eval_xyz;
         d.user = &cb[k];
         d.bounds = (sdfccd_Aabb){ { -0.15, -0.15, -0.05 }, { 0.15, 0.15, 0.05 } };
         d.smooth = 1; /* as the built-in torus: no kink guard, no certified check */
@@ -526,34 +558,38 @@ static void exp_cost(const options* o)
     }
     const int only_k = getenv("SDFCCD_BENCH_COST_ONLY") ? atoi(getenv("SDFCCD_BENCH_COST_ONLY")) : -1;
     int R = o->quick >= 2 || only_k >= 0 ? 1 : (o->quick ? 5 : 15); /* the fastest of the repeats: more of them find a quieter moment on a shared machine */
-    printf("mesh,queries,evals_per_query,ns_per_evaluation,ns_field,ns_motion_solver_dispatch,ns_per_evaluation_builtin_torus,"
+    printf("mesh,callback,queries,evals_per_query,ns_per_evaluation,ns_field,ns_motion_solver_dispatch,ns_per_evaluation_builtin_torus,"
            "ns_field_latency,ns_rest_after_field_latency\n");
     const char* only = getenv("SDFCCD_BENCH_MESH"); /* one mesh only (a shorter run) */
     for (int mesh = 0; mesh < 2; ++mesh) {
         if (only && strcmp(only, k_mesh_name[mesh]) != 0) continue;
         int n = ds.n_per_mesh;
-        double best[4] = { INFINITY, INFINITY, INFINITY, INFINITY };
+        double best[NV];
+        for (int k = 0; k < NV; ++k) best[k] = INFINITY;
         long long evals = 0;
         for (int rep = 0; rep < R; ++rep)
-            for (int k = 0; k < 4; ++k) { /* interleaved: callback x1, callback x5, the built-in torus, callback x5 chained */
+            for (int k = 0; k < NV; ++k) { /* interleaved, so that every variant meets the same moments of a shared machine */
                 if (only_k >= 0 && k != only_k) continue;
-                sdfccd_SdfId f = k < 2 ? sdf[k] : k == 2 ? ds.torus : sdf[2];
                 long long e = 0;
                 double t0 = clock_us();
                 for (int i = 0; i < n; ++i) {
                     sdfccd_QueryResult res;
-                    CHECK(sdfccd_query_mesh_ws(ws, f, NULL, ds.mid[mesh], &ds.c[mesh * n + i].m, 0.0, DT, &p, contacts, 16, &res));
+                    CHECK(sdfccd_query_mesh_ws(ws, sdf[k], NULL, ds.mid[mesh], &ds.c[mesh * n + i].m, 0.0, DT, &p, contacts, 16, &res));
                     e += (long long)res.sdf_evaluations;
                 }
                 best[k] = fmin(best[k], clock_us() - t0);
                 if (k == 0) evals = e;
             }
-        double per = best[0] * 1e3 / (double)evals, field = (best[1] - best[0]) * 1e3 / (4.0 * (double)evals);
-        double latency = (best[3] - best[0]) * 1e3 / (4.0 * (double)evals);
-        printf("%s,%d,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", k_mesh_name[mesh], n, (double)evals / n, per, field, per - field,
-               best[2] * 1e3 / (double)evals, latency, per - latency);
+        for (int form = 0; form < 2; ++form) {
+            const double one = form == 0 ? best[0] : best[4], five = form == 0 ? best[1] : best[5], chained = form == 0 ? best[3] : best[6];
+            double per = one * 1e3 / (double)evals, field = (five - one) * 1e3 / (4.0 * (double)evals);
+            double latency = (chained - one) * 1e3 / (4.0 * (double)evals);
+            printf("%s,%s,%d,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", k_mesh_name[mesh], k_cost_form[form], n, (double)evals / n, per, field,
+                   per - field, best[2] * 1e3 / (double)evals, latency, per - latency);
+        }
     }
-    for (int k = 0; k < 3; ++k) sdfccd_destroy_sdf(sdf[k]);
+    for (int k = 0; k < NV; ++k)
+        if (k_cost_variant[k].form >= 0) sdfccd_destroy_sdf(sdf[k]);
     sdfccd_destroy_workspace(ws);
     free_dataset(&ds);
 }
@@ -601,6 +637,7 @@ static inline sdfccd_Vec3 chain_point(const chain_path* q, double t)
  * solver issues it. The torus is the cost experiment's user callback (called through a pointer the
  * compiler cannot see through), so these compare with section 5's columns:
  *   field: the next point is the last one moved by 1e-12 x phi (the field's latency and the call);
+ *   field eval_xyz: the same through the callback's other form (the point as three coordinates);
  *   spatial: a point on a segment, phi and its gradient, the slope, a secant step on the slope;
  *   temporal: a point at a new time on a rotating path (as above), phi, a secant step in time;
  *   temporal x2: two such chains that do not depend on each other, one sample of each per turn (the
@@ -611,12 +648,14 @@ static void exp_chain(const options* o)
     torus_cb one = { 1 };
     double (*volatile eval_ptr)(sdfccd_Vec3, sdfccd_Vec3*, void*) = torus_eval;
     double (*const eval)(sdfccd_Vec3, sdfccd_Vec3*, void*) = eval_ptr;
+    double (*volatile xyz_ptr)(double, double, double, sdfccd_Vec3*, void*) = torus_eval_xyz;
+    double (*const eval_xyz)(double, double, double, sdfccd_Vec3*, void*) = xyz_ptr;
     const chain_path q[2] = {
         { { 0.02, 0.1, 0.03 }, { 0.3, -1.0, 0.5 }, { 0.01, 0.02, -0.005 }, { 0.003, -0.01, 0.02 }, { 0.267, 0.534, 0.801 }, 0.004, 40.0, 0.955336, 0.295520 },
         { { -0.1, 0.02, 0.01 }, { -0.5, 0.2, 1.0 }, { -0.02, 0.01, 0.01 }, { 0.01, 0.01, -0.02 }, { 0.801, 0.267, 0.534 }, -0.002, 25.0, 0.980067, 0.198669 },
     };
     const int n = o->quick ? 200000 : 1000000, passes = o->quick ? 5 : 15;
-    double best[4] = { INFINITY, INFINITY, INFINITY, INFINITY }, sink = 0.0;
+    double best[5] = { INFINITY, INFINITY, INFINITY, INFINITY, INFINITY }, sink = 0.0;
     for (int pass = 0; pass < passes; ++pass) {
         double t0 = thread_cpu_us();
         sdfccd_Vec3 x = { 0.12, 0.01, 0.02 };
@@ -626,6 +665,15 @@ static void exp_chain(const options* o)
             sink += f;
         }
         best[0] = fmin(best[0], thread_cpu_us() - t0);
+
+        t0 = thread_cpu_us();
+        x = (sdfccd_Vec3){ 0.12, 0.01, 0.02 };
+        for (int i = 0; i < n; ++i) {
+            const double f = eval_xyz(x.x, x.y, x.z, NULL, &one);
+            x.x = 0.12 + 1e-12 * f;
+            sink += f;
+        }
+        best[4] = fmin(best[4], thread_cpu_us() - t0);
 
         t0 = thread_cpu_us();
         const sdfccd_Vec3 a = { 0.1, 0.02, 0.04 }, d = { -0.03, 0.02, -0.01 };
@@ -663,9 +711,9 @@ static void exp_chain(const options* o)
             }
         best[3] = fmin(best[3], thread_cpu_us() - t0);
     }
-    static const char* name[4] = { "field", "spatial", "temporal", "temporal x2" };
+    static const char* name[5] = { "field", "spatial", "temporal", "temporal x2", "field eval_xyz" };
     printf("chain,samples,ns_per_sample\n");
-    for (int k = 0; k < 4; ++k) printf("%s,%d,%.1f\n", name[k], k == 3 ? n / 2 * 2 : n, best[k] * 1e3 / (double)(k == 3 ? n / 2 * 2 : n));
+    for (int k = 0; k < 5; ++k) printf("%s,%d,%.1f\n", name[k], k == 3 ? n / 2 * 2 : n, best[k] * 1e3 / (double)(k == 3 ? n / 2 * 2 : n));
     if (sink == 1234.5) fprintf(stderr, "-\n"); /* keeps the loops' values live */
 }
 

@@ -93,11 +93,19 @@ static double counted_sphere(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
     return l - 1.0;
 }
 
+/* The same with the point as three coordinates (sdfccd_CallbackSdfDef::eval_xyz). */
+static double counted_sphere_xyz(double x, double y, double z, sdfccd_Vec3* g, void* user)
+{
+    return counted_sphere((sdfccd_Vec3){ x, y, z }, g, user);
+}
+
 START_TEST(test_field_calls_are_counted)
 {
     int64_t calls = 0;
     sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
-    d.eval = counted_sphere;
+    /* _i: 0 the point as an sdfccd_Vec3 (eval), 1 as three coordinates (eval_xyz) */
+    if (_i == 0) d.eval = counted_sphere;
+    else d.eval_xyz = counted_sphere_xyz;
     d.user = &calls;
     d.bounds = (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } };
     d.smooth = 1;
@@ -798,7 +806,7 @@ int main(void)
     test_add_memory_fixture(tc);
     tcase_add_test(tc, test_huge_spin_rejected);
     tcase_add_test(tc, test_budget_shared_by_segments);
-    tcase_add_test(tc, test_field_calls_are_counted);
+    tcase_add_loop_test(tc, test_field_calls_are_counted, 0, 2);
     tcase_add_test(tc, test_budget_shared_by_triangles);
     tcase_add_test(tc, test_overflowing_query_inputs_rejected);
     tcase_add_test(tc, test_query_argument_names);

@@ -125,6 +125,7 @@ class BatchQuery(C.Structure):
 
 
 EvalFcn = C.CFUNCTYPE(C.c_double, Vec3, C.POINTER(Vec3), C.c_void_p)
+EvalXyzFcn = C.CFUNCTYPE(C.c_double, C.c_double, C.c_double, C.c_double, C.POINTER(Vec3), C.c_void_p)
 ProgressFcn = C.CFUNCTYPE(C.c_int32, C.c_double, C.c_void_p)
 
 
@@ -135,6 +136,7 @@ class CallbackSdfDef(C.Structure):
         ("lipschitz", C.c_double),
         ("bounds", Aabb),
         ("smooth", C.c_int32),
+        ("eval_xyz", EvalXyzFcn),
         ("internal_value", C.c_int32),
     ]
 
