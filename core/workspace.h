@@ -34,6 +34,8 @@ enum {
     SCC_WS_VERTEX_LIST, /* contact sets: the vertices of the touching triangles, sorted (contacts.c) */
     SCC_WS_DEFERRED,  /* mesh query: FWGSS answers whose check waits for the earliest contact (mesh_query.c) */
     SCC_WS_BELOW,     /* broad phase: the triangles a traversal marked, with the motions of those bounded below their leaves (bsh.c) */
+    SCC_WS_CHECK,     /* certified searches: the region store's first regions and the sample cache, one fixed size (certified.c) */
+    SCC_WS_CELLS,     /* certified searches on grids: the cell cache, one fixed size (certified.c) */
     SCC_WS_SLOTS
 };
 
