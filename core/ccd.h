@@ -90,9 +90,8 @@ scc_dcd_result scc_dcd_traced(const scc_sdf* sdf, const scc_vec3 tri[3], scc_ver
 /* ---- CCD on one interval [ta, tb] with at most max_rotation of rotation ---- */
 void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out);
 void scc_fw(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out);
-/* Returns 0 on allocation failure (out untouched), 1 otherwise. The certified searches (this, the
- * check and the clear proof below) keep their scratch in `ws` (slots SCC_WS_CHECK, SCC_WS_CELLS) and
- * allocate through ws->alloc. */
+/* Returns 0 on allocation failure (out untouched), 1 otherwise. Allocates through ws->alloc; the
+ * check and the clear proof below keep their scratch in `ws` (slots SCC_WS_CHECK, SCC_WS_CELLS). */
 int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                   scc_workspace* ws, scc_tri_hit* out);
 

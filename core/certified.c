@@ -1133,11 +1133,12 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
 int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
                   scc_workspace* ws, scc_tri_hit* out)
 {
+    /* The CERTIFIED method's store is on the allocator from its first region, as certified_max_bytes
+     * counts it (nothing allocated below one region: test_hardening), and its sample cache (7 KB)
+     * on the stack: only the check's and the clear proof's scratch is the workspace's. */
     const double none[3] = { 1, 0, 0 };
-    region_store store;
-    scc_allocator hooks;
-    search_scratch* sc = scratch_of(ws, &store, &hooks);
-    return sc && certified_search(sdf, m, ta, tb, p, &hooks, &sc->samples, INFINITY, none, 0.0, p->max_evals, NULL, out, NULL);
+    sample_cache cache;
+    return certified_search(sdf, m, ta, tb, p, ws->alloc, &cache, INFINITY, none, 0.0, p->max_evals, NULL, out, NULL);
 }
 
 /* Whether FWGSS's answer on this field is checked by the certified search (ours, issue 20): fields

@@ -3,7 +3,7 @@
  * sdfccd_query_mesh_linear_ws) a mesh query allocates nothing after the first one of its size,
  * counted with a counting allocator installed through sdfccd_set_allocator; results are the same
  * as without the workspace. Also on fields with kinks, where the certified check's scratch is the
- * workspace's. Public ABI only. */
+ * workspace's, and triangle queries through one (sdfccd_query_triangle_ws). Public ABI only. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -210,6 +210,18 @@ START_TEST(test_no_allocation_kinked)
             checked += ra.sdf_evaluations != rb.sdf_evaluations;
             hits += ra.hit;
         }
+        /* triangle queries through the workspace (sdfccd_query_triangle_ws): the same answers as
+         * without it, and no allocation */
+        const sdfccd_Vec3 tri[3] = { { 0.03, 0, 0 }, { -0.02, 0.03, 0 }, { -0.02, -0.03, 0 } };
+        for (int i = 0; i < 24; ++i) {
+            ck_assert_int_eq(sdfccd_query_triangle(fields[k], NULL, tri, &mo[i], 0.0, 1.0 / 60.0, &p, cb, 64, &rb), SDFCCD_OK);
+            long before = cnt.allocs;
+            ck_assert_int_eq(sdfccd_query_triangle_ws(ws, fields[k], NULL, tri, &mo[i], 0.0, 1.0 / 60.0, &p, ca, 64, &ra), SDFCCD_OK);
+            ck_assert_msg(cnt.allocs == before, "%s: triangle query %d through the workspace allocated %ld times", names[k], i,
+                          cnt.allocs - before);
+            same_result(&ra, ca, &rb, cb);
+        }
+        ck_assert_int_eq(sdfccd_query_triangle_ws(NULL, fields[k], NULL, tri, &mo[0], 0.0, 1.0 / 60.0, &p, ca, 64, &ra), SDFCCD_INVALID_ARGUMENT);
         const int64_t bytes = sdfccd_workspace_bytes(ws), bytes_off = sdfccd_workspace_bytes(ws_off);
         printf("workspace, %s: %d of 24 queries hit, the check ran in %d; workspace %lld bytes (%lld without the check)\n", names[k], hits,
                checked, (long long)bytes, (long long)bytes_off);

@@ -15,11 +15,15 @@ static sdfccd_Status run_one(sdfccd_BatchQuery* b, sdfccd_Workspace* ws)
 {
     switch (b->kind) {
     case SDFCCD_BATCH_TRIANGLE:
-        return sdfccd__query_triangle_in(ws, b->sdf, b->sdf_motion, b->triangle, b->motion, b->t0, b->t1, b->params, b->out_contacts,
-                                         b->capacity, b->out_result);
+        return ws ? sdfccd_query_triangle_ws(ws, b->sdf, b->sdf_motion, b->triangle, b->motion, b->t0, b->t1, b->params, b->out_contacts,
+                                             b->capacity, b->out_result)
+                  : sdfccd_query_triangle(b->sdf, b->sdf_motion, b->triangle, b->motion, b->t0, b->t1, b->params, b->out_contacts, b->capacity,
+                                          b->out_result);
     case SDFCCD_BATCH_TRIANGLE_LINEAR:
-        return sdfccd__query_triangle_linear_in(ws, b->sdf, b->sdf_motion, b->triangle, b->triangle_end, b->t0, b->t1, b->params,
-                                                b->out_contacts, b->capacity, b->out_result);
+        return ws ? sdfccd_query_triangle_linear_ws(ws, b->sdf, b->sdf_motion, b->triangle, b->triangle_end, b->t0, b->t1, b->params,
+                                                    b->out_contacts, b->capacity, b->out_result)
+                  : sdfccd_query_triangle_linear(b->sdf, b->sdf_motion, b->triangle, b->triangle_end, b->t0, b->t1, b->params,
+                                                 b->out_contacts, b->capacity, b->out_result);
     case SDFCCD_BATCH_MESH:
         return ws ? sdfccd_query_mesh_ws(ws, b->sdf, b->sdf_motion, b->mesh, b->motion, b->t0, b->t1, b->params, b->out_contacts,
                                          b->capacity, b->out_result)

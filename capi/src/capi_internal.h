@@ -192,16 +192,6 @@ sdfccd_Status sdfccd__linear_vertices(const sdfccd__mesh* m, const sdfccd_Vec3* 
 struct sdfccd_Workspace {
     scc_workspace ws;
 };
-/* sdfccd_query_triangle(_linear) with the certified searches' scratch in `workspace` (NULL: a
- * temporary one), for the batch's threads (ccd_api.c) */
-sdfccd_Status sdfccd__query_triangle_in(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
-                                        const sdfccd_Vec3 triangle[3], const sdfccd_RigidMotion* motion, double t0, double t1,
-                                        const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
-                                        sdfccd_QueryResult* out_result);
-sdfccd_Status sdfccd__query_triangle_linear_in(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
-                                               const sdfccd_Vec3 start[3], const sdfccd_Vec3 end[3], double t0, double t1,
-                                               const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
-                                               sdfccd_QueryResult* out_result);
 
 
 #endif

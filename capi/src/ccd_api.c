@@ -246,8 +246,8 @@ static void write_result(const query_setup* q, double t0, double t1, const scc_q
     }
 }
 
-/* The triangle query with the certified searches' scratch in `workspace` (a batch thread's), or
- * in a temporary workspace freed before returning (NULL). */
+/* The triangle query with the certified searches' scratch in `workspace`, or in a temporary
+ * workspace freed before returning (NULL). */
 static sdfccd_Status run_triangle(const query_setup* q, const scc_tri_motion* m, double t0, double t1, sdfccd_Workspace* workspace,
                                   sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result, const char* fn)
 {
@@ -324,11 +324,13 @@ sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* 
     SDFCCD__HELD_CALL(query_triangle(NULL, sdf, sdf_motion, triangle, motion, t0, t1, params, out_contacts, capacity, out_result));
 }
 
-sdfccd_Status sdfccd__query_triangle_in(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
-                                        const sdfccd_Vec3 triangle[3], const sdfccd_RigidMotion* motion, double t0, double t1,
-                                        const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
-                                        sdfccd_QueryResult* out_result)
+sdfccd_Status sdfccd_query_triangle_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                       const sdfccd_Vec3 triangle[3], const sdfccd_RigidMotion* motion, double t0, double t1,
+                                       const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+                                       sdfccd_QueryResult* out_result)
 {
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_triangle_ws: workspace"))) return st;
     SDFCCD__HELD_CALL(query_triangle(workspace, sdf, sdf_motion, triangle, motion, t0, t1, params, out_contacts, capacity, out_result));
 }
 
@@ -339,11 +341,13 @@ sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
     SDFCCD__HELD_CALL(query_triangle_linear(NULL, sdf, sdf_motion, start, end, t0, t1, params, out_contacts, capacity, out_result));
 }
 
-sdfccd_Status sdfccd__query_triangle_linear_in(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
-                                               const sdfccd_Vec3 start[3], const sdfccd_Vec3 end[3], double t0, double t1,
-                                               const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
-                                               sdfccd_QueryResult* out_result)
+sdfccd_Status sdfccd_query_triangle_linear_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                              const sdfccd_Vec3 start[3], const sdfccd_Vec3 end[3], double t0, double t1,
+                                              const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+                                              sdfccd_QueryResult* out_result)
 {
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_triangle_linear_ws: workspace"))) return st;
     SDFCCD__HELD_CALL(query_triangle_linear(workspace, sdf, sdf_motion, start, end, t0, t1, params, out_contacts, capacity, out_result));
 }
 
