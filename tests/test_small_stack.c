@@ -144,20 +144,9 @@ END_TEST
 
 START_TEST(test_grid_on_small_stack)
 {
-    sdfccd_SdfId box, ball, carved, grid;
-    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.1, 0.1, 0.1 }, &box), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd_create_sphere(0.12, &ball), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_DIFFERENCE, box, ball, &carved), SDFCCD_OK);
-    sdfccd_GridDef def = sdfccd_default_grid_def();
-    def.resolution[0] = def.resolution[1] = def.resolution[2] = 16;
-    def.padding = 0.05;
-    def.threads = 1;
-    ck_assert_int_eq(sdfccd_create_grid_from_sdf(carved, &def, &grid), SDFCCD_OK);
+    const sdfccd_SdfId grid = test_carved_box_grid();
     check_field(grid, "grid of a box minus a ball");
     ck_assert_int_eq(sdfccd_destroy_sdf(grid), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd_destroy_sdf(carved), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd_destroy_sdf(ball), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd_destroy_sdf(box), SDFCCD_OK);
 }
 END_TEST
 

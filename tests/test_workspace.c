@@ -172,15 +172,9 @@ START_TEST(test_no_allocation_kinked)
 {
     counter cnt = { 0, 0, 0 };
     ck_assert_int_eq(sdfccd_set_allocator(count_alloc, count_free, &cnt), SDFCCD_OK);
-    sdfccd_SdfId box, ball, carved, grid;
+    sdfccd_SdfId box;
     ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.1, 0.08, 0.06 }, &box), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd_create_sphere(0.12, &ball), SDFCCD_OK);
-    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_DIFFERENCE, box, ball, &carved), SDFCCD_OK);
-    sdfccd_GridDef def = sdfccd_default_grid_def();
-    def.resolution[0] = def.resolution[1] = def.resolution[2] = 16;
-    def.padding = 0.05;
-    def.threads = 1;
-    ck_assert_int_eq(sdfccd_create_grid_from_sdf(carved, &def, &grid), SDFCCD_OK);
+    const sdfccd_SdfId grid = test_carved_box_grid();
     sdfccd_MeshId mesh = uv_sphere(0.03, 6, 8);
     const sdfccd_SdfId fields[2] = { box, grid };
     const char* names[2] = { "box", "grid" };
@@ -233,8 +227,6 @@ START_TEST(test_no_allocation_kinked)
     }
     sdfccd_destroy_mesh(mesh);
     sdfccd_destroy_sdf(grid);
-    sdfccd_destroy_sdf(carved);
-    sdfccd_destroy_sdf(ball);
     sdfccd_destroy_sdf(box);
     ck_assert_int_eq(sdfccd_byte_count(), 0);
     ck_assert_int_eq(cnt.allocs, cnt.frees);
