@@ -488,6 +488,15 @@ _OPTIONAL_PROTOTYPES = {
     "sdfccd_generate_contacts_linear": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, C.c_void_p, C.c_void_p,
                                              C.c_double, C.c_double, _P(ContactParams), C.c_void_p, C.c_int32,
                                              _P(ContactSet)]),
+    "sdfccd_query_triangle_ws": (_S, [C.c_void_p, SdfId, _P(RigidMotion), C.c_void_p, _P(RigidMotion), C.c_double,
+                                      C.c_double, _P(QueryParams), C.c_void_p, C.c_int32, _P(QueryResult)]),
+    "sdfccd_query_triangle_linear_ws": (_S, [C.c_void_p, SdfId, _P(RigidMotion), C.c_void_p, C.c_void_p, C.c_double,
+                                             C.c_double, _P(QueryParams), C.c_void_p, C.c_int32, _P(QueryResult)]),
+    "sdfccd_query_mesh_ws": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, _P(RigidMotion), C.c_double, C.c_double,
+                                  _P(QueryParams), C.c_void_p, C.c_int32, _P(QueryResult)]),
+    "sdfccd_query_mesh_linear_ws": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, C.c_void_p, C.c_void_p,
+                                         C.c_double, C.c_double, _P(QueryParams), C.c_void_p, C.c_int32,
+                                         _P(QueryResult)]),
 }
 HAVE_CONTACTS = False
 
