@@ -90,9 +90,10 @@ scc_dcd_result scc_dcd_traced(const scc_sdf* sdf, const scc_vec3 tri[3], scc_ver
 /* ---- CCD on one interval [ta, tb] with at most max_rotation of rotation ---- */
 void scc_fwgss(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out);
 void scc_fw(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_tri_hit* out);
-/* Returns 0 on allocation failure (out untouched), 1 otherwise. */
+/* Returns 0 on allocation failure (out untouched), 1 otherwise. Allocates through ws->alloc; the
+ * check and the clear proof below keep their scratch in `ws` (slots SCC_WS_CHECK, SCC_WS_CELLS). */
 int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                  const scc_allocator* alloc, scc_tri_hit* out);
+                  scc_workspace* ws, scc_tri_hit* out);
 
 /* FWGSS's answer checked on a field whose gradient may jump (issue 20; certified.c): the certified
  * search over [ta, toi] (no hit: [ta, tb]) seeded with FWGSS's witness, stopped once no contact is
@@ -113,7 +114,7 @@ int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double
 #define SCC_VERIFY_MAX_EVALS 1000000
 #define SCC_VERIFY_PROBES 2 /* rounds of scc_fwgss_probe when the check stops at a cap short of FWGSS's witness */
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                     const scc_allocator* alloc, scc_tri_hit* io);
+                     scc_workspace* ws, scc_tri_hit* io);
 /* A search for a contact in (t_lo, t_hi) near the weights b (fwgss.c; the check's fallback when it stops
  * at a cap with its lower bound t_lo more than tol before t_hi): the minimum of phi over the triangle by
  * FWGSS's spatial steps at t_lo + tol / 2, then at times 4x further each, up to t_hi; a contact found
@@ -124,12 +125,12 @@ void scc_fwgss_probe(const scc_sdf* sdf, const scc_tri_motion* m, double ta, dou
 /* scc_fwgss_verify, and with `force` also where FWGSS's own no-contact proof held (io a no-hit made
  * from a contact after tb: the check then proves [ta, tb] clear or finds a contact there). */
 int scc_fwgss_check(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                    const scc_allocator* alloc, int force, scc_tri_hit* io);
+                    scc_workspace* ws, int force, scc_tri_hit* io);
 /* The certified search over [ta, tb] within `budget` evaluations, for a short clear proof: no hit
  * with state SCC_NO_HIT proves [ta, tb] free of contact; a stop at the budget (SCC_NOT_CONVERGED)
  * still proves none before out->toi_lower, and a hit is a witness at out->toi. Returns 0 on
  * allocation failure. */
-int scc_certified_clear(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, const scc_allocator* alloc,
+int scc_certified_clear(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_workspace* ws,
                         int64_t budget, scc_tri_hit* out);
 /* Whether scc_fwgss_verify checks FWGSS on this field: fields with gradient jumps (analytic kinked
  * fields, grids, user fields) with fwgss_kink_guard and fwgss_verify on. On grids the search bounds
@@ -168,9 +169,10 @@ typedef struct scc_query_summary {
 } scc_query_summary;
 
 /* One triangle over [ta, tb] (within the motion's [t0, t1]): splits large rotations, runs the method, then subdivision.
- * Returns 0 on allocation failure. Contacts: primary first, then subdivision points. */
+ * Returns 0 on allocation failure. Contacts: primary first, then subdivision points. The certified
+ * searches' scratch is in `ws` (scc_certified). */
 int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                       const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
+                       scc_workspace* ws, uint32_t triangle_index, scc_contact* out, int capacity,
                        scc_query_summary* sum);
 /* scc_query_triangle, except that with `raw` (not NULL) an FWGSS search of one segment on a field
  * whose answers are checked (scc_fwgss_verified) stops before the check: *deferred = 1, *raw holds
@@ -179,10 +181,10 @@ int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, d
  * [ta, tb] (a contact of raw after tb becomes a proof owed up to tb), then the contacts, exactly as
  * scc_query_triangle would have (with the same tb); `sum` then counts only what the finish added. */
 int scc_query_triangle_deferred(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                                const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
+                                scc_workspace* ws, uint32_t triangle_index, scc_contact* out, int capacity,
                                 scc_query_summary* sum, scc_tri_hit* raw, int* deferred);
 int scc_triangle_finish_deferred(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                                 const scc_allocator* alloc, uint32_t triangle_index, scc_tri_hit raw, scc_contact* out,
+                                 scc_workspace* ws, uint32_t triangle_index, scc_tri_hit raw, scc_contact* out,
                                  int capacity, scc_query_summary* sum);
 
 /* A mesh whose triangles all follow one motion template: rigid (`body` set, vertices local) or

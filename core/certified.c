@@ -23,6 +23,7 @@
 #include "grid.h"
 #include "grid_access.h"
 #include "grid_cell.h"
+#include "workspace.h"
 #include <string.h>
 
 typedef struct region {
@@ -113,7 +114,7 @@ static scc_vec3 corner(const scc_tri_state* st, double u, double v)
  * Lipschitz bounds needed 10^5. M_Q comes from the tensor Bernstein form of phi_Q (coefficients
  * enclose a polynomial's range; a derivative's coefficients are differences): over the whole cell
  * (cached), and only when that does not prune, over Q's part of B (the form re-expressed there). */
-#define CELL_CACHE 64 /* per search, direct-mapped by a hash of the cell index (regions cluster on a few cells) */
+#define CELL_CACHE 64 /* per check, direct-mapped by a hash of the cell index (regions cluster on a few cells); in the workspace (SCC_WS_CELLS) */
 typedef struct cell_poly {
     uint64_t l;   /* full-grid cell index (UINT64_MAX: empty slot) */
     double v[32]; /* node values, slot order */
@@ -125,7 +126,7 @@ typedef struct cell_poly {
 } cell_poly;
 typedef struct grid_bound_ctx {
     const scc_grid* g;
-    cell_poly cell[CELL_CACHE];
+    cell_poly* cell; /* CELL_CACHE entries */
 } grid_bound_ctx;
 
 /* The slot of the node at tensor point (i, j, k) of {-1,-1/3,1/3,1}^3, or -1 (a face or inner point). */
@@ -772,8 +773,10 @@ int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const dou
                           double* out_bound)
 {
     if (sdf->kind != SCC_SDF_GRID) return 0;
+    cell_poly cells[CELL_CACHE]; /* a test's entry point, not a query's: on the stack */
     grid_bound_ctx ctx;
     ctx.g = (const scc_grid*)sdf;
+    ctx.cell = cells;
     for (int i = 0; i < CELL_CACHE; ++i) ctx.cell[i].l = UINT64_MAX;
     region r = { ta, tb, { u[0], u[1], u[2] }, { v[0], v[1], v[2] }, 0, 0 };
     scc_tri_state st;
@@ -794,27 +797,49 @@ int scc_grid_region_bound(const scc_sdf* sdf, const scc_tri_motion* m, const dou
                              &time);
 }
 
-/* The region store of a check of FWGSS (scc_fwgss_verify) starts in a buffer on the stack (ours): a
- * check that never holds more regions than it does allocates nothing, so a mesh or guard query
- * through a warm workspace allocates nothing when its checks stay within it (test_guard). The heap
- * grows by allocating the new array, copying, then freeing the old one, so a request that fits is
- * given the same buffer again (the copy is onto itself); larger ones go to the caller's allocator. */
-#define STACK_REGIONS 1024 /* 72 KB */
-typedef struct stack_store {
-    region buf[STACK_REGIONS];
-    const scc_allocator* next;
-} stack_store;
+/* A certified search's scratch lives in the caller's workspace (ours), not on the calling thread's
+ * stack (a job system's 64 KB fibre): the region store's first STORE_REGIONS regions and the sample
+ * cache (slot SCC_WS_CHECK), and on grids the cell cache (SCC_WS_CELLS), each allocated on the first
+ * search that needs it and kept. A search whose regions fit allocates nothing through a warm
+ * workspace (test_guard, test_workspace). The heap grows by allocating the new array, copying, then
+ * freeing the old one, so a request that fits is given the same buffer again (the copy is onto
+ * itself); larger ones go to the workspace's allocator and are freed when the search ends. Nothing
+ * is cleared beyond what a search used to clear on its stack (the caches' keys). */
+#define STORE_REGIONS 1024 /* 72 KB */
+typedef struct search_scratch {
+    region regions[STORE_REGIONS];
+    sample_cache samples;
+} search_scratch;
 
-static void* stack_alloc(size_t size, void* user)
+typedef struct region_store {
+    region* buf; /* STORE_REGIONS regions */
+    const scc_allocator* next;
+} region_store;
+
+static void* store_alloc(size_t size, void* user)
 {
-    stack_store* st = user;
-    return size <= sizeof st->buf ? st->buf : scc_alloc(st->next, size);
+    region_store* st = user;
+    return size <= STORE_REGIONS * sizeof(region) ? (void*)st->buf : scc_alloc(st->next, size);
 }
 
-static void stack_free(void* mem, size_t size, void* user)
+static void store_free(void* mem, size_t size, void* user)
 {
-    stack_store* st = user;
+    region_store* st = user;
     if (mem != (void*)st->buf) scc_free(st->next, mem, size);
+}
+
+/* The workspace's search scratch, with `hooks` set to the allocator that hands out its regions
+ * first; NULL when it cannot be allocated. */
+static search_scratch* scratch_of(scc_workspace* ws, region_store* store, scc_allocator* hooks)
+{
+    search_scratch* sc = scc_ws_get(ws, SCC_WS_CHECK, sizeof *sc);
+    if (!sc) return NULL;
+    store->buf = sc->regions;
+    store->next = ws->alloc;
+    hooks->alloc = store_alloc;
+    hooks->free = store_free;
+    hooks->user = store;
+    return sc;
 }
 
 /* Whether splitting the region's space at its edges' midpoints gives sub-regions different from it. */
@@ -844,7 +869,7 @@ static int split_changes(const region* r)
  * bound: while no earlier witness turns up, the search stops once the bracket is `seed_tol` wide;
  * after one, at the certified time tolerance. At most `max_evals` evaluations. */
 static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                            const scc_allocator* alloc, double seed_t, const double seed_b[3], double seed_tol, int64_t max_evals,
+                            const scc_allocator* alloc, sample_cache* cache, double seed_t, const double seed_b[3], double seed_tol, int64_t max_evals,
                             grid_bound_ctx* grid, scc_tri_hit* out, double low_b[3])
 {
     /* The region store never holds more than cert_max_bytes (0: no limit); when it is full the
@@ -865,8 +890,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
     if (isfinite(seed_t))
         for (int j = 0; j < 3; ++j) hit_b[j] = seed_b[j];
     int64_t processed = 0, evals = 0;
-    sample_cache cache;
-    for (int i = 0; i < SAMPLE_CACHE; ++i) cache.s[i].key[0] = bits_of(NAN);
+    for (int i = 0; i < SAMPLE_CACHE; ++i) cache->s[i].key[0] = bits_of(NAN);
     state_cache states;
     states.s[0].t = states.s[1].t = NAN;
     states.next = 0;
@@ -891,7 +915,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         if (low_b) { low_b[0] = cu; low_b[1] = cv; low_b[2] = 1.0 - cu - cv; }
         scc_vec3 c = corner(&st, cu, cv);
         scc_vec3 gc;
-        double phi = sample_at(&cache, sdf, &st, r.ta, cu, cv, &gc, &evals);
+        double phi = sample_at(cache, sdf, &st, r.ta, cu, cv, &gc, &evals);
         if (phi <= p->margin && r.ta < hi) {
             hi = r.ta;
             hit_b[0] = cu; hit_b[1] = cv; hit_b[2] = 1.0 - cu - cv;
@@ -934,7 +958,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
                 y[0] = c; fy[0] = phi; gy[0] = gc;
                 for (int i = 0; i < 3 && !done; ++i) {
                     y[i + 1] = cx.x[i];
-                    fy[i + 1] = sample_at(&cache, sdf, &st, r.ta, r.u[i], r.v[i], &gy[i + 1], &evals);
+                    fy[i + 1] = sample_at(cache, sdf, &st, r.ta, r.u[i], r.v[i], &gy[i + 1], &evals);
                     if (fy[i + 1] <= p->margin) {
                         hi = lo = r.ta;
                         hit_b[0] = r.u[i]; hit_b[1] = r.v[i]; hit_b[2] = 1.0 - r.u[i] - r.v[i];
@@ -993,7 +1017,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
         for (int i = 0; i < 3 && !done && sample && !corners_done; ++i) {
             scc_vec3 g;
             if (have_point_lb && point_lb[i] > p->margin) continue;
-            if (sample_at(&cache, sdf, &st, r.ta, r.u[i], r.v[i], &g, &evals) <= p->margin) {
+            if (sample_at(cache, sdf, &st, r.ta, r.u[i], r.v[i], &g, &evals) <= p->margin) {
                 hi = lo = r.ta;
                 hit_b[0] = r.u[i]; hit_b[1] = r.v[i]; hit_b[2] = 1.0 - r.u[i] - r.v[i];
                 done = 1;
@@ -1018,7 +1042,7 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
             for (int i = 0; i < 4; ++i) {
                 scc_vec3 g;
                 if (k == 0 && have_point_lb && point_lb[i == 0 ? 6 : 2 + i] > p->margin) continue; /* bounds at r.tb only */
-                if (sample_at(&cache, sdf, &se, tw, su[i], sv[i], &g, &evals) <= p->margin) {
+                if (sample_at(cache, sdf, &se, tw, su[i], sv[i], &g, &evals) <= p->margin) {
                     hi = tw;
                     hit_b[0] = su[i]; hit_b[1] = sv[i]; hit_b[2] = 1.0 - su[i] - sv[i];
                     break;
@@ -1107,10 +1131,14 @@ static int certified_search(const scc_sdf* sdf, const scc_tri_motion* m, double 
 }
 
 int scc_certified(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                  const scc_allocator* alloc, scc_tri_hit* out)
+                  scc_workspace* ws, scc_tri_hit* out)
 {
+    /* The CERTIFIED method's store is on the allocator from its first region, as certified_max_bytes
+     * counts it (nothing allocated below one region: test_hardening), and its sample cache (7 KB)
+     * on the stack: only the check's and the clear proof's scratch is the workspace's. */
     const double none[3] = { 1, 0, 0 };
-    return certified_search(sdf, m, ta, tb, p, alloc, INFINITY, none, 0.0, p->max_evals, NULL, out, NULL);
+    sample_cache cache;
+    return certified_search(sdf, m, ta, tb, p, ws->alloc, &cache, INFINITY, none, 0.0, p->max_evals, NULL, out, NULL);
 }
 
 /* Whether FWGSS's answer on this field is checked by the certified search (ours, issue 20): fields
@@ -1125,29 +1153,28 @@ int scc_fwgss_verified(const scc_sdf* sdf, const scc_params* p)
     }
 }
 
-/* The check itself, out of line: its 64 KB region buffer and the grid's cell cache are on the stack
- * only when a check runs, not on every FWGSS query's path (fwgss_verify 0 in the bridge's guard). */
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((noinline))
-#endif
-static int verify_search(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, const scc_allocator* alloc,
+/* The check itself (its scratch in the workspace: scratch_of). */
+static int verify_search(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_workspace* ws,
                          int64_t budget, scc_tri_hit* io)
 {
     scc_tri_hit c;
-    stack_store store;
-    store.next = alloc;
-    const scc_allocator hooks = { stack_alloc, stack_free, &store };
+    region_store store;
+    scc_allocator hooks;
+    search_scratch* sc = scratch_of(ws, &store, &hooks);
+    if (!sc) return 0;
     grid_bound_ctx grid;
     const int on_grid = sdf->kind == SCC_SDF_GRID;
     if (on_grid) {
         grid.g = (const scc_grid*)sdf;
+        grid.cell = scc_ws_get(ws, SCC_WS_CELLS, CELL_CACHE * sizeof *grid.cell);
+        if (!grid.cell) return 0;
         for (int i = 0; i < CELL_CACHE; ++i) grid.cell[i].l = UINT64_MAX;
     }
     const double tol = scc_fmax(SCC_VERIFY_TOL_FRACTION * p->time_tol, SCC_VERIFY_TOL);
     for (int round = 0;; ++round) {
         const double seed_t = io->hit ? io->toi : INFINITY;
         double low_b[3] = { 1, 0, 0 };
-        if (!certified_search(sdf, m, ta, io->hit ? io->toi : tb, p, &hooks, seed_t, io->bary, tol, budget, on_grid ? &grid : NULL, &c, low_b))
+        if (!certified_search(sdf, m, ta, io->hit ? io->toi : tb, p, &hooks, &sc->samples, seed_t, io->bary, tol, budget, on_grid ? &grid : NULL, &c, low_b))
             return 0;
         budget -= c.evals;
         io->evals += c.evals;
@@ -1189,17 +1216,14 @@ static int verify_search(const scc_sdf* sdf, const scc_tri_motion* m, double ta,
  * [ta, tb] within `budget` evaluations. Its first-order bounds prove a triangle that passes a
  * kinked convex piece without touching it clear in tens of evaluations, where FWGSS's descents
  * spend hundreds before their own check proves the same. */
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((noinline))
-#endif
-int scc_certified_clear(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, const scc_allocator* alloc,
+int scc_certified_clear(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p, scc_workspace* ws,
                         int64_t budget, scc_tri_hit* out)
 {
     const double none[3] = { 1, 0, 0 };
-    stack_store store;
-    store.next = alloc;
-    const scc_allocator hooks = { stack_alloc, stack_free, &store };
-    return certified_search(sdf, m, ta, tb, p, &hooks, INFINITY, none, 0.0, budget, NULL, out, NULL);
+    region_store store;
+    scc_allocator hooks;
+    search_scratch* sc = scratch_of(ws, &store, &hooks);
+    return sc && certified_search(sdf, m, ta, tb, p, &hooks, &sc->samples, INFINITY, none, 0.0, budget, NULL, out, NULL);
 }
 
 /* Whether a grid may be sharp where the triangle goes over [ta, tb] (ours): the largest bound on
@@ -1230,13 +1254,13 @@ static int grid_sharp_along(const scc_sdf* sdf, const scc_tri_motion* m, double 
 }
 
 int scc_fwgss_verify(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                     const scc_allocator* alloc, scc_tri_hit* io)
+                     scc_workspace* ws, scc_tri_hit* io)
 {
-    return scc_fwgss_check(sdf, m, ta, tb, p, alloc, 0, io);
+    return scc_fwgss_check(sdf, m, ta, tb, p, ws, 0, io);
 }
 
 int scc_fwgss_check(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                    const scc_allocator* alloc, int force, scc_tri_hit* io)
+                    scc_workspace* ws, int force, scc_tri_hit* io)
 {
     if (!scc_fwgss_verified(sdf, p) || (io->hit && !(io->toi > ta))) return 1;
     /* No hit with no descent run: FWGSS's conservative no-contact proof (fwgss_clear_proof) held */
@@ -1252,5 +1276,5 @@ int scc_fwgss_check(const scc_sdf* sdf, const scc_tri_motion* m, double ta, doub
     if (budget > SCC_VERIFY_MAX_EVALS) budget = SCC_VERIFY_MAX_EVALS;
     if (budget <= 0) return 1;
     if (sdf->kind == SCC_SDF_GRID && !grid_sharp_along(sdf, m, ta, tb)) return 1;
-    return verify_search(sdf, m, ta, tb, p, alloc, budget, io);
+    return verify_search(sdf, m, ta, tb, p, ws, budget, io);
 }

@@ -125,7 +125,7 @@ int scc_search_faces(const scc_sdf* sdf, const scc_mesh_motion* mm, double time,
             }
             scc_contact k[1 + SCC_MAX_SUBDIVISION_CONTACTS];
             scc_query_summary s;
-            if (!scc_query_triangle(sdf, &leaf, time, time, &p, ws->alloc, t, k, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s)) return 0;
+            if (!scc_query_triangle(sdf, &leaf, time, time, &p, ws, t, k, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s)) return 0;
             *io_evals += s.evals;
             if (!s.hit || s.contacts_found < 1) continue;
             double bary[3];

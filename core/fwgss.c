@@ -458,8 +458,9 @@ static void trace_vertices(scc_fw_state* s, int cap)
 typedef struct clear_region { double u[3], v[3], t, rad; int depth; } clear_region;
 
 /* Radius about its centroid of the sub-triangle with barycentric corners (u[i], v[i],
- * 1 - u[i] - v[i]) of the triangle x[0..2]. */
-static double region_radius(const scc_vec3 x[3], const double u[3], const double v[3], scc_vec3 c)
+ * 1 - u[i] - v[i]) of the triangle x[0..2]. Pointer parameters, not arrays of 3: with arrays, GCC 12's
+ * -Wstringop-overread misreads the size of s->r0 in a partly inlined caller (the TSan build). */
+static double region_radius(const scc_vec3* x, const double* u, const double* v, scc_vec3 c)
 {
     double rad = 0.0;
     for (int i = 0; i < 3; ++i) {

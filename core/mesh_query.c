@@ -233,7 +233,7 @@ static int precheck(mesh_ctx* c, const scc_tri_motion* m, double ta, double tb, 
     *lower = ta;
     scc_tri_hit h;
     const int64_t budget = tp->max_evals < SCC_PRECHECK_EVALS ? tp->max_evals : SCC_PRECHECK_EVALS;
-    if (!scc_certified_clear(c->in.sdf, m, ta, tb, tp, c->in.ws->alloc, budget, &h)) return -1;
+    if (!scc_certified_clear(c->in.sdf, m, ta, tb, tp, c->in.ws, budget, &h)) return -1;
     c->sum->evals += h.evals;
     tp->max_evals -= h.evals;
     if (!h.hit && h.state == SCC_NO_HIT) { /* the same answer as a search that found nothing on [ta, tb] */
@@ -299,7 +299,7 @@ static int test_triangle(mesh_ctx* c, uint32_t t, double ta, int rounds)
     }
     int deferred = 0;
     scc_tri_hit raw;
-    int ok = scc_query_triangle_deferred(c->in.sdf, &m, ta, tb, p, c->in.ws->alloc, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s,
+    int ok = scc_query_triangle_deferred(c->in.sdf, &m, ta, tb, p, c->in.ws, t, local, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s,
                                          c->defer ? &raw : NULL, &deferred);
     if (c->probe) c->probe(c->probe_user, t, 0);
     if (!ok) return 0;
@@ -339,7 +339,7 @@ static int finish_deferred(mesh_ctx* c)
         if (c->traces) scc_triangle_traces(c->traces, mm->mesh, d->triangle, c->in.ws->trace_epoch, m.trace);
         scc_query_summary s;
         if (c->probe) c->probe(c->probe_user, d->triangle, 1);
-        const int ok = scc_triangle_finish_deferred(c->in.sdf, &m, d->ta, scc_fmin(d->tb, limit), &tp, c->in.ws->alloc, d->triangle, d->raw, local,
+        const int ok = scc_triangle_finish_deferred(c->in.sdf, &m, d->ta, scc_fmin(d->tb, limit), &tp, c->in.ws, d->triangle, d->raw, local,
                                                     1 + SCC_MAX_SUBDIVISION_CONTACTS, &s);
         if (c->probe) c->probe(c->probe_user, d->triangle, 0);
         if (!ok) return 0;

@@ -53,14 +53,15 @@ struct scc_sdf {
 };
 
 /* A user's field (the public API's sdfccd_create_callback_sdf): the user's function, of the public
- * type sdfccd_SdfEvalFcn, and its pointer. eval is scc_sdf_user_eval (sdf_user.h), which calls the
+ * type sdfccd_SdfEvalFcn or sdfccd_SdfEvalXyzFcn (one of the two is set), and its pointer. eval is scc_sdf_user_eval (sdf_user.h), which calls the
  * function; the solvers call it directly for phi alone (fw_common.h), one call less per sample. The
  * function is kept as a generic function pointer (core does not include the public headers;
  * sdf_user.h converts it back to its type). */
 typedef void scc_generic_fn(void);
 typedef struct scc_sdf_user {
     scc_sdf base; /* first member; eval = scc_sdf_user_eval */
-    scc_generic_fn* fn;
+    scc_generic_fn* fn;     /* sdfccd_SdfEvalFcn, or NULL */
+    scc_generic_fn* fn_xyz; /* sdfccd_SdfEvalXyzFcn (the point as three coordinates), or NULL */
     void* user;
 } scc_sdf_user;
 

@@ -17,14 +17,14 @@ static void finish(const scc_sdf* sdf, const scc_tri_motion* m, const scc_params
                    int64_t evals, int64_t iterations, scc_contact* out, int capacity, scc_query_summary* sum);
 
 int scc_query_triangle(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                       const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
+                       scc_workspace* ws, uint32_t triangle_index, scc_contact* out, int capacity,
                        scc_query_summary* sum)
 {
-    return scc_query_triangle_deferred(sdf, m, ta, tb, p, alloc, triangle_index, out, capacity, sum, NULL, NULL);
+    return scc_query_triangle_deferred(sdf, m, ta, tb, p, ws, triangle_index, out, capacity, sum, NULL, NULL);
 }
 
 int scc_query_triangle_deferred(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                                const scc_allocator* alloc, uint32_t triangle_index, scc_contact* out, int capacity,
+                                scc_workspace* ws, uint32_t triangle_index, scc_contact* out, int capacity,
                                 scc_query_summary* sum, scc_tri_hit* raw, int* deferred)
 {
     scc_tri_hit h;
@@ -81,10 +81,10 @@ int scc_query_triangle_deferred(const scc_sdf* sdf, const scc_tri_motion* m, dou
                     sum->triangles_tested = 1;
                     return 1;
                 }
-                if (!scc_fwgss_verify(sdf, m, sa, sb, &sp, alloc, &seg)) return 0;
+                if (!scc_fwgss_verify(sdf, m, sa, sb, &sp, ws, &seg)) return 0;
             }
             else if (p->method == SCC_METHOD_FW) scc_fw(sdf, m, sa, sb, &sp, &seg);
-            else if (!scc_certified(sdf, m, sa, sb, &sp, alloc, &seg)) return 0;
+            else if (!scc_certified(sdf, m, sa, sb, &sp, ws, &seg)) return 0;
             evals += seg.evals;
             iterations += seg.iterations;
             if (seg.hit) {
@@ -112,7 +112,7 @@ int scc_query_triangle_deferred(const scc_sdf* sdf, const scc_tri_motion* m, dou
 }
 
 int scc_triangle_finish_deferred(const scc_sdf* sdf, const scc_tri_motion* m, double ta, double tb, const scc_params* p,
-                                 const scc_allocator* alloc, uint32_t triangle_index, scc_tri_hit raw, scc_contact* out,
+                                 scc_workspace* ws, uint32_t triangle_index, scc_tri_hit raw, scc_contact* out,
                                  int capacity, scc_query_summary* sum)
 {
     /* what scc_query_triangle does after its one segment's FWGSS: the check, then the answer */
@@ -124,7 +124,7 @@ int scc_triangle_finish_deferred(const scc_sdf* sdf, const scc_tri_motion* m, do
         raw.toi = raw.toi_lower = tb;
         force = 1;
     }
-    if (!scc_fwgss_check(sdf, m, ta, tb, p, alloc, force, &raw)) return 0;
+    if (!scc_fwgss_check(sdf, m, ta, tb, p, ws, force, &raw)) return 0;
     scc_tri_hit h = raw;
     if (!h.hit) {
         h.state = raw.state == SCC_NOT_CONVERGED ? SCC_NOT_CONVERGED : SCC_NO_HIT;

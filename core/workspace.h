@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT
  * sdfccd core: a reusable workspace for the mesh query (issue 9). The mesh query's scratch
  * storage (contact buffer, broad-phase heap, segment table, tested-triangle bits, refit nodes,
- * output staging) lives in slots that only grow, so a caller who keeps one workspace per thread
+ * output staging, the certified searches' region buffer and caches) lives in slots that only grow,
+ * so a caller who keeps one workspace per thread
  * allocates nothing after the first query of a given size. A query given no workspace uses a
  * temporary one and frees it at the end (the allocations of a one-off call). */
 #ifndef SCC_WORKSPACE_H
@@ -34,6 +35,8 @@ enum {
     SCC_WS_VERTEX_LIST, /* contact sets: the vertices of the touching triangles, sorted (contacts.c) */
     SCC_WS_DEFERRED,  /* mesh query: FWGSS answers whose check waits for the earliest contact (mesh_query.c) */
     SCC_WS_BELOW,     /* broad phase: the triangles a traversal marked, with the motions of those bounded below their leaves (bsh.c) */
+    SCC_WS_CHECK,     /* certified searches: the region store's first regions and the sample cache, one fixed size (certified.c) */
+    SCC_WS_CELLS,     /* certified searches on grids: the cell cache, one fixed size (certified.c) */
     SCC_WS_SLOTS
 };
 

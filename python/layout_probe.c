@@ -105,6 +105,7 @@ int main(void)
     OFF(sdfccd_CallbackSdfDef, lipschitz);
     OFF(sdfccd_CallbackSdfDef, bounds);
     OFF(sdfccd_CallbackSdfDef, smooth);
+    OFF(sdfccd_CallbackSdfDef, eval_xyz);
     OFF(sdfccd_CallbackSdfDef, internal_value);
     SIZE(sdfccd_SpikeGridDef);
     OFF(sdfccd_SpikeGridDef, spacing);

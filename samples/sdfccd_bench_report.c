@@ -491,17 +491,49 @@ static void section_cost(FILE* md, const char* dir, const table* t)
                 "torus, 3 %% more with the callback; Estrin's scheme alone: 3 %% less, but the shuriken 6551.7 -> 6551.9 "
                 "evaluations per query. Selects instead of branches in the secant and derivative searches' bracket updates "
                 "and witness (the same bits): 0.5 %%, inside the noise.\n\n");
+    const int forms = has_col(t, "callback");
+    if (forms)
+        fprintf(md, "The callback in its two forms: `eval` takes the point as an `sdfccd_Vec3`, which the x86-64 calling "
+                    "conventions pass through memory (24 bytes: stored by the caller and loaded by the callee, in the chain of "
+                    "every sample), and `eval_xyz` (`sdfccd_CallbackSdfDef::eval_xyz`) as three doubles, passed in registers; "
+                    "the same calls and answers bit for bit. Each row's columns are measured with its form; the built-in "
+                    "torus's column is the same for both rows.\n\n");
     const int latency = has_col(t, "ns_field_latency");
-    fprintf(md, "| mesh | SDF evals/query | ns per evaluation | field (ns) | motion + solver + dispatch (ns) | built-in torus (ns per evaluation) |%s\n"
-                "|---|---|---|---|---|---|%s\n",
-            latency ? " field latency (ns) | the rest after the field's latency (ns) |" : "", latency ? "---|---|" : "");
+    fprintf(md, "| mesh |%s SDF evals/query | ns per evaluation | field (ns) | motion + solver + dispatch (ns) | built-in torus (ns per evaluation) |%s\n"
+                "|---|%s---|---|---|---|---|%s\n",
+            forms ? " callback |" : "", latency ? " field latency (ns) | the rest after the field's latency (ns) |" : "",
+            forms ? "---|" : "", latency ? "---|---|" : "");
     for (int r = 0; r < t->rows; ++r) {
-        fprintf(md, "| %s | %.0f | %.1f | %.1f | %.1f | %.1f |", S(t, r, "mesh"), D(t, r, "evals_per_query"), D(t, r, "ns_per_evaluation"),
+        fprintf(md, "| %s |", S(t, r, "mesh"));
+        if (forms) fprintf(md, " `%s` |", S(t, r, "callback"));
+        fprintf(md, " %.0f | %.1f | %.1f | %.1f | %.1f |", D(t, r, "evals_per_query"), D(t, r, "ns_per_evaluation"),
                 D(t, r, "ns_field"), D(t, r, "ns_motion_solver_dispatch"), D(t, r, "ns_per_evaluation_builtin_torus"));
         if (latency) fprintf(md, " %.1f | %.1f |", D(t, r, "ns_field_latency"), D(t, r, "ns_rest_after_field_latency"));
         fprintf(md, "\n");
     }
     fprintf(md, "\nThe shuriken's cost per evaluation includes the broad phase's sphere marching and the per-triangle setup. CSV: `cost.csv`.\n\n");
+    table c;
+    if (!load(dir, "chain", &c)) return;
+    fprintf(md, "**The floor of a dependent sample** (`sdfccd_bench chain`, run with this section): loops whose every sample depends on "
+                "the one before's value, as a secant or conservative-advancement step's does, with nothing else in them, through the "
+                "same callback torus (`eval`). *field*: the next point is the last moved by 1e-12 x phi (the field's latency and the call; "
+                "*field eval_xyz*: the same through the callback's other form); "
+                "*spatial*: a point on a segment, phi and its gradient, the slope and a secant step on it; *temporal*: a point at a new "
+                "time on a rotating path (the solver's sine and cosine series, angle sum and Rodrigues' formula), phi and a secant "
+                "step in time; *temporal x2*: two such chains that do not depend on each other, a sample of each in turn. Fastest "
+                "of 15 passes of 10^6 samples, thread CPU time.\n\n| chain | ns per sample |\n|---|---|\n");
+    for (int r = 0; r < c.rows; ++r) fprintf(md, "| %s | %.1f |\n", S(&c, r, "chain"), D(&c, r, "ns_per_sample"));
+    fprintf(md, "\nA sample whose point waits for the value before it costs at least the *field* row through the public callback, with "
+                "no motion and no solver at all, and a temporal secant sample the *temporal* row; item 4's target, 25 ns of motion, "
+                "solver and dispatch plus the field's throughput, is about the *field* row alone. FWGSS's time per evaluation (the "
+                "table above) is close to these floors weighted by its samples: on the triangle about half are on spatial segments "
+                "at one time and 45 %% at new times (callgrind's calls of the callback by caller: 68,877 and 62,678 of 138,591; the "
+                "broad phase's 7,016). Two independent chains in flight cost about half as much per sample (*temporal x2*). "
+                "A single triangle's query has no second search to run beside the first (its descents share the shrinking interval "
+                "and start at the earliest witness, which is where their evaluations are saved), so the target needs queries "
+                "interleaved in one thread, which the data set's one-triangle queries, each its own call, do not allow. CSV: "
+                "`chain.csv`.\n\n");
+    unload(&c);
 }
 
 static void section_batch(FILE* md, const table* t)

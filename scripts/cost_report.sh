@@ -11,9 +11,9 @@ shift
 . "$(dirname "$0")/lib.sh"
 report_options cost_report.sh "--build --only" "$@"
 case "$only" in
-  "") exps="scaling cost"; ran="scaling --baseline and cost"; from="4"; to="6" ;;
+  "") exps="scaling cost chain"; ran="scaling --baseline, cost and chain"; from="4"; to="6" ;;
   scaling) exps="scaling"; ran="scaling --baseline"; from="4"; to="5" ;;
-  cost) exps="cost"; ran="cost"; from="5"; to="6" ;;
+  cost) exps="cost chain"; ran="cost and chain"; from="5"; to="6" ;;
   *) echo "cost_report.sh: --only takes scaling or cost (got $only)" >&2; exit 2 ;;
 esac
 bench="$build/samples/sdfccd_bench"

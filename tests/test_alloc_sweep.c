@@ -96,6 +96,7 @@ static sdfccd_Status queries(sdfccd_SdfId sdf, sdfccd_MeshId mesh, made* m)
     if (!m->ws) TRY(sdfccd_create_workspace(&m->ws));
     sdfccd_QueryParams p = sdfccd_default_query_params();
     TRY(sdfccd_query_mesh_ws(m->ws, sdf, NULL, mesh, &mo, 0, 1, &p, c, 16, &r));
+    TRY(sdfccd_query_triangle_ws(m->ws, sdf, NULL, tri, &mo, 0, 1, &p, c, 16, &r)); /* the check's scratch in the workspace */
     sdfccd_GuardParams gp = sdfccd_default_guard_params(); /* the guard (contact.h) */
     sdfccd_GuardResult gr;
     TRY(sdfccd_guard_rigid(m->ws, sdf, NULL, mesh, &mo, 0, 1, &gp, &gr));

@@ -333,7 +333,7 @@ static void run_case(test_rng* rng, const fields* fl, int kind, sweep_stats* st)
         scc_mesh_triangle_motion(&mm, t, &m);
         scc_query_summary s;
         scc_contact dummy[1 + SCC_MAX_SUBDIVISION_CONTACTS];
-        ck_assert(scc_query_triangle(sdf, &m, 0.0, DT, &pc, &k_alloc, t, dummy, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+        ck_assert(scc_query_triangle(sdf, &m, 0.0, DT, &pc, &ws, t, dummy, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
         if (s.state == SCC_NOT_CONVERGED) st->cert_nc++;
         cert[t] = s.hit ? s.toi : INFINITY;
         if (s.hit) {
@@ -425,7 +425,7 @@ skip_exact:
         scc_mesh_triangle_motion(&mm, t, &m);
         scc_query_summary s;
         scc_contact dummy[1 + SCC_MAX_SUBDIVISION_CONTACTS];
-        ck_assert(scc_query_triangle(sdf, &m, 0.0, DT, &pd, &k_alloc, t, dummy, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+        ck_assert(scc_query_triangle(sdf, &m, 0.0, DT, &pd, &ws, t, dummy, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
         if (s.hit && !isfinite(rec.tc[t])) st->dcd_culled++;
         alone[t] = dummy[0];
         if (!s.hit) alone[t].distance = NAN;
@@ -549,7 +549,7 @@ static double slide_candidate(double z, double* out_cert, int64_t* out_candidate
     scc_query_summary s;
     scc_contact c[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     scc_params pc = default_params(SCC_METHOD_CERTIFIED);
-    ck_assert(scc_query_triangle(&box.base, &m, 0.0, DT, &pc, &k_alloc, 0, c, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+    ck_assert(scc_query_triangle(&box.base, &m, 0.0, DT, &pc, &ws, 0, c, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
     *out_cert = s.hit ? s.toi : INFINITY;
     *out_candidates = bst.candidates;
     scc_ws_release(&ws);

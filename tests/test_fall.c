@@ -144,6 +144,8 @@ static scc_rigid spike_scene_body(void)
  * pairwise-only spatial step answered 0.0271158 (NOT_CONVERGED, 36 us late). */
 START_TEST(test_spike_apex_triangle)
 {
+    scc_workspace ws; /* the certified searches' scratch */
+    scc_ws_init(&ws, &k_alloc);
     scc_sdf_spike_grid spikes;
     scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
     scc_rigid body = spike_scene_body();
@@ -159,14 +161,15 @@ START_TEST(test_spike_apex_triangle)
     scc_contact out[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     scc_query_summary c, f;
     scc_params pc = params_of(SDFCCD_METHOD_CERTIFIED);
-    ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &k_alloc, 0, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &c));
+    ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &ws, 0, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &c));
     ck_assert(c.hit);
     scc_params pf = params_of(SDFCCD_METHOD_FWGSS);
-    ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 0, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &f));
+    ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pf, &ws, 0, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &f));
     printf("spike apex: certified [%.10f, %.10f]; FWGSS %.10f (state %d)\n", c.toi_lower, c.toi, f.toi, (int)f.state);
     ck_assert(f.hit);
     ck_assert_int_eq(f.state, SCC_HIT);
     ck_assert_msg(f.toi <= c.toi + 1e-6 && f.toi >= c.toi_lower - 1e-6, "FWGSS toi %.10f vs certified [%.10f, %.10f]", f.toi, c.toi_lower, c.toi);
+    scc_ws_release(&ws);
 }
 END_TEST
 
@@ -208,6 +211,8 @@ static const double k_step2[5][3][3] = {
  * bracket, and the query must spend fewer evaluations than the triangles' own checked queries. */
 START_TEST(test_deferred_checks)
 {
+    scc_workspace ws; /* the certified searches' scratch */
+    scc_ws_init(&ws, &k_alloc);
     const double (*v)[3][3] = k_step2;
     scc_vec3 vv[15];
     uint32_t f[15];
@@ -233,7 +238,7 @@ START_TEST(test_deferred_checks)
         scc_tri_motion m;
         scc_mesh_triangle_motion(&mm, t, &m);
         scc_query_summary s;
-        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pf, &ws, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
         own_evals += s.evals;
         if (s.hit) first = fmin(first, s.toi);
         later += s.hit && s.toi > c.toi + 1e-4; /* a contact well after the earliest */
@@ -247,6 +252,7 @@ START_TEST(test_deferred_checks)
     ck_assert_double_le(r.toi, first + 1e-9);
     ck_assert_int_lt(r.evals, own_evals);
     scc_bsh_destroy((scc_bsh*)mesh.bsh, &k_alloc);
+    scc_ws_release(&ws);
 }
 END_TEST
 
@@ -258,6 +264,8 @@ END_TEST
  * no descent and no check runs, and fewer than the triangles' own checked FWGSS queries. */
 START_TEST(test_precheck_clears)
 {
+    scc_workspace ws; /* the certified searches' scratch */
+    scc_ws_init(&ws, &k_alloc);
     static const double v[6][3][3] = {
         { { -0.1530245, 0.072401, -0.567027 }, { -0.1576415, 0.0642195, -0.567656 }, { -0.173972, 0.046571, -0.567053 } },
         { { -0.25639, 0.0745555, -0.569931 }, { -0.264921, 0.060383, -0.570608 }, { -0.2635205, 0.0675165, -0.5691865 } },
@@ -283,13 +291,13 @@ START_TEST(test_precheck_clears)
         scc_tri_motion m;
         scc_mesh_triangle_motion(&mm, t, &m);
         scc_query_summary s;
-        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &k_alloc, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &ws, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
         ck_assert_msg(!s.hit && s.state == SCC_NO_HIT, "triangle %u touches (certified)", t);
-        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pf, &ws, t, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s));
         ck_assert(!s.hit);
         own += s.evals;
         scc_tri_hit h;
-        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 24, &h));
+        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &ws, 24, &h));
         ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "triangle %u: no clear proof in 24 evaluations", t);
         proofs += h.evals;
     }
@@ -302,6 +310,7 @@ START_TEST(test_precheck_clears)
     ck_assert(r.toi_lower == mm.t1);
     ck_assert_int_eq(r.evals, proofs);
     ck_assert_int_lt(r.evals, own);
+    scc_ws_release(&ws);
 }
 END_TEST
 
@@ -313,6 +322,8 @@ END_TEST
  * certified search must agree (no contact), for the tip under each of the face's three corners' sides. */
 START_TEST(test_clear_over_tip)
 {
+    scc_workspace ws; /* the certified searches' scratch */
+    scc_ws_init(&ws, &k_alloc);
     scc_sdf_spike_grid spikes;
     scc_sdf_spike_grid_init(&spikes, 0.1, 0.05, 0.1, 20, 20);
     const scc_vec3 tip = scc_v3(0.05, 0.05, 0.1); /* the cone of cell (10, 10) */
@@ -333,16 +344,17 @@ START_TEST(test_clear_over_tip)
         }
         scc_params pf = params_of(SDFCCD_METHOD_FWGSS);
         scc_tri_hit h;
-        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &k_alloc, 1000000, &h));
+        ck_assert(scc_certified_clear(&spikes.base, &m, m.t0, m.t1, &pf, &ws, 1000000, &h));
         printf("clear over a tip (%d): %lld evaluations, state %d\n", k, (long long)h.evals, (int)h.state);
         ck_assert_msg(!h.hit && h.state == SCC_NO_HIT, "face %d: touches or unproven", k);
         ck_assert_int_le(h.evals, 24);
         scc_query_summary c;
         scc_contact out[1 + SCC_MAX_SUBDIVISION_CONTACTS];
         scc_params pc = params_of(SDFCCD_METHOD_CERTIFIED);
-        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &k_alloc, 0, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &c));
+        ck_assert(scc_query_triangle(&spikes.base, &m, m.t0, m.t1, &pc, &ws, 0, out, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &c));
         ck_assert(!c.hit && c.state == SCC_NO_HIT);
     }
+    scc_ws_release(&ws);
 }
 END_TEST
 

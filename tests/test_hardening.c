@@ -93,11 +93,19 @@ static double counted_sphere(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
     return l - 1.0;
 }
 
-/* A user field declared smooth, with the given function, user pointer and bounds. */
-static sdfccd_SdfId smooth_callback(sdfccd_SdfEvalFcn* eval, void* user, sdfccd_Aabb bounds)
+/* The same with the point as three coordinates (sdfccd_CallbackSdfDef::eval_xyz). */
+static double counted_sphere_xyz(double x, double y, double z, sdfccd_Vec3* g, void* user)
+{
+    return counted_sphere((sdfccd_Vec3){ x, y, z }, g, user);
+}
+
+/* A user field declared smooth with the given bounds: the point as an sdfccd_Vec3 (eval) when eval is
+ * set, else as three coordinates (eval_xyz). */
+static sdfccd_SdfId smooth_callback(sdfccd_SdfEvalFcn* eval, sdfccd_SdfEvalXyzFcn* eval_xyz, void* user, sdfccd_Aabb bounds)
 {
     sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
-    d.eval = eval;
+    if (eval) d.eval = eval;
+    else d.eval_xyz = eval_xyz;
     d.user = user;
     d.bounds = bounds;
     d.smooth = 1;
@@ -109,7 +117,8 @@ static sdfccd_SdfId smooth_callback(sdfccd_SdfEvalFcn* eval, void* user, sdfccd_
 START_TEST(test_field_calls_are_counted)
 {
     int64_t calls = 0;
-    const sdfccd_SdfId s = smooth_callback(counted_sphere, &calls, (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } });
+    /* _i: 0 the point as an sdfccd_Vec3 (eval), 1 as three coordinates (eval_xyz) */
+    const sdfccd_SdfId s = smooth_callback(_i == 0 ? counted_sphere : NULL, counted_sphere_xyz, &calls, (sdfccd_Aabb){ { -1, -1, -1 }, { 1, 1, 1 } });
     /* z = 1.0005 slides 0.5 mm over the top (the traces' steps shrink there); z = 0.5 hits */
     const double heights[2] = { 1.0005, 0.5 };
     for (int k = 0; k < 2; ++k) {
@@ -141,13 +150,18 @@ START_TEST(test_field_calls_are_counted)
 END_TEST
 
 /* A user's gradient with an infinite or NaN coordinate is never handed on: the solvers and the
- * contacts get (0, 0, 1) in its place (scc_sdf_user_value), whichever coordinate is bad. The field is
- * the half-space z <= 0, whose true gradient is that fallback, so the query still hits at the time
- * the plane is reached. */
+ * contacts get (0, 0, 1) in its place (scc_sdf_user_value), whichever coordinate is bad, in either form
+ * of the function (_i: 0 eval, 1 eval_xyz). The field is the half-space z <= 0, whose true gradient is
+ * that fallback, so the query still hits at the time the plane is reached. */
 static double bad_gradient_plane(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 {
     if (g) *g = *(const sdfccd_Vec3*)user;
     return p.z;
+}
+
+static double bad_gradient_plane_xyz(double x, double y, double z, sdfccd_Vec3* g, void* user)
+{
+    return bad_gradient_plane((sdfccd_Vec3){ x, y, z }, g, user);
 }
 
 START_TEST(test_user_gradient_not_finite)
@@ -155,7 +169,8 @@ START_TEST(test_user_gradient_not_finite)
     const sdfccd_Vec3 bad[4] = { { INFINITY, 0, 1 }, { 0, NAN, 1 }, { 0, 0, -INFINITY }, { NAN, NAN, NAN } };
     for (int k = 0; k < 4; ++k) {
         sdfccd_Vec3 grad = bad[k];
-        const sdfccd_SdfId s = smooth_callback(bad_gradient_plane, &grad, (sdfccd_Aabb){ { -10, -10, -10 }, { 10, 10, 0 } });
+        const sdfccd_SdfId s = smooth_callback(_i == 0 ? bad_gradient_plane : NULL, bad_gradient_plane_xyz, &grad,
+                                               (sdfccd_Aabb){ { -10, -10, -10 }, { 10, 10, 0 } });
         const sdfccd_Vec3 tri[3] = { { 0, 0, 1 }, { 0.5, 0, 1 }, { 0, 0.5, 1 } };
         sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
         m.linear_velocity.z = -4.0; /* reaches the plane at t = 0.25 */
@@ -841,8 +856,8 @@ int main(void)
     test_add_memory_fixture(tc);
     tcase_add_test(tc, test_huge_spin_rejected);
     tcase_add_test(tc, test_budget_shared_by_segments);
-    tcase_add_test(tc, test_field_calls_are_counted);
-    tcase_add_test(tc, test_user_gradient_not_finite);
+    tcase_add_loop_test(tc, test_field_calls_are_counted, 0, 2);
+    tcase_add_loop_test(tc, test_user_gradient_not_finite, 0, 2);
     tcase_add_test(tc, test_budget_shared_by_triangles);
     tcase_add_test(tc, test_overflowing_query_inputs_rejected);
     tcase_add_test(tc, test_query_argument_names);

@@ -353,6 +353,89 @@ START_TEST(test_callback_smooth)
 }
 END_TEST
 
+/* The built-in field behind `user` with the point as three coordinates (sdfccd_CallbackSdfDef::eval_xyz). */
+static double wrapped_builtin_xyz(double x, double y, double z, sdfccd_Vec3* g, void* user)
+{
+    return wrapped_builtin((sdfccd_Vec3){ x, y, z }, g, user);
+}
+
+/* A callback given as eval_xyz is the same field as the one given as eval: the same values and
+ * gradients (sdfccd_sdf_eval, sdfccd_sdf_eval_batch) and FWGSS's answers, evaluation counts and
+ * contacts bit for bit, declared smooth or not; exactly one of the two forms must be set. */
+START_TEST(test_callback_xyz)
+{
+    sdfccd_SdfId box, cb[2][2]; /* [form][smooth] */
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.1, 0.06, 0.03 }, &box), SDFCCD_OK);
+    for (int form = 0; form < 2; ++form)
+        for (int k = 0; k < 2; ++k) {
+            sdfccd_CallbackSdfDef def = sdfccd_default_callback_sdf_def();
+            ck_assert(def.eval_xyz == NULL);
+            if (form == 0) def.eval = wrapped_builtin;
+            else def.eval_xyz = wrapped_builtin_xyz;
+            def.user = &box;
+            def.smooth = k;
+            ck_assert_int_eq(sdfccd_create_callback_sdf(&def, &cb[form][k]), SDFCCD_OK);
+        }
+    sdfccd_CallbackSdfDef bad = sdfccd_default_callback_sdf_def();
+    sdfccd_SdfId none = { 0, 0 };
+    ck_assert_int_eq(sdfccd_create_callback_sdf(&bad, &none), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "eval_xyz"));
+    bad.eval = wrapped_builtin;
+    bad.eval_xyz = wrapped_builtin_xyz;
+    bad.user = &box;
+    ck_assert_int_eq(sdfccd_create_callback_sdf(&bad, &none), SDFCCD_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(sdfccd_last_error(), "both"));
+    ck_assert_int_eq(none.index1, 0);
+
+    test_rng rng = { 77 };
+    sdfccd_Vec3 pts[64];
+    for (int i = 0; i < 64; ++i) {
+        const sdfccd_Vec3 u = test_rng_unit_vector(&rng);
+        const double r = test_rng_uniform(&rng, 0.0, 0.2);
+        pts[i] = (sdfccd_Vec3){ r * u.x, r * u.y, r * u.z };
+    }
+    double v[2][64];
+    sdfccd_Vec3 g[2][64];
+    for (int form = 0; form < 2; ++form) ck_assert_int_eq(sdfccd_sdf_eval_batch(cb[form][0], pts, 64, v[form], g[form]), SDFCCD_OK);
+    ck_assert(memcmp(v[0], v[1], sizeof v[0]) == 0 && memcmp(g[0], g[1], sizeof g[0]) == 0);
+    for (int i = 0; i < 64; ++i) {
+        double w;
+        sdfccd_Vec3 gw;
+        ck_assert_int_eq(sdfccd_sdf_eval(cb[1][1], pts[i], &w, &gw), SDFCCD_OK);
+        ck_assert(w == v[0][i] && memcmp(&gw, &g[0][i], sizeof gw) == 0);
+    }
+
+    const sdfccd_Vec3 tri[3] = { { -0.05, -0.03, 0 }, { 0.05, -0.03, 0 }, { 0, 0.06, 0 } };
+    const sdfccd_QueryParams p = sdfccd_default_query_params();
+    int hits = 0;
+    for (int i = 0; i < 16; ++i) {
+        /* from 20-30 cm out towards the box, arriving in about half a step, spinning */
+        sdfccd_RigidMotion m = sdfccd_default_rigid_motion();
+        const sdfccd_Vec3 dir = test_rng_unit_vector(&rng), aim = test_rng_unit_vector(&rng), w = test_rng_unit_vector(&rng);
+        const double dist = test_rng_uniform(&rng, 0.2, 0.3), speed = dist / (test_rng_uniform(&rng, 0.6, 1.2) / 60.0);
+        const sdfccd_Vec3 target = { 0.06 * aim.x, 0.06 * aim.y, 0.04 * aim.z };
+        m.pose.position = (sdfccd_Vec3){ target.x + dist * dir.x, target.y + dist * dir.y, target.z + dist * dir.z };
+        m.linear_velocity = (sdfccd_Vec3){ -speed * dir.x, -speed * dir.y, -speed * dir.z };
+        const double wl = test_rng_uniform(&rng, 0.0, 100.0);
+        m.angular_velocity = (sdfccd_Vec3){ wl * w.x, wl * w.y, wl * w.z };
+        for (int k = 0; k < 2; ++k) {
+            sdfccd_QueryResult r[2];
+            sdfccd_Contact c[2][8];
+            memset(c, 0, sizeof c);
+            for (int form = 0; form < 2; ++form)
+                ck_assert_int_eq(sdfccd_query_triangle(cb[form][k], NULL, tri, &m, 0.0, 1.0 / 60.0, &p, c[form], 8, &r[form]), SDFCCD_OK);
+            ck_assert(memcmp(&r[0], &r[1], sizeof r[0]) == 0);
+            ck_assert(memcmp(c[0], c[1], sizeof c[0]) == 0);
+            hits += r[0].hit;
+        }
+    }
+    ck_assert_msg(hits >= 8, "only %d of 32 queries hit the box", hits);
+    for (int form = 0; form < 2; ++form)
+        for (int k = 0; k < 2; ++k) sdfccd_destroy_sdf(cb[form][k]);
+    sdfccd_destroy_sdf(box);
+}
+END_TEST
+
 /* The plane z = 0 as a user's field: its gradient (0, 0, 1), or not finite where asked for. */
 static double plane_field(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
 {
@@ -437,6 +520,7 @@ int main(void)
     tcase_add_test(tc, test_csg_and_transform);
     tcase_add_test(tc, test_callback);
     tcase_add_test(tc, test_callback_smooth);
+    tcase_add_test(tc, test_callback_xyz);
     tcase_add_test(tc, test_callback_nonfinite_gradient);
     tcase_add_test(tc, test_bad_parameters);
     tcase_add_test(tc, test_eval_batch_matches_eval);

@@ -126,3 +126,20 @@ void test_counting_free(void* mem, size_t size, void* user)
     (void)user;
     free(mem);
 }
+
+sdfccd_SdfId test_carved_box_grid(void)
+{
+    sdfccd_SdfId box, ball, carved, grid;
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.1, 0.1, 0.1 }, &box), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_sphere(0.12, &ball), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_create_csg(SDFCCD_CSG_DIFFERENCE, box, ball, &carved), SDFCCD_OK);
+    sdfccd_GridDef def = sdfccd_default_grid_def();
+    def.resolution[0] = def.resolution[1] = def.resolution[2] = 16;
+    def.padding = 0.05;
+    def.threads = 1;
+    ck_assert_int_eq(sdfccd_create_grid_from_sdf(carved, &def, &grid), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(carved), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(ball), SDFCCD_OK);
+    ck_assert_int_eq(sdfccd_destroy_sdf(box), SDFCCD_OK);
+    return grid;
+}

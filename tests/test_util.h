@@ -32,6 +32,11 @@ double test_box_distance(sdfccd_Vec3 p, double h);
  * (two triangles a cell, outward winding); fails the test when it cannot be created. */
 sdfccd_MeshId test_box_mesh(sdfccd_Vec3 half, int nx, int ny, int nz);
 
+/* A 16^3 grid (5 cm padding, one build thread) of the cube [-0.1, 0.1]^3 less the ball of radius 0.12
+ * about its centre: eight corner pieces with concave creases, a field FWGSS's answers are checked on;
+ * fails the test when it cannot be created. */
+sdfccd_SdfId test_carved_box_grid(void);
+
 /* An allocator for sdfccd_set_allocator that counts its allocations in the long `user` points to. */
 void* test_counting_alloc(size_t size, void* user);
 void test_counting_free(void* mem, size_t size, void* user);

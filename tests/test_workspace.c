@@ -2,7 +2,8 @@
  * Issue 9: no allocation per mesh query. Through a caller-kept workspace (sdfccd_query_mesh_ws,
  * sdfccd_query_mesh_linear_ws) a mesh query allocates nothing after the first one of its size,
  * counted with a counting allocator installed through sdfccd_set_allocator; results are the same
- * as without the workspace. Public ABI only. */
+ * as without the workspace. Also on fields with kinks, where the certified check's scratch is the
+ * workspace's, and triangle queries through one (sdfccd_query_triangle_ws). Public ABI only. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -163,11 +164,82 @@ START_TEST(test_no_allocation_after_first_query)
 }
 END_TEST
 
+/* The same on fields with kinks, where FWGSS's answers are checked by the certified search, whose
+ * scratch (the region store's first regions, the sample cache, a grid's cell cache) the workspace
+ * holds: a box and a grid of a box minus a ball. The check runs (the evaluations differ from
+ * fwgss_verify 0) and the workspace holds its scratch (it is larger than one that never checked). */
+START_TEST(test_no_allocation_kinked)
+{
+    counter cnt = { 0, 0, 0 };
+    ck_assert_int_eq(sdfccd_set_allocator(count_alloc, count_free, &cnt), SDFCCD_OK);
+    sdfccd_SdfId box;
+    ck_assert_int_eq(sdfccd_create_box((sdfccd_Vec3){ 0.1, 0.08, 0.06 }, &box), SDFCCD_OK);
+    const sdfccd_SdfId grid = test_carved_box_grid();
+    sdfccd_MeshId mesh = uv_sphere(0.03, 6, 8);
+    const sdfccd_SdfId fields[2] = { box, grid };
+    const char* names[2] = { "box", "grid" };
+    for (int k = 0; k < 2; ++k) {
+        sdfccd_Workspace *ws, *ws_off;
+        ck_assert_int_eq(sdfccd_create_workspace(&ws), SDFCCD_OK);
+        ck_assert_int_eq(sdfccd_create_workspace(&ws_off), SDFCCD_OK);
+        sdfccd_QueryParams p = sdfccd_default_query_params(), p_off = p;
+        p_off.fwgss_verify = 0;
+        sdfccd_Contact ca[64], cb[64];
+        sdfccd_QueryResult ra, rb;
+        test_rng rng = { 5 };
+        sdfccd_RigidMotion mo[24];
+        for (int i = 0; i < 24; ++i) mo[i] = motion_of(&rng);
+        for (int i = 0; i < 24; ++i) {
+            ck_assert_int_eq(sdfccd_query_mesh_ws(ws, fields[k], NULL, mesh, &mo[i], 0.0, 1.0 / 60.0, &p, ca, 64, &ra), SDFCCD_OK);
+            ck_assert_int_eq(sdfccd_query_mesh_ws(ws_off, fields[k], NULL, mesh, &mo[i], 0.0, 1.0 / 60.0, &p_off, cb, 64, &rb), SDFCCD_OK);
+        }
+        int checked = 0, hits = 0;
+        for (int i = 0; i < 24; ++i) {
+            ck_assert_int_eq(sdfccd_query_mesh(fields[k], NULL, mesh, &mo[i], 0.0, 1.0 / 60.0, &p, cb, 64, &rb), SDFCCD_OK);
+            long before = cnt.allocs;
+            ck_assert_int_eq(sdfccd_query_mesh_ws(ws, fields[k], NULL, mesh, &mo[i], 0.0, 1.0 / 60.0, &p, ca, 64, &ra), SDFCCD_OK);
+            ck_assert_msg(cnt.allocs == before, "%s: query %d through the workspace allocated %ld times", names[k], i, cnt.allocs - before);
+            same_result(&ra, ca, &rb, cb);
+            ck_assert_int_eq(sdfccd_query_mesh_ws(ws_off, fields[k], NULL, mesh, &mo[i], 0.0, 1.0 / 60.0, &p_off, cb, 64, &rb), SDFCCD_OK);
+            checked += ra.sdf_evaluations != rb.sdf_evaluations;
+            hits += ra.hit;
+        }
+        /* triangle queries through the workspace (sdfccd_query_triangle_ws): the same answers as
+         * without it, and no allocation */
+        const sdfccd_Vec3 tri[3] = { { 0.03, 0, 0 }, { -0.02, 0.03, 0 }, { -0.02, -0.03, 0 } };
+        for (int i = 0; i < 24; ++i) {
+            ck_assert_int_eq(sdfccd_query_triangle(fields[k], NULL, tri, &mo[i], 0.0, 1.0 / 60.0, &p, cb, 64, &rb), SDFCCD_OK);
+            long before = cnt.allocs;
+            ck_assert_int_eq(sdfccd_query_triangle_ws(ws, fields[k], NULL, tri, &mo[i], 0.0, 1.0 / 60.0, &p, ca, 64, &ra), SDFCCD_OK);
+            ck_assert_msg(cnt.allocs == before, "%s: triangle query %d through the workspace allocated %ld times", names[k], i,
+                          cnt.allocs - before);
+            same_result(&ra, ca, &rb, cb);
+        }
+        ck_assert_int_eq(sdfccd_query_triangle_ws(NULL, fields[k], NULL, tri, &mo[0], 0.0, 1.0 / 60.0, &p, ca, 64, &ra), SDFCCD_INVALID_ARGUMENT);
+        const int64_t bytes = sdfccd_workspace_bytes(ws), bytes_off = sdfccd_workspace_bytes(ws_off);
+        printf("workspace, %s: %d of 24 queries hit, the check ran in %d; workspace %lld bytes (%lld without the check)\n", names[k], hits,
+               checked, (long long)bytes, (long long)bytes_off);
+        ck_assert_int_gt(hits, 0);
+        ck_assert_int_gt(checked, 0);
+        ck_assert_int_ge(bytes - bytes_off, 64 * 1024);
+        sdfccd_destroy_workspace(ws);
+        sdfccd_destroy_workspace(ws_off);
+    }
+    sdfccd_destroy_mesh(mesh);
+    sdfccd_destroy_sdf(grid);
+    sdfccd_destroy_sdf(box);
+    ck_assert_int_eq(sdfccd_byte_count(), 0);
+    ck_assert_int_eq(cnt.allocs, cnt.frees);
+    ck_assert_int_eq(sdfccd_set_allocator(NULL, NULL, NULL), SDFCCD_OK);
+}
+END_TEST
+
 int main(void)
 {
     Suite* s = suite_create("workspace");
     TCase* tc = tcase_create("allocation");
     tcase_add_test(tc, test_no_allocation_after_first_query);
+    tcase_add_test(tc, test_no_allocation_kinked);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -1,25 +1,29 @@
 /* SPDX-License-Identifier: MIT
  * sdfccd C ABI: sdfccd_query_batch, many independent triangle or mesh queries on a caller-chosen
  * number of threads (issue 9), through the thread loop in threads.c. Mesh queries go through one
- * workspace per thread, so a batch allocates only per thread, not per query. Every query is computed
+ * workspace per thread, so a batch allocates only per thread, not per query; so do triangle queries' certified searches (their scratch). Every query is computed
  * exactly as by itself (the solvers are deterministic and the workspace does not change results), so
  * the results do not depend on the thread count or on the order in which threads take queries. */
 #include "capi_internal.h"
 
 typedef struct batch {
     sdfccd_BatchQuery* q;
-    sdfccd_Workspace* ws[SDFCCD__MAX_THREADS]; /* one per thread slot; NULL: each mesh query allocates its own */
+    sdfccd_Workspace* ws[SDFCCD__MAX_THREADS]; /* one per thread slot; NULL: each query allocates its own */
 } batch;
 
 static sdfccd_Status run_one(sdfccd_BatchQuery* b, sdfccd_Workspace* ws)
 {
     switch (b->kind) {
     case SDFCCD_BATCH_TRIANGLE:
-        return sdfccd_query_triangle(b->sdf, b->sdf_motion, b->triangle, b->motion, b->t0, b->t1, b->params, b->out_contacts,
-                                     b->capacity, b->out_result);
+        return ws ? sdfccd_query_triangle_ws(ws, b->sdf, b->sdf_motion, b->triangle, b->motion, b->t0, b->t1, b->params, b->out_contacts,
+                                             b->capacity, b->out_result)
+                  : sdfccd_query_triangle(b->sdf, b->sdf_motion, b->triangle, b->motion, b->t0, b->t1, b->params, b->out_contacts, b->capacity,
+                                          b->out_result);
     case SDFCCD_BATCH_TRIANGLE_LINEAR:
-        return sdfccd_query_triangle_linear(b->sdf, b->sdf_motion, b->triangle, b->triangle_end, b->t0, b->t1, b->params,
-                                            b->out_contacts, b->capacity, b->out_result);
+        return ws ? sdfccd_query_triangle_linear_ws(ws, b->sdf, b->sdf_motion, b->triangle, b->triangle_end, b->t0, b->t1, b->params,
+                                                    b->out_contacts, b->capacity, b->out_result)
+                  : sdfccd_query_triangle_linear(b->sdf, b->sdf_motion, b->triangle, b->triangle_end, b->t0, b->t1, b->params,
+                                                 b->out_contacts, b->capacity, b->out_result);
     case SDFCCD_BATCH_MESH:
         return ws ? sdfccd_query_mesh_ws(ws, b->sdf, b->sdf_motion, b->mesh, b->motion, b->t0, b->t1, b->params, b->out_contacts,
                                          b->capacity, b->out_result)

@@ -246,18 +246,23 @@ static void write_result(const query_setup* q, double t0, double t1, const scc_q
     }
 }
 
-static sdfccd_Status run_triangle(const query_setup* q, const scc_tri_motion* m, double t0, double t1,
+/* The triangle query with the certified searches' scratch in `workspace`, or in a temporary
+ * workspace freed before returning (NULL). */
+static sdfccd_Status run_triangle(const query_setup* q, const scc_tri_motion* m, double t0, double t1, sdfccd_Workspace* workspace,
                                   sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result, const char* fn)
 {
     scc_contact c[1 + SCC_MAX_SUBDIVISION_CONTACTS];
     scc_query_summary s;
-    if (!scc_query_triangle(q->sdf->sdf, m, t0, t1, &q->p, sdfccd__allocator(), 0, c, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s))
-        return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory in the certified search", fn);
+    scc_workspace tmp;
+    scc_ws_init(&tmp, sdfccd__allocator());
+    const int ok = scc_query_triangle(q->sdf->sdf, m, t0, t1, &q->p, workspace ? &workspace->ws : &tmp, 0, c, 1 + SCC_MAX_SUBDIVISION_CONTACTS, &s);
+    scc_ws_release(&tmp);
+    if (!ok) return sdfccd__error(SDFCCD_OUT_OF_MEMORY, "%s: out of memory in the certified search", fn);
     write_result(q, t0, t1, &s, c, out_contacts, capacity, out_result);
     return SDFCCD_OK;
 }
 
-static sdfccd_Status query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3],
+static sdfccd_Status query_triangle(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3],
                                     const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
                                     sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
@@ -282,10 +287,10 @@ static sdfccd_Status query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* 
     m.sdf = q.sdf_motion_ptr;
     m.t0 = t0;
     m.t1 = t1;
-    return run_triangle(&q, &m, t0, t1, out_contacts, capacity, out_result, fn);
+    return run_triangle(&q, &m, t0, t1, workspace, out_contacts, capacity, out_result, fn);
 }
 
-static sdfccd_Status query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3],
+static sdfccd_Status query_triangle_linear(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3],
                                            const sdfccd_Vec3 end[3], double t0, double t1, const sdfccd_QueryParams* params,
                                            sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
@@ -309,21 +314,41 @@ static sdfccd_Status query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidM
     m.sdf = q.sdf_motion_ptr;
     m.t0 = t0;
     m.t1 = t1;
-    return run_triangle(&q, &m, t0, t1, out_contacts, capacity, out_result, fn);
+    return run_triangle(&q, &m, t0, t1, workspace, out_contacts, capacity, out_result, fn);
 }
 
 sdfccd_Status sdfccd_query_triangle(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3],
                                     const sdfccd_RigidMotion* motion, double t0, double t1, const sdfccd_QueryParams* params,
                                     sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
-    SDFCCD__HELD_CALL(query_triangle(sdf, sdf_motion, triangle, motion, t0, t1, params, out_contacts, capacity, out_result));
+    SDFCCD__HELD_CALL(query_triangle(NULL, sdf, sdf_motion, triangle, motion, t0, t1, params, out_contacts, capacity, out_result));
+}
+
+sdfccd_Status sdfccd_query_triangle_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                       const sdfccd_Vec3 triangle[3], const sdfccd_RigidMotion* motion, double t0, double t1,
+                                       const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+                                       sdfccd_QueryResult* out_result)
+{
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_triangle_ws: workspace"))) return st;
+    SDFCCD__HELD_CALL(query_triangle(workspace, sdf, sdf_motion, triangle, motion, t0, t1, params, out_contacts, capacity, out_result));
 }
 
 sdfccd_Status sdfccd_query_triangle_linear(sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3],
                                            const sdfccd_Vec3 end[3], double t0, double t1, const sdfccd_QueryParams* params,
                                            sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result)
 {
-    SDFCCD__HELD_CALL(query_triangle_linear(sdf, sdf_motion, start, end, t0, t1, params, out_contacts, capacity, out_result));
+    SDFCCD__HELD_CALL(query_triangle_linear(NULL, sdf, sdf_motion, start, end, t0, t1, params, out_contacts, capacity, out_result));
+}
+
+sdfccd_Status sdfccd_query_triangle_linear_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf, const sdfccd_RigidMotion* sdf_motion,
+                                              const sdfccd_Vec3 start[3], const sdfccd_Vec3 end[3], double t0, double t1,
+                                              const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+                                              sdfccd_QueryResult* out_result)
+{
+    sdfccd_Status st;
+    if ((st = sdfccd__check_ptr(workspace, "sdfccd_query_triangle_linear_ws: workspace"))) return st;
+    SDFCCD__HELD_CALL(query_triangle_linear(workspace, sdf, sdf_motion, start, end, t0, t1, params, out_contacts, capacity, out_result));
 }
 
 sdfccd_Status sdfccd_create_workspace(sdfccd_Workspace** out_workspace)

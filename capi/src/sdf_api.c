@@ -205,7 +205,10 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
 {
     sdfccd_Status st;
     if ((st = SDFCCD__CHECK_DEF_ARGS("sdfccd_create_callback_sdf", def, out_sdf, "out_sdf", "sdfccd_default_callback_sdf_def"))) return st;
-    if (!def->eval) return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def->eval is NULL");
+    if (!def->eval && !def->eval_xyz)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def->eval and def->eval_xyz are NULL (set one)");
+    if (def->eval && def->eval_xyz)
+        return sdfccd__error(SDFCCD_INVALID_ARGUMENT, "sdfccd_create_callback_sdf: def->eval and def->eval_xyz are both set (set one)");
     if ((st = positive(def->lipschitz, "sdfccd_create_callback_sdf: lipschitz"))) return st;
     if (isnan(def->bounds.lo.x) || isnan(def->bounds.lo.y) || isnan(def->bounds.lo.z) || isnan(def->bounds.hi.x) ||
         isnan(def->bounds.hi.y) || isnan(def->bounds.hi.z))
@@ -226,6 +229,7 @@ sdfccd_Status sdfccd_create_callback_sdf(const sdfccd_CallbackSdfDef* def, sdfcc
     c->base.smooth = def->smooth;
     c->base.kind = SCC_SDF_CALLBACK;
     c->fn = (scc_generic_fn*)def->eval;
+    c->fn_xyz = (scc_generic_fn*)def->eval_xyz;
     c->user = def->user;
     return sdfccd__sdf_register(s, out_sdf);
 }

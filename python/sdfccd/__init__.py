@@ -662,35 +662,43 @@ def _capacity(max_contacts):
     return n
 
 
-def _run_query(fn, sdf, args, t0, t1, p, max_contacts, sdf_motion):
+def _run_query(name, sdf, args, t0, t1, p, max_contacts, sdf_motion, workspace):
+    """Calls sdfccd_<name>, or sdfccd_<name>_ws with the workspace's scratch when one is given."""
     sm = _motion_arg(sdf_motion, "sdf_motion", True)
     cap = _capacity(max_contacts)
     contacts = np.zeros(cap, dtype=CONTACT_DTYPE)
     res = _lib.QueryResult()
-    st = fn(_sdf_arg(sdf, "sdf"), C.byref(sm) if sm is not None else None, *args, _scalar(t0, "t0"),
-            _scalar(t1, "t1"), C.byref(p), contacts.ctypes.data if cap else None, cap, C.byref(res))
+    rest = (_sdf_arg(sdf, "sdf"), C.byref(sm) if sm is not None else None, *args, _scalar(t0, "t0"), _scalar(t1, "t1"),
+            C.byref(p), contacts.ctypes.data if cap else None, cap, C.byref(res))
+    if workspace is None:
+        st = getattr(_L, "sdfccd_" + name)(*rest)
+    else:
+        _need_contacts()
+        st = _with_workspace(workspace, lambda ws: getattr(_L, "sdfccd_" + name + "_ws")(ws, *rest))
     _raise_callback_errors(sdf)
     _check(st)
     return QueryResult(res, contacts)
 
 
 def query_triangle(sdf, triangle, motion=None, t0=0.0, t1=1.0 / 60.0, params=None, method="fwgss", sdf_motion=None,
-                   max_contacts=16):
+                   max_contacts=16, workspace=None):
     """First time of impact of one triangle (3, 3) (local frame) under a rigid Motion against `sdf`
-    (static at the origin, or moving with `sdf_motion`)."""
+    (static at the origin, or moving with `sdf_motion`). With a Workspace, its scratch is reused: after
+    the first query nothing is allocated (sdfccd_query_triangle_ws)."""
     tri = _float_array(triangle, "triangle", (3, 3))
     m = _motion_arg(motion, "motion", False)
-    return _run_query(_L.sdfccd_query_triangle, sdf, (tri.ctypes.data, C.byref(m)), t0, t1, _params_arg(params, method),
-                      max_contacts, sdf_motion)
+    return _run_query("query_triangle", sdf, (tri.ctypes.data, C.byref(m)), t0, t1, _params_arg(params, method),
+                      max_contacts, sdf_motion, workspace)
 
 
 def query_triangle_linear(sdf, start, end, t0=0.0, t1=1.0 / 60.0, params=None, method="fwgss", sdf_motion=None,
-                          max_contacts=16):
-    """One triangle whose world vertices move linearly from `start` (3, 3) at t0 to `end` at t1."""
+                          max_contacts=16, workspace=None):
+    """One triangle whose world vertices move linearly from `start` (3, 3) at t0 to `end` at t1 (`workspace`:
+    as query_triangle)."""
     a = _float_array(start, "start", (3, 3))
     b = _float_array(end, "end", (3, 3))
-    return _run_query(_L.sdfccd_query_triangle_linear, sdf, (a.ctypes.data, b.ctypes.data), t0, t1,
-                      _params_arg(params, method), max_contacts, sdf_motion)
+    return _run_query("query_triangle_linear", sdf, (a.ctypes.data, b.ctypes.data), t0, t1,
+                      _params_arg(params, method), max_contacts, sdf_motion, workspace)
 
 
 def _mesh_arg(m, name="mesh"):
@@ -700,22 +708,24 @@ def _mesh_arg(m, name="mesh"):
 
 
 def query_mesh(sdf, mesh, motion=None, t0=0.0, t1=1.0 / 60.0, params=None, method="fwgss", sdf_motion=None,
-               max_contacts=64):
-    """A rigid mesh: the earliest time of impact over its triangles and the contacts at it."""
+               max_contacts=64, workspace=None):
+    """A rigid mesh: the earliest time of impact over its triangles and the contacts at it (`workspace`: as
+    query_triangle)."""
     m = _motion_arg(motion, "motion", False)
-    return _run_query(_L.sdfccd_query_mesh, sdf, (_mesh_arg(mesh), C.byref(m)), t0, t1, _params_arg(params, method),
-                      max_contacts, sdf_motion)
+    return _run_query("query_mesh", sdf, (_mesh_arg(mesh), C.byref(m)), t0, t1, _params_arg(params, method),
+                      max_contacts, sdf_motion, workspace)
 
 
 def query_mesh_linear(sdf, mesh, start, end, t0=0.0, t1=1.0 / 60.0, params=None, method="fwgss", sdf_motion=None,
-                      max_contacts=64):
-    """A deforming mesh: its world vertices (V, 3) move linearly from `start` at t0 to `end` at t1."""
+                      max_contacts=64, workspace=None):
+    """A deforming mesh: its world vertices (V, 3) move linearly from `start` at t0 to `end` at t1 (`workspace`:
+    as query_triangle)."""
     h = _mesh_arg(mesh)
     nv = mesh.info()["vertex_count"]
     a = _float_array(start, "start", (nv, 3))
     b = _float_array(end, "end", (nv, 3))
-    return _run_query(_L.sdfccd_query_mesh_linear, sdf, (h, a.ctypes.data, b.ctypes.data), t0, t1,
-                      _params_arg(params, method), max_contacts, sdf_motion)
+    return _run_query("query_mesh_linear", sdf, (h, a.ctypes.data, b.ctypes.data), t0, t1,
+                      _params_arg(params, method), max_contacts, sdf_motion, workspace)
 
 
 _BATCH_DTYPE = np.dtype(_lib.BatchQuery)

@@ -125,6 +125,7 @@ class BatchQuery(C.Structure):
 
 
 EvalFcn = C.CFUNCTYPE(C.c_double, Vec3, C.POINTER(Vec3), C.c_void_p)
+EvalXyzFcn = C.CFUNCTYPE(C.c_double, C.c_double, C.c_double, C.c_double, C.POINTER(Vec3), C.c_void_p)
 ProgressFcn = C.CFUNCTYPE(C.c_int32, C.c_double, C.c_void_p)
 
 
@@ -135,6 +136,7 @@ class CallbackSdfDef(C.Structure):
         ("lipschitz", C.c_double),
         ("bounds", Aabb),
         ("smooth", C.c_int32),
+        ("eval_xyz", EvalXyzFcn),
         ("internal_value", C.c_int32),
     ]
 
@@ -486,6 +488,15 @@ _OPTIONAL_PROTOTYPES = {
     "sdfccd_generate_contacts_linear": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, C.c_void_p, C.c_void_p,
                                              C.c_double, C.c_double, _P(ContactParams), C.c_void_p, C.c_int32,
                                              _P(ContactSet)]),
+    "sdfccd_query_triangle_ws": (_S, [C.c_void_p, SdfId, _P(RigidMotion), C.c_void_p, _P(RigidMotion), C.c_double,
+                                      C.c_double, _P(QueryParams), C.c_void_p, C.c_int32, _P(QueryResult)]),
+    "sdfccd_query_triangle_linear_ws": (_S, [C.c_void_p, SdfId, _P(RigidMotion), C.c_void_p, C.c_void_p, C.c_double,
+                                             C.c_double, _P(QueryParams), C.c_void_p, C.c_int32, _P(QueryResult)]),
+    "sdfccd_query_mesh_ws": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, _P(RigidMotion), C.c_double, C.c_double,
+                                  _P(QueryParams), C.c_void_p, C.c_int32, _P(QueryResult)]),
+    "sdfccd_query_mesh_linear_ws": (_S, [C.c_void_p, SdfId, _P(RigidMotion), MeshId, C.c_void_p, C.c_void_p,
+                                         C.c_double, C.c_double, _P(QueryParams), C.c_void_p, C.c_int32,
+                                         _P(QueryResult)]),
 }
 HAVE_CONTACTS = False
 

@@ -26,6 +26,12 @@ static double wobble_eval(sdfccd_Vec3 p, sdfccd_Vec3* g, void* user)
     return l - w->r + w->a * sin(w->f * p.x);
 }
 
+/* The same field with the point as three coordinates (sdfccd_CallbackSdfDef::eval_xyz). */
+static double wobble_eval_xyz(double x, double y, double z, sdfccd_Vec3* g, void* user)
+{
+    return wobble_eval((sdfccd_Vec3){ x, y, z }, g, user);
+}
+
 int LLVMFuzzerInitialize(int* argc, char*** argv)
 {
     (void)argc;
@@ -147,7 +153,8 @@ static int make_sdf(fuzz_in* in, made* m, wobble* w, sdfccd_SdfId* out)
         w->f = fabs(fmod(fz_double(in), 20.0));
         if (!isfinite(w->r) || !isfinite(w->a) || !isfinite(w->f)) return 0;
         sdfccd_CallbackSdfDef d = sdfccd_default_callback_sdf_def();
-        d.eval = wobble_eval;
+        if (w->f > 10.0) d.eval_xyz = wobble_eval_xyz; /* the other form, chosen by bytes already read */
+        else d.eval = wobble_eval;
         d.user = w;
         d.lipschitz = 1.0 + w->a * w->f;
         return keep(m, sdfccd_create_callback_sdf(&d, &id), id, out);

@@ -270,10 +270,13 @@ SDFCCD_API sdfccd_Status sdfccd_query_mesh_linear(sdfccd_SdfId sdf, const sdfccd
     const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
     sdfccd_QueryResult* out_result);
 
-/** A reusable workspace for mesh queries: the scratch storage of the broad phase and the contact
- * buffers, kept from call to call so that, after a first query of a given size, queries through
- * it allocate nothing (a physics engine querying every pair every step should keep one per
- * thread). A workspace may be used by one thread at a time; it holds no handle. */
+/** A reusable workspace for queries: the scratch storage of the broad phase, the contact buffers
+ * and the certified search's (FWGSS's check on fields with kinks and on grids: its first 1,024
+ * regions and its sample cache, 80,896 bytes, and on grids its cell cache, 54,272 bytes, each
+ * allocated at the first check that needs it), kept from call to call so that, after a first
+ * query of a given size, queries through it allocate nothing (a physics engine querying every
+ * pair every step should keep one per thread), and a query takes only a few KB of the calling
+ * thread's stack. A workspace may be used by one thread at a time; it holds no handle. */
 typedef struct sdfccd_Workspace sdfccd_Workspace;
 
 /** Creates an empty workspace (it grows on first use). */
@@ -282,6 +285,19 @@ SDFCCD_API sdfccd_Status sdfccd_create_workspace(sdfccd_Workspace** out_workspac
 SDFCCD_API void sdfccd_destroy_workspace(sdfccd_Workspace* workspace);
 /** Bytes the workspace holds (0 for NULL). */
 SDFCCD_API int64_t sdfccd_workspace_bytes(const sdfccd_Workspace* workspace);
+
+/** sdfccd_query_triangle with the certified search's scratch in `workspace` (not NULL); same
+ * results. Without a workspace a triangle query whose check runs allocates that scratch and frees
+ * it before returning. */
+SDFCCD_API sdfccd_Status sdfccd_query_triangle_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf,
+    const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 triangle[3], const sdfccd_RigidMotion* motion, double t0,
+    double t1, const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity,
+    sdfccd_QueryResult* out_result);
+
+/** sdfccd_query_triangle_linear with the certified search's scratch in `workspace` (not NULL); same results. */
+SDFCCD_API sdfccd_Status sdfccd_query_triangle_linear_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf,
+    const sdfccd_RigidMotion* sdf_motion, const sdfccd_Vec3 start[3], const sdfccd_Vec3 end[3], double t0, double t1,
+    const sdfccd_QueryParams* params, sdfccd_Contact* out_contacts, int32_t capacity, sdfccd_QueryResult* out_result);
 
 /** sdfccd_query_mesh with its scratch storage in `workspace` (not NULL); same results. */
 SDFCCD_API sdfccd_Status sdfccd_query_mesh_ws(sdfccd_Workspace* workspace, sdfccd_SdfId sdf,
